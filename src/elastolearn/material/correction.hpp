@@ -1,0 +1,26 @@
+#pragma once
+/// \file The material correction hook N(F̂, Ḟ̂) of paper 000, Eq. (1):
+///   P = U (P̂(F̂) + N(F̂, Ḟ̂)) Vᵀ,
+/// with F̂ the principal stretches (sorted descending) and Ḟ̂ = diag(Uᵀ Ḟ V) the stretch rates.
+#include <elastolearn/core/types.hpp>
+
+#include <memory>
+#include <string>
+
+namespace elastolearn::material {
+
+/// A correction to the principal stress: 6 inputs (stretches, stretch rates), 3 outputs [Pa].
+/// Implementations must be thread-safe and allocation-free in `correction`/`correction_gradient`.
+class Correction {
+public:
+  virtual ~Correction() = default;
+  virtual std::string name() const = 0;
+  /// N(F̂, Ḟ̂).
+  virtual Vec3 correction(const Vec3& stretches, const Vec3& stretch_rates) const = 0;
+  /// ∂N/∂F̂ (3×3, row = output) and ∂N/∂Ḟ̂ (3×3).
+  virtual void correction_gradient(const Vec3& stretches, const Vec3& stretch_rates,
+                                   Mat3& d_stretches, Mat3& d_stretch_rates) const = 0;
+  virtual std::unique_ptr<Correction> clone() const = 0;
+};
+
+} // namespace elastolearn::material
