@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,49 @@ struct TrajectoryData {
 
 /// Write atomically (temporary file + rename). Throws InputError naming the path on failure.
 void write_trajectory_h5(const std::filesystem::path& path, const TrajectoryData& data);
+
+/// Incremental trajectory writer for long simulations: frames go straight to extendible,
+/// compressed datasets in `<path>.tmp-<pid>`; finish() publishes the file by rename. Destroyed
+/// without finish() (exception, divergence, Ctrl-C unwinding) it removes the temporary file,
+/// unless keep_partial() was called: then it finalises the frames written so far (used to keep
+/// the frames before a divergence). Every frame is validated before it is written, so whatever
+/// lands on disk passes read_trajectory_h5(). `write_trajectory_h5` is this class in one call.
+class TrajectoryWriter {
+public:
+  /// Start the file with the rest state (n×3, n ≥ 1, finite) and the optional elements (indices
+  /// in [0, n)). Throws InputError naming `path` on invalid data or when the file cannot be made.
+  TrajectoryWriter(const std::filesystem::path& path, ConstRef<Positions> rest_positions,
+                   const Tets& tets = Tets(), const Edges& edges = Edges(),
+                   const Faces& faces = Faces());
+  ~TrajectoryWriter();
+  TrajectoryWriter(TrajectoryWriter&&) noexcept;
+  TrajectoryWriter& operator=(TrajectoryWriter&&) noexcept;
+  TrajectoryWriter(const TrajectoryWriter&) = delete;
+  TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
+
+  /// Append one frame: `time` [s] finite and greater than the previous frame's, `positions` n×3
+  /// finite [m]. Either every frame has velocities (n×3 [m/s]) or none has. A rejected frame
+  /// throws InputError and leaves the file as it was.
+  void append(double time, ConstRef<Positions> positions);
+  void append(double time, ConstRef<Positions> positions, ConstRef<Positions> velocities);
+
+  /// Write `metadata` as root string attributes ("format" is reserved), close the file and move
+  /// it onto the target path. Throws InputError; afterwards the writer accepts nothing more.
+  void finish(const std::map<std::string, std::string>& metadata = {});
+
+  /// On destruction without finish(), publish the frames written so far with `metadata`
+  /// (plus `status = "partial"` unless given) instead of discarding them.
+  void keep_partial(std::map<std::string, std::string> metadata = {});
+
+  /// Frames appended so far.
+  long frames() const;
+  /// The target path.
+  const std::filesystem::path& path() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> m_impl;
+};
 
 /// Read and validate (shapes consistent, indices in range, finite values).
 /// Throws InputError naming the file and dataset on any problem.

@@ -1,0 +1,42 @@
+#pragma once
+/// \file One small interface for every force term (as PolyFEM's forms): elastic(+correction),
+/// damping, gravity, loads, and later position pulls. The integrator sums terms and never knows
+/// which material it runs.
+#include <elastolearn/core/types.hpp>
+#include <elastolearn/fem/system_matrix.hpp>
+
+namespace elastolearn::fem {
+
+/// The state a force is evaluated at: flat 3n positions and velocities, and time [s].
+struct ForceState {
+  const VecX& x;
+  const VecX& v;
+  double time = 0;
+};
+
+class ForceTerm {
+public:
+  virtual ~ForceTerm() = default;
+  /// f += force(x, v, t) (full 3n vector, N).
+  virtual void add_force(const ForceState& state, VecX& f) = 0;
+  /// f += force, and A += c_x·K + c_v·D over the free dofs, where K ≈ −∂f/∂x and D ≈ −∂f/∂v are
+  /// the term's positive semi-definite (projected) Jacobians. Terms without Jacobians (constant
+  /// loads) only add the force.
+  virtual void add_force_and_jacobian(const ForceState& state, double c_x, double c_v, VecX& f,
+                                      SystemMatrix& A) {
+    add_force(state, f);
+  }
+};
+
+/// A constant external force (gravity, or any fixed nodal load): f += value.
+class ConstantForce final : public ForceTerm {
+public:
+  explicit ConstantForce(VecX value) : m_value(std::move(value)) {}
+  void add_force(const ForceState&, VecX& f) override { f += m_value; }
+  const VecX& value() const { return m_value; }
+
+private:
+  VecX m_value;
+};
+
+} // namespace elastolearn::fem

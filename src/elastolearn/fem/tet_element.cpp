@@ -1,0 +1,38 @@
+#include <elastolearn/fem/tet_element.hpp>
+
+#include <Eigen/LU>
+
+namespace elastolearn::fem {
+
+std::vector<TetRestData> precompute_rest_data(const mesh::TetMesh& mesh) {
+  const auto& X = mesh.rest_positions();
+  const auto& T = mesh.tets();
+  std::vector<TetRestData> out(mesh.num_tets());
+  for (int e = 0; e < mesh.num_tets(); ++e) {
+    Mat3 Dm;
+    for (int c = 0; c < 3; ++c) Dm.col(c) = (X.row(T(e, c + 1)) - X.row(T(e, 0))).transpose();
+    const Mat3 Dm_inv = Dm.inverse(); // TetMesh guarantees non-degenerate, positive tets
+    out[e].volume = Dm.determinant() / 6.0;
+    out[e].gradients.rightCols<3>() = Dm_inv.transpose();
+    out[e].gradients.col(0) = -Dm_inv.transpose().rowwise().sum();
+  }
+  return out;
+}
+
+Mat12 element_matrix_from_tangent(const Mat9& H, const TetRestData& rest) {
+  const auto& g = rest.gradients;
+  // W = H B: column (3b + k) of B has g_b[l] at row (k + 3l).
+  Eigen::Matrix<double, 9, 12> W;
+  for (int b = 0; b < 4; ++b)
+    for (int k = 0; k < 3; ++k)
+      W.col(3 * b + k) = H.col(k) * g(0, b) + H.col(k + 3) * g(1, b) + H.col(k + 6) * g(2, b);
+  // K = Bᵀ W: row (3a + i) = Σ_j g_a[j] W.row(i + 3j).
+  Mat12 K;
+  for (int a = 0; a < 4; ++a)
+    for (int i = 0; i < 3; ++i)
+      K.row(3 * a + i) = rest.volume * (g(0, a) * W.row(i) + g(1, a) * W.row(i + 3) +
+                                        g(2, a) * W.row(i + 6));
+  return K;
+}
+
+} // namespace elastolearn::fem

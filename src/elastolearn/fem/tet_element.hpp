@@ -1,0 +1,36 @@
+#pragma once
+/// \file Per-tet rest-state precomputation for linear tetrahedra (paper 000 §4.1, "B_m").
+#include <elastolearn/core/types.hpp>
+#include <elastolearn/mesh/tet_mesh.hpp>
+
+#include <vector>
+
+namespace elastolearn::fem {
+
+/// Rest data of one linear tet: volume and the gradients of its four shape functions.
+/// F = Σ_a x_a g_aᵀ = Ds Dm⁻¹, so g_1..g_3 are the rows of Dm⁻¹ and g_0 = −(g_1 + g_2 + g_3).
+struct TetRestData {
+  double volume = 0;                          ///< rest volume [m³]
+  Eigen::Matrix<double, 3, 4> gradients;      ///< column a = ∂N_a/∂X [1/m]
+};
+
+/// Precompute the rest data of every tet (once per mesh).
+std::vector<TetRestData> precompute_rest_data(const mesh::TetMesh& mesh);
+
+/// Gather the 4 vertex 3-vectors of tet `tet` from a flat 3n vector into a 3×4 matrix.
+inline Eigen::Matrix<double, 3, 4> gather_tet(const VecX& flat, const Eigen::Vector4i& tet) {
+  Eigen::Matrix<double, 3, 4> out;
+  for (int a = 0; a < 4; ++a) out.col(a) = flat.segment<3>(3 * tet[a]);
+  return out;
+}
+
+/// F = Σ_a x_a g_aᵀ for vertex positions (or velocities, giving Ḟ) as columns of `x`.
+inline Mat3 deformation_gradient(const Eigen::Matrix<double, 3, 4>& x, const TetRestData& rest) {
+  return x * rest.gradients.transpose();
+}
+
+/// Element 12×12 matrix vol · Bᵀ H B with B = ∂vec(F)/∂x_e (column-major vec(F); x_e ordered
+/// x0,y0,z0,x1,...). Exploits B's Kronecker structure: ~750 multiply-adds instead of ~2300.
+Mat12 element_matrix_from_tangent(const Mat9& H, const TetRestData& rest);
+
+} // namespace elastolearn::fem

@@ -1,0 +1,39 @@
+#pragma once
+/// \file Scene JSON files ("format": "elastolearn-scene/1"); the format is documented in
+/// docs/scene_format.md. Every error names the file and the field.
+#include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/sim/scene.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace elastolearn::io {
+
+/// Where a scene asks its results to go (paths relative to the scene file's folder).
+struct SceneOutputs {
+  std::optional<std::filesystem::path> trajectory; ///< HDF5
+  std::optional<std::filesystem::path> vtu_directory;
+  int every = 1;                                   ///< record every k-th frame
+};
+
+struct SceneFile {
+  sim::Scene scene;
+  SceneOutputs outputs;
+  std::filesystem::path path;
+};
+
+/// Read and validate a scene file. Throws InputError naming the file and field.
+SceneFile read_scene_file(const std::filesystem::path& path);
+
+/// Parse a scene from JSON already in memory; `file` is used in messages and `base_dir` to
+/// resolve relative paths.
+SceneFile parse_scene(const nlohmann::json& json, const std::string& file,
+                      const std::filesystem::path& base_dir);
+
+/// A vertex selection: {"vertices": [...]} | {"box": {"min": [..], "max": [..]}} |
+/// {"plane": {"axis": "x"|"y"|"z", "value": v, "tolerance": t}} | {"min": "x"} | {"max": "y"}
+/// (the vertices at the extreme coordinate along an axis, within 1e-9 of the bounding box).
+std::vector<int> parse_selection(const JsonObject& object, const mesh::TetMesh& mesh);
+
+} // namespace elastolearn::io

@@ -1,0 +1,20 @@
+#pragma once
+/// \file The "material" object of scene files (and of learned-material files):
+///   {"model": "corotated"|"stvk"|"neohookean"|"spline_edited", "young": Pa, "poisson": ν,
+///    "density": kg/m³,
+///    "edit": {"base": "neohookean"|"corotated", "region": "tension"|"compression",
+///             "stretches": [...], "scales": [...]}            (spline_edited only)
+///    "damping": {"alpha0": 1/s, "alpha1": s}
+///            or {"alpha0": {"stretches": [...], "values": [...]},
+///                "alpha1": {"stretches": [...], "values": [...]}} (splines of the largest stretch)}
+#include <elastolearn/fem/elastic_force.hpp>
+#include <elastolearn/io/json_fields.hpp>
+
+#include <nlohmann/json.hpp>
+
+namespace elastolearn::io {
+
+/// Build the material model; errors name the file and field.
+fem::MaterialModel parse_material(const JsonObject& object);
+
+} // namespace elastolearn::io

@@ -1,0 +1,39 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/material/stretch_dependent_rayleigh.hpp>
+
+#include <sstream>
+
+namespace elastolearn::material {
+
+namespace {
+void check_spline(const CubicSpline& s, const std::string& where) {
+    if (s.min_value() < 0) {
+        std::ostringstream os;
+        os << "Rayleigh coefficient spline must be non-negative, got a knot value "
+           << s.min_value();
+        throw InputError(where, os.str());
+    }
+}
+} // namespace
+
+StretchDependentRayleigh::StretchDependentRayleigh(
+    CubicSpline alpha0, CubicSpline alpha1, const std::string& where)
+    : m_alpha0(std::move(alpha0))
+    , m_alpha1(std::move(alpha1)) {
+    check_spline(m_alpha0, where + ".alpha0");
+    check_spline(m_alpha1, where + ".alpha1");
+}
+
+RayleighCoefficients StretchDependentRayleigh::coefficients(double max_stretch) const {
+    return { m_alpha0.value(max_stretch), m_alpha1.value(max_stretch) };
+}
+
+RayleighCoefficients StretchDependentRayleigh::coefficient_derivatives(double max_stretch) const {
+    return { m_alpha0.derivative(max_stretch), m_alpha1.derivative(max_stretch) };
+}
+
+std::unique_ptr<DampingModel> StretchDependentRayleigh::clone() const {
+    return std::make_unique<StretchDependentRayleigh>(*this);
+}
+
+} // namespace elastolearn::material

@@ -1,0 +1,102 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/sim/newton.hpp>
+
+#include <chrono>
+#include <cmath>
+
+namespace elastolearn::sim {
+
+void NewtonOptions::validate() const {
+  if (!(relative_tolerance > 0 && relative_tolerance < 1))
+    throw InputError("newton.relative_tolerance", "must be in (0, 1), got " + std::to_string(relative_tolerance));
+  if (!(absolute_tolerance >= 0))
+    throw InputError("newton.absolute_tolerance", "must be >= 0");
+  if (max_iterations < 1) throw InputError("newton.max_iterations", "must be >= 1");
+  if (max_line_search < 0) throw InputError("newton.max_line_search", "must be >= 0");
+}
+
+SolverTimings& SolverTimings::operator+=(const SolverTimings& o) {
+  assembly += o.assembly;
+  factorization += o.factorization;
+  solve += o.solve;
+  return *this;
+}
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+} // namespace
+
+NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatrix& A,
+                          LinearSolver& solver, const NewtonOptions& options) {
+  NewtonReport report;
+  VecX g(u.size()), g_trial(u.size()), du = VecX::Zero(u.size()), u_prev(u.size());
+  auto evaluate = [&](const VecX& at) {
+    const auto t0 = Clock::now();
+    problem.residual_and_jacobian(at, g, A);
+    report.timings.assembly += seconds_since(t0);
+    return g.norm();
+  };
+  double norm = evaluate(u);
+  report.initial_residual = norm;
+  const double target =
+      std::max(options.relative_tolerance * report.initial_residual, options.absolute_tolerance);
+  for (;;) {
+    report.residual = norm;
+    if (!std::isfinite(norm)) {
+      report.message = "residual is not finite";
+      return report;
+    }
+    if (norm <= target) {
+      report.converged = true;
+      return report;
+    }
+    if (report.iterations == options.max_iterations) {
+      report.message = "no convergence in " + std::to_string(report.iterations) +
+                       " Newton iterations (residual " + std::to_string(norm) + ", target " +
+                       std::to_string(target) + ")";
+      return report;
+    }
+    ++report.iterations;
+    auto t0 = Clock::now();
+    if (!solver.factorize(A.matrix())) {
+      report.message = "system matrix is not positive definite";
+      return report;
+    }
+    report.timings.factorization += seconds_since(t0);
+    t0 = Clock::now();
+    du.setZero();
+    // Inexact Newton for iterative solvers: solve only as accurately as the outer iteration needs.
+    const double linear_tol = std::clamp(0.1 * target / norm, 1e-12, 1e-2);
+    const bool solved = solver.solve(-g, du, linear_tol);
+    report.timings.solve += seconds_since(t0);
+    report.linear_iterations += solver.last_iterations();
+    if (!solved) {
+      report.message = "linear solve failed";
+      return report;
+    }
+    // Full step first: its residual comes with the Jacobian the next iteration needs anyway.
+    u_prev = u;
+    const double norm_prev = norm;
+    u = u_prev + du;
+    norm = evaluate(u);
+    if (std::isfinite(norm) && norm <= (1 - 1e-4) * norm_prev) continue;
+    // Backtracking on ‖g‖ (residual only); keep the best trial if none decreases it enough.
+    double alpha = 0.5, best_alpha = 1, best_norm = std::isfinite(norm) ? norm : INFINITY;
+    t0 = Clock::now();
+    for (int ls = 0; ls < options.max_line_search; ++ls, alpha *= 0.5) {
+      u = u_prev + alpha * du;
+      problem.residual(u, g_trial);
+      const double trial = g_trial.norm();
+      if (trial < best_norm) best_norm = trial, best_alpha = alpha;
+      if (trial <= (1 - 1e-4 * alpha) * norm_prev) break;
+    }
+    report.timings.assembly += seconds_since(t0);
+    u = u_prev + best_alpha * du;
+    norm = evaluate(u);
+  }
+}
+
+} // namespace elastolearn::sim

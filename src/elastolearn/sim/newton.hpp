@@ -1,0 +1,55 @@
+#pragma once
+/// \file One Newton solver with backtracking line search, shared by the dynamic step and the
+/// static equilibrium solve. The Jacobian is the projected (PSD) one, so the step is a descent
+/// direction for the incremental potential; the line search accepts a step that reduces ‖g‖.
+#include <elastolearn/core/types.hpp>
+#include <elastolearn/fem/system_matrix.hpp>
+#include <elastolearn/sim/linear_solver.hpp>
+
+#include <functional>
+#include <string>
+
+namespace elastolearn::sim {
+
+struct NewtonOptions {
+  double relative_tolerance = 1e-6; ///< stop when ‖g‖ ≤ tol · ‖g₀‖ …
+  double absolute_tolerance = 0;    ///< … or ‖g‖ ≤ this [N] (0: chosen by the caller's scale)
+  int max_iterations = 50;
+  int max_line_search = 12;         ///< step halvings before taking the best trial
+  /// Throws InputError naming the offending option.
+  void validate() const;
+};
+
+/// Accumulated wall time of the stages of Newton solves [s].
+struct SolverTimings {
+  double assembly = 0;
+  double factorization = 0;
+  double solve = 0;
+  SolverTimings& operator+=(const SolverTimings& o);
+};
+
+struct NewtonReport {
+  bool converged = false;
+  int iterations = 0;
+  int linear_iterations = 0;
+  double initial_residual = 0;
+  double residual = 0;
+  std::string message; ///< why it stopped when not converged
+  SolverTimings timings;
+};
+
+/// The nonlinear system g(u) = 0 over the free dofs.
+struct NewtonProblem {
+  /// g(u).
+  std::function<void(const VecX& u, VecX& g)> residual;
+  /// g(u) and its (PSD) Jacobian written into A (A is zeroed by the callee).
+  std::function<void(const VecX& u, VecX& g, fem::SystemMatrix& A)> residual_and_jacobian;
+};
+
+/// Solve g(u) = 0 starting from u. The solver's symbolic analysis must already be done on A's
+/// pattern. Never throws on divergence: non-finite values or no convergence give a report
+/// with `converged == false` and a message.
+NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatrix& A,
+                          LinearSolver& solver, const NewtonOptions& options);
+
+} // namespace elastolearn::sim

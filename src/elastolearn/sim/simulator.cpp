@@ -1,0 +1,202 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/fem/mass.hpp>
+#include <elastolearn/sim/simulator.hpp>
+
+namespace elastolearn::sim {
+
+Simulator::Simulator(const Scene& scene) : m_scene(scene) {
+  m_scene.validate();
+  const auto& mesh = m_scene.mesh;
+  m_dofs = fem::DofMap(mesh.num_vertices(), m_scene.prescribed_vertices());
+  if (m_dofs.num_free() == 0) throw InputError("fixed", "every vertex is fixed or keyframed: nothing to simulate");
+  m_system = fem::SystemMatrix(mesh.tets(), m_dofs);
+  m_elastic = std::make_unique<fem::ElasticForce>(mesh, m_scene.material);
+  m_dof_masses = fem::lumped_dof_masses(fem::lumped_vertex_masses(
+      mesh.tets(), m_elastic->rest_data(), mesh.num_vertices(), m_scene.material.density));
+  m_reduced_masses = m_dofs.restrict(m_dof_masses);
+  if (m_scene.mass == fem::MassType::Consistent) {
+    const auto blocks = fem::consistent_mass_blocks(m_elastic->rest_data(), m_scene.material.density);
+    m_system.set_zero();
+    m_system.add_element_blocks(blocks);
+    m_consistent_values = m_system.values();
+    fem::DofMap all(mesh.num_vertices(), {});
+    fem::SystemMatrix full(mesh.tets(), all);
+    full.add_element_blocks(blocks);
+    m_consistent = full.matrix();
+  }
+  m_loads = std::make_unique<ExternalLoads>(m_dof_masses, m_scene.gravity, m_scene.loads);
+  m_solver = make_linear_solver(m_scene.linear_solver);
+  m_solver->analyze(m_system.matrix());
+  if (m_scene.newton.absolute_tolerance == 0)
+    m_scene.newton.absolute_tolerance = 1e-10 * std::max(1.0, m_dof_masses.sum() / 3.0);
+  m_x = flatten(mesh.rest_positions());
+  m_v = VecX::Zero(m_x.size());
+  m_x_prescribed = prescribed_positions(0);
+}
+
+VecX Simulator::prescribed_positions(double t) const {
+  VecX x = flatten(m_scene.mesh.rest_positions());
+  for (const auto& k : m_scene.keyframes) {
+    const Vec3 offset = k.offset_at(t);
+    for (int v : k.vertices) x.segment<3>(3 * v) += offset;
+  }
+  return x;
+}
+
+void Simulator::set_state(const VecX& x, const VecX& v, double time) {
+  ELASTOLEARN_CHECK(x.size() == m_x.size() && v.size() == m_v.size(), "state size mismatch");
+  m_x = x;
+  m_v = v;
+  m_time = time;
+}
+
+double Simulator::kinetic_energy() const {
+  if (m_scene.mass == fem::MassType::Consistent) return 0.5 * m_v.dot(m_consistent * m_v);
+  return 0.5 * m_v.dot(m_dof_masses.cwiseProduct(m_v));
+}
+
+void Simulator::apply_mass(const VecX& dv, VecX& out) const {
+  if (m_scene.mass == fem::MassType::Consistent) out.noalias() = m_consistent * dv;
+  else out = m_dof_masses.cwiseProduct(dv);
+}
+
+void Simulator::sum_forces(const VecX& x, const VecX& v, double t, VecX& f) {
+  f.setZero(x.size());
+  const fem::ForceState state{x, v, t};
+  m_elastic->add_force(state, f);
+  m_loads->add_force(state, f);
+  for (auto* term : m_extra_terms) term->add_force(state, f);
+}
+
+void Simulator::sum_forces_and_jacobian(const VecX& x, const VecX& v, double t, double c_x,
+                                        double c_v, VecX& f) {
+  f.setZero(x.size());
+  m_system.set_zero();
+  const fem::ForceState state{x, v, t};
+  m_elastic->add_force_and_jacobian(state, c_x, c_v, f, m_system);
+  m_loads->add_force_and_jacobian(state, c_x, c_v, f, m_system);
+  for (auto* term : m_extra_terms) term->add_force_and_jacobian(state, c_x, c_v, f, m_system);
+}
+
+NewtonReport Simulator::step() {
+  const double h = m_scene.dt;
+  const double t_next = (m_step + 1) * h;
+  m_x_prescribed = prescribed_positions(t_next);
+  // Unknowns: free end-of-step velocities; prescribed velocities follow the keyframes.
+  auto state_from = [&](const VecX& u) {
+    m_v_new = m_v;
+    for (int v = 0; v < m_scene.mesh.num_vertices(); ++v)
+      if (m_dofs.is_prescribed_vertex(v))
+        m_v_new.segment<3>(3 * v) = (m_x_prescribed.segment<3>(3 * v) - m_x.segment<3>(3 * v)) / h;
+    const auto& free = m_dofs.free_dofs();
+    for (size_t i = 0; i < free.size(); ++i) m_v_new[free[i]] = u[i];
+    m_x_new = m_x + h * m_v_new;
+  };
+  auto inertia_minus_force = [&](VecX& g) {
+    m_dv = m_v_new - m_v;
+    apply_mass(m_dv, m_mass_dv);
+    m_force = m_mass_dv / h - m_force;
+    g = m_dofs.restrict(m_force);
+  };
+  NewtonProblem problem;
+  problem.residual = [&](const VecX& u, VecX& g) {
+    state_from(u);
+    sum_forces(m_x_new, m_v_new, t_next, m_force);
+    inertia_minus_force(g);
+  };
+  problem.residual_and_jacobian = [&](const VecX& u, VecX& g, fem::SystemMatrix& A) {
+    state_from(u);
+    sum_forces_and_jacobian(m_x_new, m_v_new, t_next, h, 1.0, m_force);
+    if (m_scene.mass == fem::MassType::Consistent) A.add_values(m_consistent_values, 1 / h);
+    else A.add_diagonal(m_reduced_masses, 1 / h);
+    inertia_minus_force(g);
+  };
+  VecX u = m_dofs.restrict(m_v);
+  NewtonReport report = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+  if (!report.converged) return report;
+  state_from(u);
+  if (!m_x_new.allFinite()) {
+    report.converged = false;
+    report.message = "state is not finite";
+    return report;
+  }
+  m_x = m_x_new;
+  m_v = m_v_new;
+  m_time = t_next;
+  ++m_step;
+  return report;
+}
+
+NewtonReport Simulator::solve_static(int load_steps) {
+  ELASTOLEARN_CHECK(load_steps >= 1, "load_steps must be positive");
+  const VecX x0 = m_x;
+  const VecX zero = VecX::Zero(m_x.size());
+  m_x_prescribed = prescribed_positions(m_time);
+  auto state_from = [&](const VecX& u) {
+    m_x_new = m_x_prescribed;
+    const auto& free = m_dofs.free_dofs();
+    for (size_t i = 0; i < free.size(); ++i) m_x_new[free[i]] = u[i];
+  };
+  NewtonProblem problem;
+  problem.residual = [&](const VecX& u, VecX& g) {
+    state_from(u);
+    sum_forces(m_x_new, zero, m_time, m_force);
+    g = -m_dofs.restrict(m_force);
+  };
+  problem.residual_and_jacobian = [&](const VecX& u, VecX& g, fem::SystemMatrix& A) {
+    state_from(u);
+    sum_forces_and_jacobian(m_x_new, zero, m_time, 1.0, 0.0, m_force);
+    g = -m_dofs.restrict(m_force);
+  };
+  VecX u = m_dofs.restrict(m_x);
+  NewtonReport total;
+  total.converged = true;
+  for (int k = 1; k <= load_steps; ++k) {
+    m_loads->set_scale(double(k) / load_steps);
+    NewtonReport r = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+    total.iterations += r.iterations;
+    total.linear_iterations += r.linear_iterations;
+    total.timings += r.timings;
+    total.residual = r.residual;
+    if (k == 1) total.initial_residual = r.initial_residual;
+    if (!r.converged) {
+      total.converged = false;
+      total.message = "static solve, load step " + std::to_string(k) + "/" + std::to_string(load_steps) + ": " + r.message;
+      break;
+    }
+  }
+  m_loads->set_scale(1.0);
+  if (!total.converged) {
+    m_x = x0;
+    return total;
+  }
+  state_from(u);
+  m_x = m_x_new;
+  m_v.setZero();
+  return total;
+}
+
+NewtonReport Simulator::apply_initial_condition() {
+  const auto& ic = m_scene.initial;
+  m_x = flatten(m_scene.mesh.rest_positions());
+  m_v.setZero();
+  m_time = 0;
+  m_step = 0;
+  NewtonReport report;
+  report.converged = true;
+  if (ic.kind == InitialCondition::Kind::Velocity) {
+    const auto& X = m_scene.mesh.rest_positions();
+    for (int v = 0; v < m_scene.mesh.num_vertices(); ++v)
+      if (!m_dofs.is_prescribed_vertex(v))
+        m_v.segment<3>(3 * v) = ic.velocity + ic.angular_velocity.cross(X.row(v).transpose() - ic.center);
+  } else if (ic.kind == InitialCondition::Kind::StaticLoad) {
+    // Equilibrium under gravity and the initial loads; the scene's own loads are not applied.
+    auto scene_loads = std::move(m_loads);
+    m_loads = std::make_unique<ExternalLoads>(m_dof_masses, m_scene.gravity, ic.static_loads);
+    report = solve_static(ic.load_steps);
+    m_loads = std::move(scene_loads);
+  }
+  return report;
+}
+
+} // namespace elastolearn::sim

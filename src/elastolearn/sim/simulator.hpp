@@ -1,0 +1,80 @@
+#pragma once
+/// \file Backward (implicit) Euler time stepping of a scene, paper 000 Eq. (2):
+///   M (v₊ − v)/h = f(x₊, v₊, t₊),  x₊ = x + h v₊,
+/// forces at the end of the step, solved for v₊ by Newton with the PSD Jacobian
+/// M/h + D + h K. Fixed and keyframed vertices are removed from the system; the sparsity
+/// pattern and the solver's symbolic analysis are built once, in the constructor.
+#include <elastolearn/core/types.hpp>
+#include <elastolearn/fem/dof_map.hpp>
+#include <elastolearn/fem/elastic_force.hpp>
+#include <elastolearn/fem/system_matrix.hpp>
+#include <elastolearn/sim/boundary_conditions.hpp>
+#include <elastolearn/sim/linear_solver.hpp>
+#include <elastolearn/sim/newton.hpp>
+#include <elastolearn/sim/scene.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace elastolearn::sim {
+
+class Simulator {
+public:
+  /// Precompute everything for `scene` (validated here). Starts at rest at t = 0; call
+  /// `apply_initial_condition()` to set the scene's initial state.
+  explicit Simulator(const Scene& scene);
+
+  /// Set the scene's initial condition (rest, velocity field, or static equilibrium under a load).
+  /// Returns the static solve's report (converged = true for the other kinds).
+  NewtonReport apply_initial_condition();
+
+  /// Advance one time step. On failure (Newton did not converge, non-finite state) the state is
+  /// left unchanged and the report says why.
+  NewtonReport step();
+
+  /// Static equilibrium f(x) = 0 under the current loads scaled by 1/load_steps … 1 (load stepping).
+  NewtonReport solve_static(int load_steps = 1);
+
+  const VecX& positions() const { return m_x; }   ///< flat 3n [m]
+  const VecX& velocities() const { return m_v; }  ///< flat 3n [m/s]
+  double time() const { return m_time; }
+  int step_index() const { return m_step; }
+  void set_state(const VecX& x, const VecX& v, double time);
+
+  double kinetic_energy() const;
+  double elastic_energy() const { return m_elastic->elastic_energy(m_x); }
+  /// Prescribed positions of all dofs at time t (free entries hold the rest positions).
+  VecX prescribed_positions(double t) const;
+
+  const Scene& scene() const { return m_scene; }
+  const fem::DofMap& dofs() const { return m_dofs; }
+  const fem::SystemMatrix& system_matrix() const { return m_system; }
+  fem::ElasticForce& elastic_force() { return *m_elastic; }
+  const VecX& dof_masses() const { return m_dof_masses; }
+  /// Add a force term (e.g. control forces, position pulls). Not owned; must outlive the simulator.
+  void add_force_term(fem::ForceTerm* term) { m_extra_terms.push_back(term); }
+
+private:
+  void sum_forces(const VecX& x, const VecX& v, double t, VecX& f);
+  void sum_forces_and_jacobian(const VecX& x, const VecX& v, double t, double c_x, double c_v, VecX& f);
+  void apply_mass(const VecX& dv, VecX& out) const; ///< out = M dv (full 3n)
+
+  Scene m_scene;
+  fem::DofMap m_dofs;
+  fem::SystemMatrix m_system;
+  std::unique_ptr<fem::ElasticForce> m_elastic;
+  std::unique_ptr<ExternalLoads> m_loads;
+  std::vector<fem::ForceTerm*> m_extra_terms;
+  std::unique_ptr<LinearSolver> m_solver;
+  VecX m_dof_masses;               ///< lumped, full 3n
+  VecX m_reduced_masses;           ///< lumped, free dofs
+  fem::SparseMatrix m_consistent;  ///< full 3n×3n consistent mass (empty when lumped)
+  VecX m_consistent_values;        ///< consistent mass values in the system pattern
+  VecX m_x, m_v;
+  double m_time = 0;
+  int m_step = 0;
+  // Work vectors (no allocation per Newton iteration).
+  VecX m_x_new, m_v_new, m_force, m_dv, m_mass_dv, m_x_prescribed;
+};
+
+} // namespace elastolearn::sim

@@ -1,0 +1,99 @@
+// Inversion-safe SVD, stretch rates and the world-frame stress of principal_stress.hpp.
+#include <elastolearn/material/principal_stress.hpp>
+
+#include <support/material_states.hpp>
+
+#include <gtest/gtest.h>
+
+using namespace elastolearn;
+using namespace elastolearn::material;
+using namespace elastolearn::test;
+
+namespace {
+
+std::vector<MaterialState> svd_states() {
+    auto states = material_states();
+    states.push_back({ "reflection", Vec3(1, 1, -1).asDiagonal().toDenseMatrix() });
+    states.push_back({ "singular", rotated_stretch(Vec3(1.2, 0.7, 0.0), 41) });
+    states.push_back({ "rank_one", rotated_stretch(Vec3(1.5, 0.0, 0.0), 42) });
+    states.push_back({ "zero", Mat3::Zero() });
+    states.push_back({ "inverted_all_equal", rotated_stretch(Vec3(0.9, 0.9, -0.9), 43) });
+    states.push_back({ "point_reflection", -Mat3::Identity() });
+    return states;
+}
+
+} // namespace
+
+TEST(PrincipalFrame, ReconstructsFWithProperRotationsAndSortedStretches) {
+    for (const auto& state : svd_states()) {
+        SCOPED_TRACE(state.name);
+        const PrincipalFrame f = principal_frame(state.F);
+        // Jacobi SVD is backward stable: errors of a few ulps of ‖F‖.
+        const double tol = 1e-14 * std::max(1.0, state.F.norm());
+        EXPECT_LE((f.U * f.stretches.asDiagonal() * f.V.transpose() - state.F).norm(), tol);
+        EXPECT_LE((f.U.transpose() * f.U - Mat3::Identity()).norm(), 1e-14);
+        EXPECT_LE((f.V.transpose() * f.V - Mat3::Identity()).norm(), 1e-14);
+        EXPECT_NEAR(f.U.determinant(), 1.0, 1e-14);
+        EXPECT_NEAR(f.V.determinant(), 1.0, 1e-14);
+        EXPECT_GE(f.stretches[0], f.stretches[1]);
+        EXPECT_GE(f.stretches[1], f.stretches[2]);
+        EXPECT_GE(f.stretches[1], 0.0);
+        // Only the smallest stretch may be negative, and only for an inverted F.
+        EXPECT_GE(f.stretches[1], std::abs(f.stretches[2]));
+        const double det = state.F.determinant();
+        if (det < -1e-12) {
+            EXPECT_LT(f.stretches[2], 0.0);
+        }
+        if (det > 1e-12) {
+            EXPECT_GT(f.stretches[2], 0.0);
+        }
+    }
+}
+
+TEST(PrincipalFrame, InvertedStretchesAreRecovered) {
+    const Vec3 s(1.15, 0.8, -0.3);
+    const PrincipalFrame f = principal_frame(rotated_stretch(s, 6));
+    EXPECT_LE((f.stretches - s).norm(), 1e-14);
+    const PrincipalFrame g = principal_frame(-Mat3::Identity());
+    EXPECT_LE((g.stretches - Vec3(1, 1, -1)).norm(), 1e-14);
+}
+
+TEST(PrincipalFrame, StretchRatesAreDiagonalOfRotatedRate) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (const auto& state : material_states()) {
+        const PrincipalFrame f = principal_frame(state.F);
+        Mat3 Fdot;
+        for (int k = 0; k < 9; ++k)
+            Fdot.data()[k] = u(rng);
+        const Mat3 rotated = f.U.transpose() * Fdot * f.V;
+        EXPECT_LE((stretch_rates(f, Fdot) - rotated.diagonal()).norm(), 1e-14 * Fdot.norm())
+            << state.name;
+        // A rate along the principal directions, Ḟ = U diag(r) Vᵀ, is recovered exactly.
+        const Vec3 r(0.3, -0.2, 0.5);
+        EXPECT_LE((stretch_rates(f, f.U * r.asDiagonal() * f.V.transpose()) - r).norm(), 1e-14);
+    }
+}
+
+TEST(PrincipalFrame, FirstPiolaRotatesTheDiagonalStress) {
+    const PrincipalFrame f = principal_frame(rotated_stretch(Vec3(1.3, 0.9, 0.75), 2));
+    const Vec3 p(3.0, -1.0, 2.0);
+    const Mat3 P = first_piola(f, p);
+    EXPECT_LE((f.U.transpose() * P * f.V - Mat3(p.asDiagonal())).norm(), 1e-14 * p.norm());
+}
+
+TEST(FirstPiolaDerivative, UsesColumnMajorVecOnBothSides) {
+    // For P̂ = σ (P = F), dP/dF is the identity in any vec convention; for P̂ = (σ1, 0, 0) at a
+    // diagonal F only vec index 0 = (0,0) responds to F(0,0): checks the index layout.
+    const PrincipalFrame f = principal_frame(Vec3(1.5, 1.2, 0.8).asDiagonal().toDenseMatrix());
+    const Mat9 id = first_piola_derivative(f, f.stretches, Mat3::Identity(), false);
+    EXPECT_LE((id - Mat9::Identity()).norm(), 1e-14);
+    // P̂ = (σ1², 0, 0)-like non-symmetric function is not isotropic, so use the isotropic
+    // P̂ᵢ = σᵢ³: at diagonal F, ∂P(0,1)/∂F(0,1) = (σ0³σ0 − σ1³σ1)/(σ0² − σ1²) = σ0² + σ1².
+    const Vec3 s = f.stretches;
+    const Mat9 cubic = first_piola_derivative(
+        f, s.array().cube(), Mat3((3 * s.array().square()).matrix().asDiagonal()), false);
+    const int i01 = 0 + 3 * 1; // vec index of entry (0, 1)
+    EXPECT_NEAR(cubic(i01, i01), s[0] * s[0] + s[1] * s[1], 1e-13);
+    EXPECT_NEAR(cubic(0, 0), 3 * s[0] * s[0], 1e-13);
+}
