@@ -30,6 +30,7 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
               mesh::enclosed_volume(surface));
   mesh::TetrahedralizeReport report;
   const mesh::TetMesh tets = mesh::tetrahedralize(surface, args.options, &report, args.input);
+  if (report.holes_filled > 0) std::printf("filled %d holes of the surface\n", report.holes_filled);
   if (report.simplified)
     std::printf("simplified the surface to %d faces to reach the tet budget\n", report.surface_faces);
   for (const auto& run : report.runs)
@@ -65,10 +66,13 @@ void add_tetrahedralize_command(CLI::App& root) {
                   "minimum dihedral angle in degrees (TetGen -q ratio/angle; 0 = default)");
   cmd->add_option("--tetgen", args->options.tetgen_executable,
                   "TetGen program (default: $ELASTOLEARN_TETGEN or the one found at build time)");
+  cmd->add_flag("--fill-holes", args->options.fill_holes,
+                "close holes of an open surface (fan around each hole's centroid) before meshing");
   cmd->add_flag("-v,--verbose", args->options.verbose, "show TetGen's output");
   cmd->callback([args] { run_tetrahedralize(*args); });
 }
 
 } // namespace elastolearn::app
 
+using elastolearn::app::add_tetrahedralize_command;
 ELASTOLEARN_COMMAND(20, add_tetrahedralize_command)

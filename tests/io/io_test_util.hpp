@@ -14,12 +14,12 @@ namespace elastolearn::io::test {
 
 /// A fresh, empty directory for the current test, removed afterwards.
 class ScratchDir {
-public:
+  public:
   ScratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    m_path = std::filesystem::temp_directory_path() /
-             ("elastolearn_io_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-              std::to_string(::getpid()));
+    m_path = std::filesystem::temp_directory_path()
+        / ("elastolearn_io_" + std::string(info->test_suite_name()) + "_" + info->name() + "_"
+            + std::to_string(::getpid()));
     std::filesystem::remove_all(m_path);
     std::filesystem::create_directories(m_path);
   }
@@ -38,13 +38,13 @@ public:
     return names;
   }
 
-private:
+  private:
   std::filesystem::path m_path;
 };
 
 /// Run `f`, expect an InputError whose message contains every one of `parts`; returns the message.
-inline std::string expect_input_error(const std::function<void()>& f,
-                                      const std::vector<std::string>& parts) {
+inline std::string expect_input_error(
+    const std::function<void()>& f, const std::vector<std::string>& parts) {
   try {
     f();
   } catch (const InputError& e) {

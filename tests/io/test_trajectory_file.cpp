@@ -29,15 +29,19 @@ TrajectoryData make_trajectory(int frames, int n, bool velocities) {
     d.rest_positions.row(i) << std::sin(1.0 + i), std::cos(0.3 * i) / 3.0, i * 0.1 + 1.0 / 7.0;
   }
   d.tets.resize(n - 3, 4);
-  for (int k = 0; k < n - 3; ++k) d.tets.row(k) << k, k + 1, k + 2, k + 3;
+  for (int k = 0; k < n - 3; ++k)
+    d.tets.row(k) << k, k + 1, k + 2, k + 3;
   for (int t = 0; t < frames; ++t) {
     d.time.push_back(0.01 * (t + 1) / 3.0);
     Positions x = d.rest_positions;
-    for (int i = 0; i < n; ++i) x(i, 1) += 1e-3 * std::sin(0.7 * t + i);
+    for (int i = 0; i < n; ++i)
+      x(i, 1) += 1e-3 * std::sin(0.7 * t + i);
     d.positions.push_back(x);
-    if (velocities) d.velocities.push_back(Positions::Constant(n, 3, std::exp(-t) / 11.0));
+    if (velocities)
+      d.velocities.push_back(Positions::Constant(n, 3, std::exp(-t) / 11.0));
   }
-  d.metadata = {{"scene", "bar.json"}, {"dt", "0.0033333333333333335"}, {"note", "ünïcode ok"}};
+  d.metadata
+      = { { "scene", "bar.json" }, { "dt", "0.0033333333333333335" }, { "note", "ünïcode ok" } };
   return d;
 }
 
@@ -48,9 +52,11 @@ void expect_same(const TrajectoryData& a, const TrajectoryData& b) {
   EXPECT_EQ(a.faces, b.faces);
   EXPECT_EQ(a.time, b.time);
   ASSERT_EQ(a.positions.size(), b.positions.size());
-  for (std::size_t t = 0; t < a.positions.size(); ++t) EXPECT_EQ(a.positions[t], b.positions[t]);
+  for (std::size_t t = 0; t < a.positions.size(); ++t)
+    EXPECT_EQ(a.positions[t], b.positions[t]);
   ASSERT_EQ(a.velocities.size(), b.velocities.size());
-  for (std::size_t t = 0; t < a.velocities.size(); ++t) EXPECT_EQ(a.velocities[t], b.velocities[t]);
+  for (std::size_t t = 0; t < a.velocities.size(); ++t)
+    EXPECT_EQ(a.velocities[t], b.velocities[t]);
   EXPECT_EQ(a.metadata, b.metadata);
 }
 
@@ -62,16 +68,19 @@ struct RawFile {
 
   /// Valid: T = 3 frames of n = 5 vertices, 2 tets.
   RawFile() {
-    f64["/rest_positions"] = {std::vector<double>(15, 0.5), {5, 3}};
-    f64["/positions"] = {std::vector<double>(45, 0.25), {3, 5, 3}};
-    f64["/time"] = {{0.0, 0.1, 0.2}, {3}};
-    i32["/tets"] = {{0, 1, 2, 3, 1, 2, 3, 4}, {2, 4}};
+    f64["/rest_positions"] = { std::vector<double>(15, 0.5), { 5, 3 } };
+    f64["/positions"] = { std::vector<double>(45, 0.25), { 3, 5, 3 } };
+    f64["/time"] = { { 0.0, 0.1, 0.2 }, { 3 } };
+    i32["/tets"] = { { 0, 1, 2, 3, 1, 2, 3, 4 }, { 2, 4 } };
   }
   void write(const fs::path& path) const {
     h5::File file = h5::File::create(path);
-    for (const auto& [name, data] : f64) file.write(name, data.first.data(), data.second);
-    for (const auto& [name, data] : i32) file.write(name, data.first.data(), data.second);
-    if (format) file.set_attribute("format", *format);
+    for (const auto& [name, data] : f64)
+      file.write(name, data.first.data(), data.second);
+    for (const auto& [name, data] : i32)
+      file.write(name, data.first.data(), data.second);
+    if (format)
+      file.set_attribute("format", *format);
     file.close();
   }
 };
@@ -90,7 +99,7 @@ TEST(TrajectoryFile, RoundTripIsExact) {
   const TrajectoryData data = make_trajectory(7, 9, true);
   write_trajectory_h5(dir / "t.h5", data);
   expect_same(data, read_trajectory_h5(dir / "t.h5"));
-  EXPECT_EQ(dir.files(), std::vector<std::string>{"t.h5"}); // no temporary file left
+  EXPECT_EQ(dir.files(), std::vector<std::string> { "t.h5" }); // no temporary file left
 }
 
 TEST(TrajectoryFile, RoundTripOfASpringSystemWithoutTetsOrVelocities) {
@@ -98,7 +107,8 @@ TEST(TrajectoryFile, RoundTripOfASpringSystemWithoutTetsOrVelocities) {
   TrajectoryData data = make_trajectory(4, 6, false);
   data.tets.resize(0, 4);
   data.edges.resize(5, 2);
-  for (int i = 0; i < 5; ++i) data.edges.row(i) << i, i + 1;
+  for (int i = 0; i < 5; ++i)
+    data.edges.row(i) << i, i + 1;
   data.faces.resize(1, 3);
   data.faces.row(0) << 0, 2, 5;
   write_trajectory_h5(dir / "rope.h5", data);
@@ -116,7 +126,7 @@ TEST(TrajectoryFile, FramesAreCompressedWhenDeflateIsAvailable) {
   ScratchDir dir;
   write_trajectory_h5(dir / "t.h5", make_trajectory(3, 5, true));
   const h5::File file = h5::File::open(dir / "t.h5");
-  for (const char* name : {"/positions", "/velocities"}) {
+  for (const char* name : { "/positions", "/velocities" }) {
     const hid_t ds = H5Dopen2(file.id(), name, H5P_DEFAULT);
     const hid_t dcpl = H5Dget_create_plist(ds);
     EXPECT_EQ(H5Pget_layout(dcpl), H5D_CHUNKED) << name;
@@ -130,13 +140,15 @@ TEST(TrajectoryFile, MismatchedInputIsRejectedBeforeAnythingIsWritten) {
   ScratchDir dir;
   TrajectoryData data = make_trajectory(3, 5, false);
   data.time.pop_back();
-  expect_input_error([&] { write_trajectory_h5(dir / "t.h5", data); }, {"t.h5", "3 position frames but 2 times"});
+  expect_input_error([&] { write_trajectory_h5(dir / "t.h5", data); },
+      { "t.h5", "3 position frames but 2 times" });
   data = make_trajectory(3, 5, false);
   data.tets(1, 2) = 5;
-  expect_input_error([&] { write_trajectory_h5(dir / "t.h5", data); }, {"t.h5: /tets", "vertex index 5", "[0, 5)"});
+  expect_input_error([&] { write_trajectory_h5(dir / "t.h5", data); },
+      { "t.h5: /tets", "vertex index 5", "[0, 5)" });
   data = make_trajectory(3, 5, false);
   data.metadata["format"] = "mine";
-  expect_input_error([&] { write_trajectory_h5(dir / "t.h5", data); }, {"metadata key 'format'"});
+  expect_input_error([&] { write_trajectory_h5(dir / "t.h5", data); }, { "metadata key 'format'" });
   EXPECT_TRUE(dir.files().empty());
 }
 
@@ -147,8 +159,8 @@ TEST(TrajectoryFile, FailedWriteLeavesNoTemporaryAndKeepsTheOldFile) {
   TrajectoryData bad = make_trajectory(4, 5, false);
   bad.positions[2](3, 1) = std::numeric_limits<double>::quiet_NaN();
   expect_input_error([&] { write_trajectory_h5(dir / "t.h5", bad); },
-                     {"t.h5: /positions", "frame 2", "non-finite value nan at vertex 3"});
-  EXPECT_EQ(dir.files(), std::vector<std::string>{"t.h5"});
+      { "t.h5: /positions", "frame 2", "non-finite value nan at vertex 3" });
+  EXPECT_EQ(dir.files(), std::vector<std::string> { "t.h5" });
   expect_same(good, read_trajectory_h5(dir / "t.h5"));
 }
 
@@ -191,8 +203,7 @@ TEST(TrajectoryWriter, AbandonedWriterRemovesItsTemporaryFile) {
     writer.append(data.time[0], data.positions[0]);
     EXPECT_EQ(dir.files().size(), 1u); // the temporary file exists while writing
     throw std::runtime_error("simulation failed");
-  } catch (const std::runtime_error&) {
-  }
+  } catch (const std::runtime_error&) { }
   EXPECT_TRUE(dir.files().empty());
 }
 
@@ -201,18 +212,19 @@ TEST(TrajectoryWriter, KeepPartialPublishesTheFramesBeforeADivergence) {
   const TrajectoryData data = make_trajectory(6, 5, true);
   try {
     TrajectoryWriter writer(dir / "t.h5", data.rest_positions, data.tets);
-    writer.keep_partial({{"reason", "diverged at frame 4"}});
+    writer.keep_partial({ { "reason", "diverged at frame 4" } });
     for (std::size_t t = 0; t < data.positions.size(); ++t) {
-      if (t == 4) throw std::runtime_error("diverged");
+      if (t == 4)
+        throw std::runtime_error("diverged");
       writer.append(data.time[t], data.positions[t], data.velocities[t]);
     }
-  } catch (const std::runtime_error&) {
-  }
-  EXPECT_EQ(dir.files(), std::vector<std::string>{"t.h5"});
+  } catch (const std::runtime_error&) { }
+  EXPECT_EQ(dir.files(), std::vector<std::string> { "t.h5" });
   const TrajectoryData read = read_trajectory_h5(dir / "t.h5");
   ASSERT_EQ(read.positions.size(), 4u);
   ASSERT_EQ(read.velocities.size(), 4u);
-  for (int t = 0; t < 4; ++t) EXPECT_EQ(read.positions[t], data.positions[t]);
+  for (int t = 0; t < 4; ++t)
+    EXPECT_EQ(read.positions[t], data.positions[t]);
   EXPECT_EQ(read.metadata.at("status"), "partial");
   EXPECT_EQ(read.metadata.at("reason"), "diverged at frame 4");
 }
@@ -225,13 +237,14 @@ TEST(TrajectoryWriter, RejectedFrameLeavesTheFileConsistent) {
     writer.append(data.time[0], data.positions[0]);
     Positions bad = data.positions[1];
     bad(0, 0) = std::numeric_limits<double>::infinity();
-    expect_input_error([&] { writer.append(data.time[1], bad); }, {"/positions", "frame 1", "inf"});
-    expect_input_error([&] { writer.append(data.time[0], data.positions[1]); },
-                       {"/time", "does not increase"});
+    expect_input_error(
+        [&] { writer.append(data.time[1], bad); }, { "/positions", "frame 1", "inf" });
+    expect_input_error(
+        [&] { writer.append(data.time[0], data.positions[1]); }, { "/time", "does not increase" });
     expect_input_error([&] { writer.append(data.time[1], data.positions[1].topRows(4)); },
-                       {"has 4 vertices, expected 5"});
+        { "has 4 vertices, expected 5" });
     expect_input_error([&] { writer.append(data.time[1], data.positions[1], data.positions[1]); },
-                       {"/velocities", "earlier frames have none"});
+        { "/velocities", "earlier frames have none" });
     writer.append(data.time[1], data.positions[1]);
     writer.finish();
   }
@@ -244,93 +257,97 @@ TEST(TrajectoryWriter, RejectedFrameLeavesTheFileConsistent) {
 
 TEST(TrajectoryFileRejects, MissingDataset) {
   ScratchDir dir;
-  for (const char* name : {"/positions", "/time", "/rest_positions"}) {
+  for (const char* name : { "/positions", "/time", "/rest_positions" }) {
     RawFile raw;
     raw.f64.erase(name);
-    expect_rejected(raw, dir / "missing.h5", {name, "missing dataset"});
+    expect_rejected(raw, dir / "missing.h5", { name, "missing dataset" });
   }
 }
 
 TEST(TrajectoryFileRejects, WrongShapes) {
   ScratchDir dir;
   RawFile raw;
-  raw.f64["/positions"] = {std::vector<double>(36, 0.0), {3, 4, 3}};
-  expect_rejected(raw, dir / "a.h5", {"/positions", "expected shape (T, n, 3) = (3, 5, 3), got (3, 4, 3)"});
+  raw.f64["/positions"] = { std::vector<double>(36, 0.0), { 3, 4, 3 } };
+  expect_rejected(
+      raw, dir / "a.h5", { "/positions", "expected shape (T, n, 3) = (3, 5, 3), got (3, 4, 3)" });
   raw = RawFile();
-  raw.f64["/rest_positions"] = {std::vector<double>(10, 0.0), {5, 2}};
-  expect_rejected(raw, dir / "b.h5", {"/rest_positions", "expected shape (n, 3), got (5, 2)"});
+  raw.f64["/rest_positions"] = { std::vector<double>(10, 0.0), { 5, 2 } };
+  expect_rejected(raw, dir / "b.h5", { "/rest_positions", "expected shape (n, 3), got (5, 2)" });
   raw = RawFile();
-  raw.i32["/tets"] = {{0, 1, 2, 1, 2, 3}, {2, 3}};
-  expect_rejected(raw, dir / "c.h5", {"/tets", "expected shape (m, 4), got (2, 3)"});
+  raw.i32["/tets"] = { { 0, 1, 2, 1, 2, 3 }, { 2, 3 } };
+  expect_rejected(raw, dir / "c.h5", { "/tets", "expected shape (m, 4), got (2, 3)" });
 }
 
 TEST(TrajectoryFileRejects, FrameCountMismatchBetweenPositionsAndTime) {
   ScratchDir dir;
   RawFile raw;
-  raw.f64["/time"] = {{0.0, 0.1}, {2}};
-  expect_rejected(raw, dir / "t.h5", {"/positions", "has 3 frames but /time has 2"});
+  raw.f64["/time"] = { { 0.0, 0.1 }, { 2 } };
+  expect_rejected(raw, dir / "t.h5", { "/positions", "has 3 frames but /time has 2" });
 }
 
 TEST(TrajectoryFileRejects, OutOfRangeOrNegativeIndex) {
   ScratchDir dir;
   RawFile raw;
   raw.i32["/tets"].first[6] = 5;
-  expect_rejected(raw, dir / "a.h5", {"/tets", "vertex index 5 in row 1 is out of range [0, 5)"});
+  expect_rejected(raw, dir / "a.h5", { "/tets", "vertex index 5 in row 1 is out of range [0, 5)" });
   raw = RawFile();
-  raw.i32["/edges"] = {{0, -1}, {1, 2}};
-  expect_rejected(raw, dir / "b.h5", {"/edges", "vertex index -1 in row 0"});
+  raw.i32["/edges"] = { { 0, -1 }, { 1, 2 } };
+  expect_rejected(raw, dir / "b.h5", { "/edges", "vertex index -1 in row 0" });
 }
 
 TEST(TrajectoryFileRejects, FloatIndices) {
   ScratchDir dir;
   RawFile raw;
   raw.i32.erase("/tets");
-  raw.f64["/tets"] = {{0, 1, 2, 3}, {1, 4}};
-  expect_rejected(raw, dir / "t.h5", {"/tets", "expected an integer dataset, got float"});
+  raw.f64["/tets"] = { { 0, 1, 2, 3 }, { 1, 4 } };
+  expect_rejected(raw, dir / "t.h5", { "/tets", "expected an integer dataset, got float" });
 }
 
 TEST(TrajectoryFileRejects, NonFiniteValues) {
   ScratchDir dir;
   RawFile raw;
   raw.f64["/positions"].first[2 * 15 + 4 * 3 + 2] = std::numeric_limits<double>::quiet_NaN();
-  expect_rejected(raw, dir / "a.h5", {"/positions", "frame 2: non-finite value nan at vertex 4 (component 2)"});
+  expect_rejected(raw, dir / "a.h5",
+      { "/positions", "frame 2: non-finite value nan at vertex 4 (component 2)" });
   raw = RawFile();
   raw.f64["/rest_positions"].first[0] = -std::numeric_limits<double>::infinity();
-  expect_rejected(raw, dir / "b.h5", {"/rest_positions", "non-finite value -inf at vertex 0"});
+  expect_rejected(raw, dir / "b.h5", { "/rest_positions", "non-finite value -inf at vertex 0" });
   raw = RawFile();
   raw.f64["/time"].first[1] = std::numeric_limits<double>::quiet_NaN();
-  expect_rejected(raw, dir / "c.h5", {"/time", "frame 1: non-finite time"});
+  expect_rejected(raw, dir / "c.h5", { "/time", "frame 1: non-finite time" });
 }
 
 TEST(TrajectoryFileRejects, TimeThatDoesNotIncrease) {
   ScratchDir dir;
   RawFile raw;
-  raw.f64["/time"] = {{0.0, 0.2, 0.1}, {3}};
-  expect_rejected(raw, dir / "t.h5", {"/time", "frame 2: time 0.10000000000000001 does not increase"});
+  raw.f64["/time"] = { { 0.0, 0.2, 0.1 }, { 3 } };
+  expect_rejected(
+      raw, dir / "t.h5", { "/time", "frame 2: time 0.10000000000000001 does not increase" });
 }
 
 TEST(TrajectoryFileRejects, WrongOrMissingFormat) {
   ScratchDir dir;
   RawFile raw;
   raw.format = "elastolearn-scene/1";
-  expect_rejected(raw, dir / "a.h5", {"format 'elastolearn-scene/1' is not an elastolearn trajectory"});
+  expect_rejected(
+      raw, dir / "a.h5", { "format 'elastolearn-scene/1' is not an elastolearn trajectory" });
   raw.format = "elastolearn-trajectory/2";
-  expect_rejected(raw, dir / "b.h5", {"newer than this elastolearn reads"});
+  expect_rejected(raw, dir / "b.h5", { "newer than this elastolearn reads" });
   raw.format.reset();
-  expect_rejected(raw, dir / "c.h5", {"root attribute 'format' is missing"});
+  expect_rejected(raw, dir / "c.h5", { "root attribute 'format' is missing" });
 }
 
 TEST(TrajectoryFileRejects, TruncatedFile) {
   ScratchDir dir;
   write_trajectory_h5(dir / "t.h5", make_trajectory(50, 40, true));
   const auto size = fs::file_size(dir / "t.h5");
-  for (const double fraction : {0.9, 0.5, 0.1}) {
+  for (const double fraction : { 0.9, 0.5, 0.1 }) {
     fs::copy_file(dir / "t.h5", dir / "cut.h5", fs::copy_options::overwrite_existing);
     fs::resize_file(dir / "cut.h5", std::uintmax_t(size * fraction));
-    expect_input_error([&] { read_trajectory_h5(dir / "cut.h5"); }, {(dir / "cut.h5").string()});
+    expect_input_error([&] { read_trajectory_h5(dir / "cut.h5"); }, { (dir / "cut.h5").string() });
   }
   fs::resize_file(dir / "cut.h5", 0);
-  expect_input_error([&] { read_trajectory_h5(dir / "cut.h5"); }, {"cut.h5", "not an HDF5 file"});
+  expect_input_error([&] { read_trajectory_h5(dir / "cut.h5"); }, { "cut.h5", "not an HDF5 file" });
 }
 
 TEST(TrajectoryFileRejects, CorruptChunk) {
@@ -348,14 +365,18 @@ TEST(TrajectoryFileRejects, CorruptChunk) {
     EXPECT_FALSE(h5::deflate_available()) << "corrupt compressed data was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("t.h5"), std::string::npos) << e.what();
+    if (h5::deflate_available()) {
+      EXPECT_NE(std::string(e.what()).find("inflate() failed"), std::string::npos) << e.what();
+    }
   }
 }
 
 TEST(TrajectoryFileRejects, NotAFileOrNotHdf5) {
   ScratchDir dir;
-  expect_input_error([&] { read_trajectory_h5(dir / "none.h5"); }, {"none.h5", "no such file"});
+  expect_input_error([&] { read_trajectory_h5(dir / "none.h5"); }, { "none.h5", "no such file" });
   std::ofstream(dir / "text.h5") << "{\"format\": \"elastolearn-trajectory/1\"}";
-  expect_input_error([&] { read_trajectory_h5(dir / "text.h5"); }, {"text.h5", "not an HDF5 file"});
+  expect_input_error(
+      [&] { read_trajectory_h5(dir / "text.h5"); }, { "text.h5", "not an HDF5 file" });
 }
 
 TEST(TrajectoryFileRejects, ErrorsAreNotPrintedByHdf5) {
@@ -380,7 +401,7 @@ TEST(TrajectoryFile, H5pyReadsAndWritesTheSameLayout) {
   ScratchDir dir;
   const TrajectoryData data = make_trajectory(5, 8, true);
   write_trajectory_h5(dir / "ours.h5", data);
-  std::ofstream(dir / "copy.py") << R"(import sys, h5py, numpy as np
+  std::ofstream(dir / "roundtrip_h5py.py") << R"(import sys, h5py, numpy as np
 with h5py.File(sys.argv[1], "r") as f:
     assert f.attrs["format"] == "elastolearn-trajectory/1", f.attrs["format"]
     assert f.attrs["note"] == "ünïcode ok"
@@ -395,8 +416,8 @@ with h5py.File(sys.argv[2], "w") as g:
         g.attrs[k] = v
     g.attrs["written_by"] = "h5py"
 )";
-  const std::string command = "/usr/bin/python3 " + (dir / "copy.py").string() + " " +
-                              (dir / "ours.h5").string() + " " + (dir / "theirs.h5").string();
+  const std::string command = "/usr/bin/python3 " + (dir / "roundtrip_h5py.py").string() + " "
+      + (dir / "ours.h5").string() + " " + (dir / "theirs.h5").string();
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   TrajectoryData expected = data;
   expected.metadata["written_by"] = "h5py";

@@ -83,13 +83,11 @@ TEST(PrincipalFrame, FirstPiolaRotatesTheDiagonalStress) {
 }
 
 TEST(FirstPiolaDerivative, UsesColumnMajorVecOnBothSides) {
-    // For P̂ = σ (P = F), dP/dF is the identity in any vec convention; for P̂ = (σ1, 0, 0) at a
-    // diagonal F only vec index 0 = (0,0) responds to F(0,0): checks the index layout.
+    // For P̂ = σ (P = F), dP/dF is the identity; the cubic case below checks the index layout.
     const PrincipalFrame f = principal_frame(Vec3(1.5, 1.2, 0.8).asDiagonal().toDenseMatrix());
     const Mat9 id = first_piola_derivative(f, f.stretches, Mat3::Identity(), false);
     EXPECT_LE((id - Mat9::Identity()).norm(), 1e-14);
-    // P̂ = (σ1², 0, 0)-like non-symmetric function is not isotropic, so use the isotropic
-    // P̂ᵢ = σᵢ³: at diagonal F, ∂P(0,1)/∂F(0,1) = (σ0³σ0 − σ1³σ1)/(σ0² − σ1²) = σ0² + σ1².
+    // P̂ᵢ = σᵢ³ (Ψ = Σσᵢ⁴/4) at diagonal F: ∂P(0,1)/∂F(0,1) = (σ0⁴ − σ1⁴)/(σ0² − σ1²) = σ0² + σ1².
     const Vec3 s = f.stretches;
     const Mat9 cubic = first_piola_derivative(
         f, s.array().cube(), Mat3((3 * s.array().square()).matrix().asDiagonal()), false);

@@ -42,28 +42,38 @@ Handle link_creation_list() {
 }
 
 Handle make_space(const Shape& shape, const Shape* max_shape = nullptr) {
-  if (shape.empty()) return {H5Screate(H5S_SCALAR), H5Sclose};
-  return {H5Screate_simple(static_cast<int>(shape.size()), shape.data(),
-                           max_shape ? max_shape->data() : nullptr),
-          H5Sclose};
+  if (shape.empty())
+    return { H5Screate(H5S_SCALAR), H5Sclose };
+  return { H5Screate_simple(static_cast<int>(shape.size()), shape.data(),
+               max_shape ? max_shape->data() : nullptr),
+    H5Sclose };
 }
 
 hsize_t product(const Shape& shape, std::size_t from = 0) {
   hsize_t p = 1;
-  for (std::size_t i = from; i < shape.size(); ++i) p *= shape[i];
+  for (std::size_t i = from; i < shape.size(); ++i)
+    p *= shape[i];
   return p;
 }
 
 const char* class_name(H5T_class_t c) {
   switch (c) {
-  case H5T_INTEGER: return "integer";
-  case H5T_FLOAT: return "float";
-  case H5T_STRING: return "string";
-  case H5T_COMPOUND: return "compound";
-  case H5T_ENUM: return "enum/bool";
-  case H5T_ARRAY: return "array";
-  case H5T_VLEN: return "variable-length";
-  default: return "non-numeric";
+  case H5T_INTEGER:
+    return "integer";
+  case H5T_FLOAT:
+    return "float";
+  case H5T_STRING:
+    return "string";
+  case H5T_COMPOUND:
+    return "compound";
+  case H5T_ENUM:
+    return "enum/bool";
+  case H5T_ARRAY:
+    return "array";
+  case H5T_VLEN:
+    return "variable-length";
+  default:
+    return "non-numeric";
   }
 }
 
@@ -77,10 +87,12 @@ std::string with_reason(const std::string& what) {
 std::string shape_string(const Shape& shape) {
   std::string s = "(";
   for (std::size_t i = 0; i < shape.size(); ++i) {
-    if (i) s += ", ";
+    if (i)
+      s += ", ";
     s += std::to_string(shape[i]);
   }
-  if (shape.size() == 1) s += ",";
+  if (shape.size() == 1)
+    s += ",";
   return s + ")";
 }
 
@@ -89,18 +101,22 @@ ErrorSilencer::ErrorSilencer() {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
 }
 
-ErrorSilencer::~ErrorSilencer() { H5Eset_auto2(H5E_DEFAULT, m_function, m_data); }
+ErrorSilencer::~ErrorSilencer() {
+  H5Eset_auto2(H5E_DEFAULT, m_function, m_data);
+}
 
 std::string take_error_message() {
   std::string message;
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, collect_innermost, &message);
   H5Eclear2(H5E_DEFAULT);
-  while (!message.empty() && (message.back() == ' ' || message.back() == '\n')) message.pop_back();
+  while (!message.empty() && (message.back() == ' ' || message.back() == '\n'))
+    message.pop_back();
   return message;
 }
 
 Handle::Handle(Handle&& other) noexcept
-    : m_id(std::exchange(other.m_id, H5I_INVALID_HID)), m_closer(other.m_closer) {}
+    : m_id(std::exchange(other.m_id, H5I_INVALID_HID))
+    , m_closer(other.m_closer) { }
 
 Handle& Handle::operator=(Handle&& other) noexcept {
   if (this != &other) {
@@ -112,20 +128,24 @@ Handle& Handle::operator=(Handle&& other) noexcept {
 }
 
 bool Handle::close() noexcept {
-  if (m_id < 0) return true;
+  if (m_id < 0)
+    return true;
   ErrorSilencer silence;
   const bool ok = m_closer(m_id) >= 0;
   m_id = H5I_INVALID_HID;
-  if (!ok) H5Eclear2(H5E_DEFAULT);
+  if (!ok)
+    H5Eclear2(H5E_DEFAULT);
   return ok;
 }
 
 bool deflate_available() {
   static const bool available = [] {
     ErrorSilencer silence;
-    if (H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0) return false;
+    if (H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0)
+      return false;
     unsigned config = 0;
-    if (H5Zget_filter_info(H5Z_FILTER_DEFLATE, &config) < 0) return false;
+    if (H5Zget_filter_info(H5Z_FILTER_DEFLATE, &config) < 0)
+      return false;
     return (config & H5Z_FILTER_CONFIG_ENCODE_ENABLED) != 0;
   }();
   return available;
@@ -138,7 +158,8 @@ File File::create(const std::filesystem::path& path, std::string display_name) {
   std::string name = display_name.empty() ? path.string() : std::move(display_name);
   Handle fapl = file_access_list();
   Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id()), H5Fclose);
-  if (!file.valid()) throw InputError(name, with_reason("cannot create HDF5 file"));
+  if (!file.valid())
+    throw InputError(name, with_reason("cannot create HDF5 file"));
   return File(std::move(file), std::move(name));
 }
 
@@ -146,8 +167,10 @@ File File::open(const std::filesystem::path& path, std::string display_name) {
   ErrorSilencer silence;
   std::string name = display_name.empty() ? path.string() : std::move(display_name);
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(name, "no such file");
-  if (std::filesystem::is_directory(path, ec)) throw InputError(name, "is a directory, not a file");
+  if (!std::filesystem::exists(path, ec))
+    throw InputError(name, "no such file");
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(name, "is a directory, not a file");
   Handle fapl = file_access_list();
 #if H5_VERSION_GE(1, 12, 0)
   const htri_t is_hdf5 = H5Fis_accessible(path.c_str(), fapl.id());
@@ -158,7 +181,8 @@ File File::open(const std::filesystem::path& path, std::string display_name) {
     take_error_message();
     throw InputError(name, "not an HDF5 file");
   }
-  if (is_hdf5 < 0) throw InputError(name, with_reason("cannot read file"));
+  if (is_hdf5 < 0)
+    throw InputError(name, with_reason("cannot read file"));
   Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.id()), H5Fclose);
   if (!file.valid()) {
     throw InputError(name, with_reason("cannot open HDF5 file (truncated or corrupt)"));
@@ -172,11 +196,13 @@ void File::fail(const std::string& object, const std::string& message) const {
 
 bool File::exists(const std::string& object) const {
   ErrorSilencer silence;
-  if (object.empty() || object == "/") return true;
+  if (object.empty() || object == "/")
+    return true;
   std::size_t pos = object.front() == '/' ? 1 : 0;
   while (pos <= object.size()) {
     std::size_t next = object.find('/', pos);
-    if (next == std::string::npos) next = object.size();
+    if (next == std::string::npos)
+      next = object.size();
     const std::string prefix = object.substr(0, next);
     if (H5Lexists(m_file.id(), prefix.c_str(), H5P_DEFAULT) <= 0) {
       H5Eclear2(H5E_DEFAULT);
@@ -188,10 +214,12 @@ bool File::exists(const std::string& object) const {
 }
 
 Dataset File::dataset(const std::string& name) const {
-  if (!exists(name)) fail(name, "missing dataset");
+  if (!exists(name))
+    fail(name, "missing dataset");
   ErrorSilencer silence;
   Handle ds(H5Dopen2(m_file.id(), name.c_str(), H5P_DEFAULT), H5Dclose);
-  if (!ds.valid()) fail(name, with_reason("is not a readable dataset"));
+  if (!ds.valid())
+    fail(name, with_reason("is not a readable dataset"));
   return Dataset(*this, std::move(ds), name);
 }
 
@@ -199,9 +227,11 @@ Shape Dataset::shape() const {
   ErrorSilencer silence;
   Handle space(H5Dget_space(m_handle.id()), H5Sclose);
   const int rank = H5Sget_simple_extent_ndims(space.id());
-  if (rank < 0) m_file->fail(m_name, with_reason("cannot read the dataset's shape"));
+  if (rank < 0)
+    m_file->fail(m_name, with_reason("cannot read the dataset's shape"));
   Shape dims(static_cast<std::size_t>(rank));
-  if (rank > 0) H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
+  if (rank > 0)
+    H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
   return dims;
 }
 
@@ -209,29 +239,35 @@ NumberKind Dataset::number_kind() const {
   ErrorSilencer silence;
   Handle type(H5Dget_type(m_handle.id()), H5Tclose);
   switch (H5Tget_class(type.id())) {
-  case H5T_INTEGER: return NumberKind::integer;
-  case H5T_FLOAT: return NumberKind::floating;
-  default: return NumberKind::other;
+  case H5T_INTEGER:
+    return NumberKind::integer;
+  case H5T_FLOAT:
+    return NumberKind::floating;
+  default:
+    return NumberKind::other;
   }
 }
 
 namespace {
 
 void write_dataset(const File& file, const std::string& dataset, const void* data,
-                   const Shape& shape, hid_t file_type, hid_t memory_type) {
+    const Shape& shape, hid_t file_type, hid_t memory_type) {
   ErrorSilencer silence;
-  if (file.exists(dataset)) file.fail(dataset, "dataset already exists");
+  if (file.exists(dataset))
+    file.fail(dataset, "dataset already exists");
   Handle space = make_space(shape);
   Handle lcpl = link_creation_list();
   Handle ds(H5Dcreate2(file.id(), dataset.c_str(), file_type, space.id(), lcpl.id(), H5P_DEFAULT,
-                       H5P_DEFAULT),
-            H5Dclose);
-  if (!ds.valid()) file.fail(dataset, with_reason("cannot create dataset"));
-  if (product(shape) > 0 &&
-      H5Dwrite(ds.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+                H5P_DEFAULT),
+      H5Dclose);
+  if (!ds.valid())
+    file.fail(dataset, with_reason("cannot create dataset"));
+  if (product(shape) > 0
+      && H5Dwrite(ds.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
     file.fail(dataset, with_reason("cannot write dataset"));
   }
-  if (!ds.close()) file.fail(dataset, with_reason("cannot write dataset"));
+  if (!ds.close())
+    file.fail(dataset, with_reason("cannot write dataset"));
 }
 
 } // namespace
@@ -244,8 +280,8 @@ void File::write(const std::string& dataset, const int* data, const Shape& shape
   write_dataset(*this, dataset, data, shape, H5T_STD_I32LE, H5T_NATIVE_INT);
 }
 
-void Dataset::read(void* out, hid_t memory_type, bool integer_only, hsize_t first,
-                   hsize_t rows) const {
+void Dataset::read(
+    void* out, hid_t memory_type, bool integer_only, hsize_t first, hsize_t rows) const {
   ErrorSilencer silence;
   {
     Handle type(H5Dget_type(m_handle.id()), H5Tclose);
@@ -258,27 +294,34 @@ void Dataset::read(void* out, hid_t memory_type, bool integer_only, hsize_t firs
     }
   }
   const Shape dims = shape();
-  herr_t status = 0;
+  // The reason must be taken before any handle closes: every HDF5 call clears the error stack.
+  const std::string failed = "cannot read data (corrupt file?)";
   if (first == 0 && rows == 0) {
-    if (product(dims) == 0) return;
-    status = H5Dread(m_handle.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out);
+    if (product(dims) == 0)
+      return;
+    if (H5Dread(m_handle.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) < 0) {
+      m_file->fail(m_name, with_reason(failed));
+    }
   } else {
     if (dims.empty() || first + rows > dims[0]) {
-      m_file->fail(m_name, "cannot read rows [" + std::to_string(first) + ", " +
-                               std::to_string(first + rows) + ") of shape " + shape_string(dims));
+      m_file->fail(m_name,
+          "cannot read rows [" + std::to_string(first) + ", " + std::to_string(first + rows)
+              + ") of shape " + shape_string(dims));
     }
     Shape start(dims.size(), 0), count = dims;
     start[0] = first;
     count[0] = rows;
-    if (product(count) == 0) return;
+    if (product(count) == 0)
+      return;
     Handle file_space(H5Dget_space(m_handle.id()), H5Sclose);
-    H5Sselect_hyperslab(file_space.id(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
-                        nullptr);
+    H5Sselect_hyperslab(
+        file_space.id(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
     Handle memory_space = make_space(count);
-    status = H5Dread(m_handle.id(), memory_type, memory_space.id(), file_space.id(), H5P_DEFAULT,
-                     out);
+    if (H5Dread(m_handle.id(), memory_type, memory_space.id(), file_space.id(), H5P_DEFAULT, out)
+        < 0) {
+      m_file->fail(m_name, with_reason(failed));
+    }
   }
-  if (status < 0) m_file->fail(m_name, with_reason("cannot read data (corrupt file?)"));
 }
 
 void Dataset::read(double* out, hsize_t first, hsize_t rows) const {
@@ -305,12 +348,13 @@ std::vector<int> File::read_i32(const std::string& name) const {
 
 // --- attributes ------------------------------------------------------------------------------
 
-void File::set_attribute(const std::string& name, const std::string& value,
-                         const std::string& object) {
+void File::set_attribute(
+    const std::string& name, const std::string& value, const std::string& object) {
   ErrorSilencer silence;
   const std::string where = object + " attribute '" + name + "'";
   Handle obj(H5Oopen(m_file.id(), object.c_str(), H5P_DEFAULT), H5Oclose);
-  if (!obj.valid()) fail(object, with_reason("cannot open object"));
+  if (!obj.valid())
+    fail(object, with_reason("cannot open object"));
   if (H5Aexists(obj.id(), name.c_str()) > 0 && H5Adelete(obj.id(), name.c_str()) < 0) {
     fail(where, with_reason("cannot replace attribute"));
   }
@@ -319,7 +363,7 @@ void File::set_attribute(const std::string& name, const std::string& value,
   H5Tset_cset(type.id(), H5T_CSET_UTF8);
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   Handle attr(H5Acreate2(obj.id(), name.c_str(), type.id(), space.id(), H5P_DEFAULT, H5P_DEFAULT),
-              H5Aclose);
+      H5Aclose);
   const char* text = value.c_str();
   if (!attr.valid() || H5Awrite(attr.id(), type.id(), &text) < 0) {
     fail(where, with_reason("cannot write attribute"));
@@ -341,7 +385,8 @@ std::string attribute_text(const File& file, hid_t attr, const std::string& wher
       H5Tset_size(memory.id(), H5T_VARIABLE);
       H5Tset_cset(memory.id(), H5Tget_cset(type.id()));
       char* text = nullptr;
-      if (H5Aread(attr, memory.id(), &text) < 0) file.fail(where, with_reason("cannot read"));
+      if (H5Aread(attr, memory.id(), &text) < 0)
+        file.fail(where, with_reason("cannot read"));
       std::string value = text ? text : "";
       H5free_memory(text);
       return value;
@@ -353,39 +398,47 @@ std::string attribute_text(const File& file, hid_t attr, const std::string& wher
     }
     value.resize(std::min(value.find('\0'), value.size()));
     if (H5Tget_strpad(type.id()) == H5T_STR_SPACEPAD) {
-      while (!value.empty() && value.back() == ' ') value.pop_back();
+      while (!value.empty() && value.back() == ' ')
+        value.pop_back();
     }
     return value;
   }
   if (c == H5T_INTEGER) {
     long long v = 0;
-    if (H5Aread(attr, H5T_NATIVE_LLONG, &v) < 0) file.fail(where, with_reason("cannot read"));
+    if (H5Aread(attr, H5T_NATIVE_LLONG, &v) < 0)
+      file.fail(where, with_reason("cannot read"));
     return std::to_string(v);
   }
   if (c == H5T_FLOAT) {
     double v = 0;
-    if (H5Aread(attr, H5T_NATIVE_DOUBLE, &v) < 0) file.fail(where, with_reason("cannot read"));
+    if (H5Aread(attr, H5T_NATIVE_DOUBLE, &v) < 0)
+      file.fail(where, with_reason("cannot read"));
     char buffer[32];
     const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
     return std::string(buffer, result.ptr);
   }
-  file.fail(where, std::string("unsupported attribute type ") + class_name(c) +
-                       " (expected a string or a number)");
+  file.fail(where,
+      std::string("unsupported attribute type ") + class_name(c)
+          + " (expected a string or a number)");
 }
 
 } // namespace
 
-std::optional<std::string> File::attribute(const std::string& name,
-                                           const std::string& object) const {
+std::optional<std::string> File::attribute(
+    const std::string& name, const std::string& object) const {
   ErrorSilencer silence;
   Handle obj(H5Oopen(m_file.id(), object.c_str(), H5P_DEFAULT), H5Oclose);
-  if (!obj.valid()) fail(object, with_reason("cannot open object"));
+  if (!obj.valid())
+    fail(object, with_reason("cannot open object"));
   const htri_t present = H5Aexists(obj.id(), name.c_str());
-  if (present < 0) fail(object, with_reason("cannot read attributes"));
-  if (present == 0) return std::nullopt;
+  if (present < 0)
+    fail(object, with_reason("cannot read attributes"));
+  if (present == 0)
+    return std::nullopt;
   Handle attr(H5Aopen(obj.id(), name.c_str(), H5P_DEFAULT), H5Aclose);
   const std::string where = object + " attribute '" + name + "'";
-  if (!attr.valid()) fail(where, with_reason("cannot open attribute"));
+  if (!attr.valid())
+    fail(where, with_reason("cannot open attribute"));
   return attribute_text(*this, attr.id(), where);
 }
 
@@ -394,38 +447,46 @@ std::map<std::string, std::string> File::attributes(const std::string& object) c
   std::vector<std::string> names;
   {
     Handle obj(H5Oopen(m_file.id(), object.c_str(), H5P_DEFAULT), H5Oclose);
-    if (!obj.valid()) fail(object, with_reason("cannot open object"));
+    if (!obj.valid())
+      fail(object, with_reason("cannot open object"));
     hsize_t index = 0;
     if (H5Aiterate2(obj.id(), H5_INDEX_NAME, H5_ITER_INC, &index, collect_name, &names) < 0) {
       fail(object, with_reason("cannot list attributes"));
     }
   }
   std::map<std::string, std::string> values;
-  for (const std::string& name : names) values[name] = *attribute(name, object);
+  for (const std::string& name : names)
+    values[name] = *attribute(name, object);
   return values;
 }
 
 void File::close() {
-  if (!m_file.valid()) return;
+  if (!m_file.valid())
+    return;
   ErrorSilencer silence;
   if (H5Fflush(m_file.id(), H5F_SCOPE_LOCAL) < 0) {
     const std::string reason = take_error_message();
     m_file.close();
     fail("", "cannot finish writing the HDF5 file: " + reason);
   }
-  if (!m_file.close()) fail("", "cannot close the HDF5 file");
+  if (!m_file.close())
+    fail("", "cannot close the HDF5 file");
 }
 
 // --- AppendableDataset -----------------------------------------------------------------------
 
-AppendableDataset::AppendableDataset(File& file, const std::string& dataset,
-                                     const Shape& frame_shape)
-    : m_file(&file), m_name(dataset), m_frame_shape(frame_shape),
-      m_frame_values(product(frame_shape)) {
+AppendableDataset::AppendableDataset(
+    File& file, const std::string& dataset, const Shape& frame_shape)
+    : m_file(&file)
+    , m_name(dataset)
+    , m_frame_shape(frame_shape)
+    , m_frame_values(product(frame_shape)) {
   ErrorSilencer silence;
-  if (m_frame_values == 0) file.fail(dataset, "cannot store empty frames");
-  if (file.exists(dataset)) file.fail(dataset, "dataset already exists");
-  Shape dims{0}, max_dims{H5S_UNLIMITED}, chunk{0};
+  if (m_frame_values == 0)
+    file.fail(dataset, "cannot store empty frames");
+  if (file.exists(dataset))
+    file.fail(dataset, "dataset already exists");
+  Shape dims { 0 }, max_dims { H5S_UNLIMITED }, chunk { 0 };
   for (hsize_t d : frame_shape) {
     dims.push_back(d);
     max_dims.push_back(d);
@@ -445,38 +506,44 @@ AppendableDataset::AppendableDataset(File& file, const std::string& dataset,
   }
   Handle lcpl = link_creation_list();
   m_dataset = Handle(H5Dcreate2(file.id(), dataset.c_str(), H5T_IEEE_F64LE, space.id(), lcpl.id(),
-                                dcpl.id(), H5P_DEFAULT),
-                     H5Dclose);
-  if (!m_dataset.valid()) file.fail(dataset, with_reason("cannot create dataset"));
+                         dcpl.id(), H5P_DEFAULT),
+      H5Dclose);
+  if (!m_dataset.valid())
+    file.fail(dataset, with_reason("cannot create dataset"));
   m_buffer.resize(m_chunk_frames * m_frame_values);
 }
 
 void AppendableDataset::append(const double* frame) {
-  if (!m_dataset.valid()) m_file->fail(m_name, "dataset is already closed");
+  if (!m_dataset.valid())
+    m_file->fail(m_name, "dataset is already closed");
   std::copy(frame, frame + m_frame_values, m_buffer.data() + m_buffered * m_frame_values);
   ++m_buffered;
-  if (m_buffered == m_chunk_frames) flush();
+  if (m_buffered == m_chunk_frames)
+    flush();
 }
 
 void AppendableDataset::flush() {
-  if (m_buffered == 0) return;
-  if (!m_dataset.valid()) m_file->fail(m_name, "dataset is already closed");
+  if (m_buffered == 0)
+    return;
+  if (!m_dataset.valid())
+    m_file->fail(m_name, "dataset is already closed");
   ErrorSilencer silence;
-  Shape dims{m_written + m_buffered}, start(m_frame_shape.size() + 1, 0), count{m_buffered};
+  Shape dims { m_written + m_buffered }, start(m_frame_shape.size() + 1, 0), count { m_buffered };
   dims.insert(dims.end(), m_frame_shape.begin(), m_frame_shape.end());
   count.insert(count.end(), m_frame_shape.begin(), m_frame_shape.end());
   start[0] = m_written;
-  const std::string frames = "frames [" + std::to_string(m_written) + ", " +
-                             std::to_string(m_written + m_buffered) + ")";
+  const std::string frames = "frames [" + std::to_string(m_written) + ", "
+      + std::to_string(m_written + m_buffered) + ")";
   if (H5Dset_extent(m_dataset.id(), dims.data()) < 0) {
     m_file->fail(m_name, with_reason("cannot extend dataset for " + frames));
   }
   Handle file_space(H5Dget_space(m_dataset.id()), H5Sclose);
   Handle memory_space = make_space(count);
-  H5Sselect_hyperslab(file_space.id(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
-                      nullptr);
-  if (H5Dwrite(m_dataset.id(), H5T_NATIVE_DOUBLE, memory_space.id(), file_space.id(),
-               H5P_DEFAULT, m_buffer.data()) < 0) {
+  H5Sselect_hyperslab(
+      file_space.id(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+  if (H5Dwrite(m_dataset.id(), H5T_NATIVE_DOUBLE, memory_space.id(), file_space.id(), H5P_DEFAULT,
+          m_buffer.data())
+      < 0) {
     const std::string reason = with_reason("cannot write " + frames);
     dims[0] = m_written; // keep the dataset at the frames that were written
     H5Dset_extent(m_dataset.id(), dims.data());
@@ -487,9 +554,11 @@ void AppendableDataset::flush() {
 }
 
 void AppendableDataset::close() {
-  if (!m_dataset.valid()) return;
+  if (!m_dataset.valid())
+    return;
   flush();
-  if (!m_dataset.close()) m_file->fail(m_name, "cannot close dataset");
+  if (!m_dataset.close())
+    m_file->fail(m_name, "cannot close dataset");
 }
 
 } // namespace elastolearn::io::h5

@@ -3,7 +3,8 @@
 /// HDF5 never prints its own error stack through this layer: every failure becomes one
 /// `InputError` whose `where` is "<file>: <dataset>" and whose message carries HDF5's most
 /// specific reason (e.g. "truncated file: eof = 96, ..."). Shapes are C order, slowest first,
-/// exactly as numpy/h5py show them.
+/// exactly as numpy/h5py show them. Debian's HDF5 is the serial, non-thread-safe build: use this
+/// layer from one thread at a time.
 #include <hdf5.h>
 
 #include <filesystem>
@@ -23,13 +24,13 @@ std::string shape_string(const Shape& shape);
 /// Turns off HDF5's automatic error printing for its lifetime, restoring the previous handler
 /// afterwards. Every function of this layer holds one, so callers never need to.
 class ErrorSilencer {
-public:
+  public:
   ErrorSilencer();
   ~ErrorSilencer();
   ErrorSilencer(const ErrorSilencer&) = delete;
   ErrorSilencer& operator=(const ErrorSilencer&) = delete;
 
-private:
+  private:
   H5E_auto2_t m_function = nullptr;
   void* m_data = nullptr;
 };
@@ -41,11 +42,13 @@ std::string take_error_message();
 /// Owner of one HDF5 identifier (file, group, dataset, dataspace, datatype, attribute or property
 /// list) and the function that closes it. Move-only.
 class Handle {
-public:
+  public:
   using Closer = herr_t (*)(hid_t);
   Handle() = default;
   /// Takes ownership of `id` (may be negative = invalid, then nothing is closed).
-  Handle(hid_t id, Closer closer) noexcept : m_id(id), m_closer(closer) {}
+  Handle(hid_t id, Closer closer) noexcept
+      : m_id(id)
+      , m_closer(closer) { }
   ~Handle() { close(); }
   Handle(Handle&& other) noexcept;
   Handle& operator=(Handle&& other) noexcept;
@@ -57,7 +60,7 @@ public:
   /// Close now. Returns false if HDF5 reported an error (e.g. a failed flush).
   bool close() noexcept;
 
-private:
+  private:
   hid_t m_id = H5I_INVALID_HID;
   Closer m_closer = nullptr;
 };
@@ -70,7 +73,7 @@ class File;
 /// An open dataset of a File. Keep it open for repeated partial reads: its chunk cache then
 /// decompresses each chunk once.
 class Dataset {
-public:
+  public:
   const std::string& name() const { return m_name; }
   /// Shape, slowest dimension first (empty for a scalar).
   Shape shape() const;
@@ -82,10 +85,12 @@ public:
   void read(double* out, hsize_t first = 0, hsize_t rows = 0) const;
   void read(int* out, hsize_t first = 0, hsize_t rows = 0) const;
 
-private:
+  private:
   friend class File;
   Dataset(const File& file, Handle handle, std::string name)
-      : m_file(&file), m_handle(std::move(handle)), m_name(std::move(name)) {}
+      : m_file(&file)
+      , m_handle(std::move(handle))
+      , m_name(std::move(name)) { }
   void read(void* out, hid_t memory_type, bool integer_only, hsize_t first, hsize_t rows) const;
   const File* m_file;
   Handle m_handle;
@@ -96,7 +101,7 @@ private:
 /// temporary file) and the dataset. Objects are addressed by absolute paths ("/positions",
 /// "/observed/vertex_ids"); missing intermediate groups are created on write.
 class File {
-public:
+  public:
   /// Create (truncate) `path` for writing. Throws InputError.
   static File create(const std::filesystem::path& path, std::string display_name = "");
   /// Open an existing file read-only. Distinguishes "no such file", "not an HDF5 file" and
@@ -132,12 +137,12 @@ public:
   std::vector<int> read_i32(const std::string& dataset) const;
 
   /// Set (or replace) a variable-length UTF-8 string attribute on `object` (h5py reads it as str).
-  void set_attribute(const std::string& name, const std::string& value,
-                     const std::string& object = "/");
+  void set_attribute(
+      const std::string& name, const std::string& value, const std::string& object = "/");
   /// A scalar attribute as text: strings as they are (fixed or variable length), numbers in
   /// shortest round-trip form. Empty if absent. Throws InputError for other kinds.
-  std::optional<std::string> attribute(const std::string& name,
-                                       const std::string& object = "/") const;
+  std::optional<std::string> attribute(
+      const std::string& name, const std::string& object = "/") const;
   /// All attributes of `object` as text (see attribute()).
   std::map<std::string, std::string> attributes(const std::string& object = "/") const;
 
@@ -148,8 +153,10 @@ public:
   /// Throw InputError("<file>: <object>", message).
   [[noreturn]] void fail(const std::string& object, const std::string& message) const;
 
-private:
-  File(Handle file, std::string name) : m_file(std::move(file)), m_name(std::move(name)) {}
+  private:
+  File(Handle file, std::string name)
+      : m_file(std::move(file))
+      , m_name(std::move(name)) { }
 
   Handle m_file;
   std::string m_name;
@@ -160,7 +167,7 @@ private:
 /// Frames are buffered in memory until a chunk is full, so each chunk is compressed and written
 /// exactly once; flush() or close() writes a partly filled last chunk.
 class AppendableDataset {
-public:
+  public:
   /// Create `dataset` in `file` with zero frames. `file` must outlive this object.
   AppendableDataset(File& file, const std::string& dataset, const Shape& frame_shape);
   /// Append one frame of prod(frame_shape) values (copied). Throws InputError.
@@ -174,7 +181,7 @@ public:
   /// object instead drops the buffered frames.
   void close();
 
-private:
+  private:
   const File* m_file;
   std::string m_name;
   Shape m_frame_shape;

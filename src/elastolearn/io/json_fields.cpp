@@ -15,20 +15,22 @@ namespace {
 
 std::string quoted_list(const std::vector<std::string>& items) {
   std::string s;
-  for (std::size_t i = 0; i < items.size(); ++i) s += (i ? ", \"" : "\"") + items[i] + "\"";
+  for (std::size_t i = 0; i < items.size(); ++i)
+    s += (i ? ", \"" : "\"") + items[i] + "\"";
   return s;
 }
 
 /// Levenshtein distance, for "did you mean" suggestions.
 std::size_t edit_distance(const std::string& a, const std::string& b) {
   std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t j = 0; j <= b.size(); ++j)
+    row[j] = j;
   for (std::size_t i = 1; i <= a.size(); ++i) {
     std::size_t diagonal = row[0];
     row[0] = i;
     for (std::size_t j = 1; j <= b.size(); ++j) {
       const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+      row[j] = std::min({ row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1]) });
       diagonal = up;
     }
   }
@@ -39,17 +41,20 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 std::optional<int> as_int(const Json& value) {
   if (value.is_number_unsigned()) {
     const auto v = value.get<std::uint64_t>();
-    if (v <= std::uint64_t(INT_MAX)) return int(v);
+    if (v <= std::uint64_t(INT_MAX))
+      return int(v);
     return std::nullopt;
   }
   if (value.is_number_integer()) {
     const auto v = value.get<std::int64_t>();
-    if (v >= INT_MIN && v <= INT_MAX) return int(v);
+    if (v >= INT_MIN && v <= INT_MAX)
+      return int(v);
     return std::nullopt;
   }
   if (value.is_number_float()) {
     const double v = value.get<double>();
-    if (std::isfinite(v) && v == std::floor(v) && v >= INT_MIN && v <= INT_MAX) return int(v);
+    if (std::isfinite(v) && v == std::floor(v) && v >= INT_MIN && v <= INT_MAX)
+      return int(v);
   }
   return std::nullopt;
 }
@@ -62,13 +67,17 @@ bool is_finite_number(const Json& value) {
 
 std::string describe_json(const Json& value) {
   std::string text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
-  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  if (text.size() > 60)
+    text = text.substr(0, 57) + "...";
   return text;
 }
 
 JsonObject::JsonObject(const Json& value, std::string file, std::string path)
-    : m_value(&value), m_file(std::move(file)), m_path(std::move(path)) {
-  if (!value.is_object()) fail("", "expected an object, got " + describe_json(value));
+    : m_value(&value)
+    , m_file(std::move(file))
+    , m_path(std::move(path)) {
+  if (!value.is_object())
+    fail("", "expected an object, got " + describe_json(value));
 }
 
 std::string JsonObject::field(const std::string& key) const {
@@ -80,18 +89,23 @@ void JsonObject::fail(const std::string& key, const std::string& message) const 
   throw InputError(name.empty() ? m_file : m_file + ": " + name, message);
 }
 
-bool JsonObject::has(const std::string& key) const { return m_value->contains(key); }
+bool JsonObject::has(const std::string& key) const {
+  return m_value->contains(key);
+}
 
 const Json& JsonObject::required(const std::string& key) const {
   const auto it = m_value->find(key);
-  if (it == m_value->end()) fail(key, "missing required field");
+  if (it == m_value->end())
+    fail(key, "missing required field");
   return *it;
 }
 
 double JsonObject::number(const std::string& key) const {
   const Json& v = required(key);
-  if (!v.is_number()) fail(key, "expected a number, got " + describe_json(v));
-  if (!is_finite_number(v)) fail(key, "expected a finite number, got " + describe_json(v));
+  if (!v.is_number())
+    fail(key, "expected a number, got " + describe_json(v));
+  if (!is_finite_number(v))
+    fail(key, "expected a finite number, got " + describe_json(v));
   return v.get<double>();
 }
 
@@ -114,7 +128,8 @@ double JsonObject::positive(const std::string& key, double fallback) const {
 int JsonObject::integer(const std::string& key) const {
   const Json& v = required(key);
   const std::optional<int> i = as_int(v);
-  if (!i) fail(key, "expected an integer, got " + describe_json(v));
+  if (!i)
+    fail(key, "expected an integer, got " + describe_json(v));
   return *i;
 }
 
@@ -123,15 +138,18 @@ int JsonObject::integer(const std::string& key, int fallback) const {
 }
 
 bool JsonObject::boolean(const std::string& key, bool fallback) const {
-  if (!has(key)) return fallback;
+  if (!has(key))
+    return fallback;
   const Json& v = required(key);
-  if (!v.is_boolean()) fail(key, "expected true or false, got " + describe_json(v));
+  if (!v.is_boolean())
+    fail(key, "expected true or false, got " + describe_json(v));
   return v.get<bool>();
 }
 
 std::string JsonObject::string(const std::string& key) const {
   const Json& v = required(key);
-  if (!v.is_string()) fail(key, "expected a string, got " + describe_json(v));
+  if (!v.is_string())
+    fail(key, "expected a string, got " + describe_json(v));
   return v.get<std::string>();
 }
 
@@ -141,10 +159,11 @@ std::string JsonObject::string(const std::string& key, const std::string& fallba
 
 Vec3 JsonObject::vec3(const std::string& key) const {
   const Json& v = required(key);
-  const bool ok = v.is_array() && v.size() == 3 &&
-                  std::all_of(v.begin(), v.end(), [](const Json& e) { return is_finite_number(e); });
-  if (!ok) fail(key, "expected an array of 3 finite numbers, got " + describe_json(v));
-  return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+  const bool ok = v.is_array() && v.size() == 3
+      && std::all_of(v.begin(), v.end(), [](const Json& e) { return is_finite_number(e); });
+  if (!ok)
+    fail(key, "expected an array of 3 finite numbers, got " + describe_json(v));
+  return { v[0].get<double>(), v[1].get<double>(), v[2].get<double>() };
 }
 
 Vec3 JsonObject::vec3(const std::string& key, const Vec3& fallback) const {
@@ -153,12 +172,14 @@ Vec3 JsonObject::vec3(const std::string& key, const Vec3& fallback) const {
 
 std::vector<double> JsonObject::numbers(const std::string& key) const {
   const Json& v = required(key);
-  if (!v.is_array()) fail(key, "expected an array of numbers, got " + describe_json(v));
+  if (!v.is_array())
+    fail(key, "expected an array of numbers, got " + describe_json(v));
   std::vector<double> out;
   out.reserve(v.size());
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!is_finite_number(v[i])) {
-      fail(key + "[" + std::to_string(i) + "]", "expected a finite number, got " + describe_json(v[i]));
+      fail(key + "[" + std::to_string(i) + "]",
+          "expected a finite number, got " + describe_json(v[i]));
     }
     out.push_back(v[i].get<double>());
   }
@@ -167,12 +188,14 @@ std::vector<double> JsonObject::numbers(const std::string& key) const {
 
 std::vector<int> JsonObject::integers(const std::string& key) const {
   const Json& v = required(key);
-  if (!v.is_array()) fail(key, "expected an array of integers, got " + describe_json(v));
+  if (!v.is_array())
+    fail(key, "expected an array of integers, got " + describe_json(v));
   std::vector<int> out;
   out.reserve(v.size());
   for (std::size_t i = 0; i < v.size(); ++i) {
     const std::optional<int> e = as_int(v[i]);
-    if (!e) fail(key + "[" + std::to_string(i) + "]", "expected an integer, got " + describe_json(v[i]));
+    if (!e)
+      fail(key + "[" + std::to_string(i) + "]", "expected an integer, got " + describe_json(v[i]));
     out.push_back(*e);
   }
   return out;
@@ -184,7 +207,8 @@ JsonObject JsonObject::object(const std::string& key) const {
 
 std::vector<JsonObject> JsonObject::objects(const std::string& key) const {
   const Json& v = required(key);
-  if (!v.is_array()) fail(key, "expected an array of objects, got " + describe_json(v));
+  if (!v.is_array())
+    fail(key, "expected an array of objects, got " + describe_json(v));
   std::vector<JsonObject> out;
   out.reserve(v.size());
   for (std::size_t i = 0; i < v.size(); ++i) {
@@ -193,32 +217,37 @@ std::vector<JsonObject> JsonObject::objects(const std::string& key) const {
   return out;
 }
 
-std::string JsonObject::choice(const std::string& key,
-                               const std::vector<std::string>& choices) const {
+std::string JsonObject::choice(
+    const std::string& key, const std::vector<std::string>& choices) const {
   const Json& v = required(key);
-  if (v.is_string() && std::find(choices.begin(), choices.end(), v.get<std::string>()) != choices.end()) {
+  if (v.is_string()
+      && std::find(choices.begin(), choices.end(), v.get<std::string>()) != choices.end()) {
     return v.get<std::string>();
   }
   fail(key, "expected one of " + quoted_list(choices) + ", got " + describe_json(v));
 }
 
 std::string JsonObject::choice(const std::string& key, const std::vector<std::string>& choices,
-                               const std::string& fallback) const {
+    const std::string& fallback) const {
   return has(key) ? choice(key, choices) : fallback;
 }
 
 void JsonObject::reject_unknown_keys(const std::vector<std::string>& known) const {
   for (const auto& [key, value] : m_value->items()) {
-    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    if (std::find(known.begin(), known.end(), key) != known.end())
+      continue;
     const std::string* best = nullptr;
     std::size_t best_distance = std::max<std::size_t>(2, key.size() / 3) + 1;
     for (const std::string& k : known) {
       const std::size_t d = edit_distance(key, k);
-      if (d < best_distance) best = &k, best_distance = d;
+      if (d < best_distance)
+        best = &k, best_distance = d;
     }
-    if (best) fail(key, "unknown field (did you mean \"" + *best + "\"?)");
-    fail(key, known.empty() ? std::string("unknown field (no fields are accepted here)")
-                            : "unknown field (expected one of " + quoted_list(known) + ")");
+    if (best)
+      fail(key, "unknown field (did you mean \"" + *best + "\"?)");
+    fail(key,
+        known.empty() ? std::string("unknown field (no fields are accepted here)")
+                      : "unknown field (expected one of " + quoted_list(known) + ")");
   }
 }
 
@@ -231,15 +260,18 @@ Json read_json_file(const std::filesystem::path& path) {
     const std::size_t end = std::min<std::size_t>(e.byte ? e.byte - 1 : 0, text.size());
     std::size_t line = 1, column = 1;
     for (std::size_t i = 0; i < end; ++i) {
-      if (text[i] == '\n') ++line, column = 1;
-      else ++column;
+      if (text[i] == '\n')
+        ++line, column = 1;
+      else
+        ++column;
     }
     std::string message = e.what();
     const std::size_t at = message.find("column ");
     const std::size_t colon = at == std::string::npos ? std::string::npos : message.find(": ", at);
-    if (colon != std::string::npos) message = message.substr(colon + 2);
+    if (colon != std::string::npos)
+      message = message.substr(colon + 2);
     throw InputError(path.string() + ":" + std::to_string(line) + ":" + std::to_string(column),
-                     "invalid JSON: " + message);
+        "invalid JSON: " + message);
   }
 }
 
@@ -251,17 +283,20 @@ int check_format(const JsonObject& root, const std::string& expected_kind, int m
   const nlohmann::json& value = root.json().at("format");
   const std::string prefix = expected_kind + "/";
   if (!value.is_string() || value.get<std::string>().rfind(prefix, 0) != 0) {
-    root.fail("format", "expected " + expected + ", got " + describe_json(value) +
-                            " (not an " + expected_kind + " file)");
+    root.fail("format",
+        "expected " + expected + ", got " + describe_json(value) + " (not an " + expected_kind
+            + " file)");
   }
   const std::string version = value.get<std::string>().substr(prefix.size());
-  const bool digits = !version.empty() && version.size() < 9 &&
-                      std::all_of(version.begin(), version.end(), [](char c) { return c >= '0' && c <= '9'; });
+  const bool digits = !version.empty() && version.size() < 9
+      && std::all_of(version.begin(), version.end(), [](char c) { return c >= '0' && c <= '9'; });
   const int v = digits ? std::stoi(version) : 0;
-  if (v < 1) root.fail("format", "invalid version in " + describe_json(value));
+  if (v < 1)
+    root.fail("format", "invalid version in " + describe_json(value));
   if (v > max_version) {
-    root.fail("format", "version " + std::to_string(v) + " is newer than this elastolearn reads (up to " +
-                            expected + ")");
+    root.fail("format",
+        "version " + std::to_string(v) + " is newer than this elastolearn reads (up to " + expected
+            + ")");
   }
   return v;
 }

@@ -15,7 +15,7 @@ namespace elastolearn::io {
 /// A view of a JSON object that knows its path ("scene.json: material.young") for error
 /// messages. It refers to `value` without copying: the JSON must outlive the view.
 class JsonObject {
-public:
+  public:
   /// Throws InputError if `value` is not an object. `path` is the object's own field path
   /// ("" for the root, "material", "loads[2]").
   JsonObject(const nlohmann::json& value, std::string file, std::string path = "");
@@ -54,7 +54,7 @@ public:
   std::string choice(const std::string& key, const std::vector<std::string>& choices) const;
   /// Optional choice: `fallback` when absent.
   std::string choice(const std::string& key, const std::vector<std::string>& choices,
-                     const std::string& fallback) const;
+      const std::string& fallback) const;
 
   /// Unknown keys are errors (catches typos; suggests the nearest known key): call after
   /// reading, with every key you accept.
@@ -69,7 +69,7 @@ public:
   const std::string& file() const { return m_file; }
   const std::string& path() const { return m_path; }
 
-private:
+  private:
   /// The value at `key`; fails with "missing required field" if absent.
   const nlohmann::json& required(const std::string& key) const;
   const nlohmann::json* m_value;

@@ -25,39 +25,38 @@ std::string format_number(double v) {
 /// Throws InputError("<file>: <dataset>", "<frame prefix>non-finite value ...") if any of the
 /// rows×3 values is NaN or infinite.
 void check_finite(const std::string& where, const double* values, Eigen::Index rows,
-                  const std::string& frame_prefix = "") {
+    const std::string& frame_prefix = "") {
   for (Eigen::Index i = 0; i < rows * 3; ++i) {
     if (!std::isfinite(values[i])) {
-      throw InputError(where, frame_prefix + "non-finite value " + format_number(values[i]) +
-                                  " at vertex " + std::to_string(i / 3) + " (component " +
-                                  std::to_string(i % 3) + ")");
+      throw InputError(where,
+          frame_prefix + "non-finite value " + format_number(values[i]) + " at vertex "
+              + std::to_string(i / 3) + " (component " + std::to_string(i % 3) + ")");
     }
   }
 }
 
 /// Throws InputError if an index of the rows×cols table lies outside [0, n).
-void check_indices(const std::string& where, const int* indices, Eigen::Index rows, int cols,
-                   Eigen::Index n) {
+void check_indices(
+    const std::string& where, const int* indices, Eigen::Index rows, int cols, Eigen::Index n) {
   for (Eigen::Index i = 0; i < rows * cols; ++i) {
     if (indices[i] < 0 || indices[i] >= n) {
-      throw InputError(where, "vertex index " + std::to_string(indices[i]) + " in row " +
-                                  std::to_string(i / cols) + " is out of range [0, " +
-                                  std::to_string(n) + ")");
+      throw InputError(where,
+          "vertex index " + std::to_string(indices[i]) + " in row " + std::to_string(i / cols)
+              + " is out of range [0, " + std::to_string(n) + ")");
     }
   }
 }
 
 /// Throws unless `time` is finite and later than `previous` (if any).
-void check_time(const std::string& where, long frame, double time,
-                std::optional<double> previous) {
+void check_time(const std::string& where, long frame, double time, std::optional<double> previous) {
   if (!std::isfinite(time)) {
-    throw InputError(where, "frame " + std::to_string(frame) + ": non-finite time " +
-                                format_number(time));
+    throw InputError(
+        where, "frame " + std::to_string(frame) + ": non-finite time " + format_number(time));
   }
   if (previous && !(time > *previous)) {
-    throw InputError(where, "frame " + std::to_string(frame) + ": time " + format_number(time) +
-                                " does not increase (previous frame at " +
-                                format_number(*previous) + ")");
+    throw InputError(where,
+        "frame " + std::to_string(frame) + ": time " + format_number(time)
+            + " does not increase (previous frame at " + format_number(*previous) + ")");
   }
 }
 
@@ -73,8 +72,12 @@ void check_table(const std::string& file, const char* dataset, const Table& tabl
 
 struct TrajectoryWriter::Impl {
   Impl(const std::filesystem::path& path, Eigen::Index vertices)
-      : atomic(path), name(path.string()), file(h5::File::create(atomic.temp_path(), name)),
-        n(vertices), positions(file, "/positions", {hsize_t(n), 3}), time(file, "/time", {}) {}
+      : atomic(path)
+      , name(path.string())
+      , file(h5::File::create(atomic.temp_path(), name))
+      , n(vertices)
+      , positions(file, "/positions", { hsize_t(n), 3 })
+      , time(file, "/time", {}) { }
 
   AtomicFile atomic; ///< destroyed last: removes the temporary file unless committed
   std::string name;
@@ -95,7 +98,8 @@ struct TrajectoryWriter::Impl {
 
   /// Contiguous row-major data of `x`, copied into `scratch` only if `x` is strided.
   static const double* contiguous(ConstRef<Positions> x, Positions& scratch) {
-    if (x.rows() == 0 || x.outerStride() == 3) return x.data();
+    if (x.rows() == 0 || x.outerStride() == 3)
+      return x.data();
     scratch = x;
     return scratch.data();
   }
@@ -103,30 +107,35 @@ struct TrajectoryWriter::Impl {
   /// Validate the whole frame first, then write it (time last: its length counts the frames).
   void append(double t, ConstRef<Positions> x, const Eigen::Ref<const Positions>* v) {
     ELASTOLEARN_CHECK(!finished, "TrajectoryWriter::append after finish");
-    if (failed) throw InputError(name, "an earlier write failed; the trajectory cannot continue");
+    if (failed)
+      throw InputError(name, "an earlier write failed; the trajectory cannot continue");
     const std::string frame = "frame " + std::to_string(frames) + ": ";
     check_time(where("/time"), frames, t, last_time);
     if (x.rows() != n) {
-      throw InputError(where("/positions"), frame + "has " + std::to_string(x.rows()) +
-                                                " vertices, expected " + std::to_string(n));
+      throw InputError(where("/positions"),
+          frame + "has " + std::to_string(x.rows()) + " vertices, expected " + std::to_string(n));
     }
     if (v && v->rows() != n) {
-      throw InputError(where("/velocities"), frame + "has " + std::to_string(v->rows()) +
-                                                 " vertices, expected " + std::to_string(n));
+      throw InputError(where("/velocities"),
+          frame + "has " + std::to_string(v->rows()) + " vertices, expected " + std::to_string(n));
     }
     if (frames > 0 && (v != nullptr) != velocities.has_value()) {
       throw InputError(where("/velocities"),
-                       frame + (v ? "has velocities but earlier frames have none"
-                                  : "has no velocities but earlier frames have them"));
+          frame
+              + (v ? "has velocities but earlier frames have none"
+                   : "has no velocities but earlier frames have them"));
     }
     const double* x_data = contiguous(x, scratch_x);
     const double* v_data = v ? contiguous(*v, scratch_v) : nullptr;
     check_finite(where("/positions"), x_data, n, frame);
-    if (v_data) check_finite(where("/velocities"), v_data, n, frame);
+    if (v_data)
+      check_finite(where("/velocities"), v_data, n, frame);
     try {
-      if (v_data && !velocities) velocities.emplace(file, "/velocities", h5::Shape{hsize_t(n), 3});
+      if (v_data && !velocities)
+        velocities.emplace(file, "/velocities", h5::Shape { hsize_t(n), 3 });
       positions.append(x_data);
-      if (v_data) velocities->append(v_data);
+      if (v_data)
+        velocities->append(v_data);
       time.append(&t);
     } catch (...) {
       failed = true;
@@ -138,7 +147,8 @@ struct TrajectoryWriter::Impl {
 
   void finish(const std::map<std::string, std::string>& metadata) {
     ELASTOLEARN_CHECK(!finished, "TrajectoryWriter::finish called twice");
-    if (failed) throw InputError(name, "an earlier write failed; nothing to finish");
+    if (failed)
+      throw InputError(name, "an earlier write failed; nothing to finish");
     for (const auto& [key, value] : metadata) {
       if (key.empty() || key == "format") {
         throw InputError(name, "invalid metadata key '" + key + "' (empty or reserved)");
@@ -146,10 +156,12 @@ struct TrajectoryWriter::Impl {
     }
     try {
       file.set_attribute("format", std::string(k_kind) + "/" + std::to_string(k_version));
-      for (const auto& [key, value] : metadata) file.set_attribute(key, value);
+      for (const auto& [key, value] : metadata)
+        file.set_attribute(key, value);
       positions.close();
       time.close();
-      if (velocities) velocities->close();
+      if (velocities)
+        velocities->close();
       file.close();
       atomic.commit();
     } catch (...) {
@@ -161,11 +173,11 @@ struct TrajectoryWriter::Impl {
 };
 
 TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path,
-                                   ConstRef<Positions> rest_positions, const Tets& tets,
-                                   const Edges& edges, const Faces& faces) {
+    ConstRef<Positions> rest_positions, const Tets& tets, const Edges& edges, const Faces& faces) {
   const std::string name = path.string();
   const Eigen::Index n = rest_positions.rows();
-  if (n == 0) throw InputError(name + ": /rest_positions", "no vertices");
+  if (n == 0)
+    throw InputError(name + ": /rest_positions", "no vertices");
   const Positions rest = rest_positions; // contiguous copy (rest data is written once)
   check_finite(name + ": /rest_positions", rest.data(), n);
   check_table(name, "/tets", tets, n);
@@ -174,10 +186,13 @@ TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path,
   m_impl = std::make_unique<Impl>(path, n);
   h5::File& file = m_impl->file;
   try {
-    file.write("/rest_positions", rest.data(), {hsize_t(n), 3});
-    if (tets.rows() > 0) file.write("/tets", tets.data(), {hsize_t(tets.rows()), 4});
-    if (edges.rows() > 0) file.write("/edges", edges.data(), {hsize_t(edges.rows()), 2});
-    if (faces.rows() > 0) file.write("/faces", faces.data(), {hsize_t(faces.rows()), 3});
+    file.write("/rest_positions", rest.data(), { hsize_t(n), 3 });
+    if (tets.rows() > 0)
+      file.write("/tets", tets.data(), { hsize_t(tets.rows()), 4 });
+    if (edges.rows() > 0)
+      file.write("/edges", edges.data(), { hsize_t(edges.rows()), 2 });
+    if (faces.rows() > 0)
+      file.write("/faces", faces.data(), { hsize_t(faces.rows()), 3 });
   } catch (...) {
     m_impl->failed = true;
     throw;
@@ -185,7 +200,8 @@ TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path,
 }
 
 TrajectoryWriter::~TrajectoryWriter() {
-  if (!m_impl || m_impl->finished) return;
+  if (!m_impl || m_impl->finished)
+    return;
   if (m_impl->keep && !m_impl->failed) {
     try {
       m_impl->finish(m_impl->partial_metadata);
@@ -203,8 +219,8 @@ void TrajectoryWriter::append(double time, ConstRef<Positions> positions) {
   m_impl->append(time, positions, nullptr);
 }
 
-void TrajectoryWriter::append(double time, ConstRef<Positions> positions,
-                              ConstRef<Positions> velocities) {
+void TrajectoryWriter::append(
+    double time, ConstRef<Positions> positions, ConstRef<Positions> velocities) {
   m_impl->append(time, positions, &velocities);
 }
 
@@ -218,19 +234,25 @@ void TrajectoryWriter::keep_partial(std::map<std::string, std::string> metadata)
   m_impl->partial_metadata = std::move(metadata);
 }
 
-long TrajectoryWriter::frames() const { return m_impl->frames; }
+long TrajectoryWriter::frames() const {
+  return m_impl->frames;
+}
 
-const std::filesystem::path& TrajectoryWriter::path() const { return m_impl->atomic.target(); }
+const std::filesystem::path& TrajectoryWriter::path() const {
+  return m_impl->atomic.target();
+}
 
 void write_trajectory_h5(const std::filesystem::path& path, const TrajectoryData& data) {
   const std::string name = path.string();
   if (data.time.size() != data.positions.size()) {
-    throw InputError(name, std::to_string(data.positions.size()) + " position frames but " +
-                               std::to_string(data.time.size()) + " times");
+    throw InputError(name,
+        std::to_string(data.positions.size()) + " position frames but "
+            + std::to_string(data.time.size()) + " times");
   }
   if (!data.velocities.empty() && data.velocities.size() != data.positions.size()) {
-    throw InputError(name, std::to_string(data.positions.size()) + " position frames but " +
-                               std::to_string(data.velocities.size()) + " velocity frames");
+    throw InputError(name,
+        std::to_string(data.positions.size()) + " position frames but "
+            + std::to_string(data.velocities.size()) + " velocity frames");
   }
   TrajectoryWriter writer(path, data.rest_positions, data.tets, data.edges, data.faces);
   for (std::size_t t = 0; t < data.positions.size(); ++t) {
@@ -249,8 +271,8 @@ namespace {
 
 /// Check a dataset's shape against `expected` (k_any matches any extent); `pattern` describes it
 /// symbolically for the message, e.g. "(T, n, 3)".
-h5::Shape require_shape(const h5::File& file, const std::string& dataset,
-                        const h5::Shape& expected, const std::string& pattern) {
+h5::Shape require_shape(const h5::File& file, const std::string& dataset, const h5::Shape& expected,
+    const std::string& pattern) {
   const h5::Shape shape = file.shape(dataset);
   bool ok = shape.size() == expected.size();
   for (std::size_t i = 0; ok && i < shape.size(); ++i) {
@@ -259,7 +281,8 @@ h5::Shape require_shape(const h5::File& file, const std::string& dataset,
   if (!ok) {
     std::string wanted = pattern;
     bool concrete = true;
-    for (hsize_t e : expected) concrete = concrete && e != k_any;
+    for (hsize_t e : expected)
+      concrete = concrete && e != k_any;
     if (concrete && pattern != h5::shape_string(expected)) {
       wanted += " = " + h5::shape_string(expected);
     }
@@ -272,27 +295,31 @@ void check_format(const h5::File& file) {
   const std::string expected = std::string(k_kind) + "/" + std::to_string(k_version);
   const std::optional<std::string> format = file.attribute("format");
   if (!format) {
-    file.fail("", "not an elastolearn trajectory: the root attribute 'format' is missing "
-                  "(expected '" + expected + "')");
+    file.fail("",
+        "not an elastolearn trajectory: the root attribute 'format' is missing "
+        "(expected '"
+            + expected + "')");
   }
   const std::string prefix = std::string(k_kind) + "/";
   if (format->rfind(prefix, 0) != 0) {
-    file.fail("", "format '" + *format + "' is not an elastolearn trajectory (expected '" +
-                      expected + "')");
+    file.fail("",
+        "format '" + *format + "' is not an elastolearn trajectory (expected '" + expected + "')");
   }
   const std::string version = format->substr(prefix.size());
   int v = 0;
   try {
     std::size_t used = 0;
     v = std::stoi(version, &used);
-    if (used != version.size()) v = 0;
+    if (used != version.size())
+      v = 0;
   } catch (const std::exception&) {
     v = 0;
   }
-  if (v < 1) file.fail("", "invalid format version in '" + *format + "'");
+  if (v < 1)
+    file.fail("", "invalid format version in '" + *format + "'");
   if (v > k_version) {
-    file.fail("", "format '" + *format + "' is newer than this elastolearn reads (up to '" +
-                      expected + "')");
+    file.fail("",
+        "format '" + *format + "' is newer than this elastolearn reads (up to '" + expected + "')");
   }
 }
 
@@ -300,9 +327,10 @@ template <typename Table>
 Table read_table(const h5::File& file, const char* dataset, Eigen::Index n) {
   constexpr int cols = Table::ColsAtCompileTime;
   Table table;
-  if (!file.exists(dataset)) return table;
-  const h5::Shape shape = require_shape(file, dataset, {k_any, hsize_t(cols)},
-                                        "(m, " + std::to_string(cols) + ")");
+  if (!file.exists(dataset))
+    return table;
+  const h5::Shape shape
+      = require_shape(file, dataset, { k_any, hsize_t(cols) }, "(m, " + std::to_string(cols) + ")");
   table.resize(Eigen::Index(shape[0]), cols);
   file.read(dataset, table.data());
   check_table(file.name(), dataset, table, n);
@@ -310,20 +338,20 @@ Table read_table(const h5::File& file, const char* dataset, Eigen::Index n) {
 }
 
 /// Read a (T, n, 3) dataset frame by frame, checking every value is finite.
-std::vector<Positions> read_frames(const h5::File& file, const char* dataset, hsize_t frames,
-                                   Eigen::Index n) {
+std::vector<Positions> read_frames(
+    const h5::File& file, const char* dataset, hsize_t frames, Eigen::Index n) {
   const h5::Shape shape = file.shape(dataset);
   if (shape.size() == 3 && shape[0] != frames && shape[1] == hsize_t(n) && shape[2] == 3) {
-    file.fail(dataset, "has " + std::to_string(shape[0]) + " frames but /time has " +
-                           std::to_string(frames));
+    file.fail(dataset,
+        "has " + std::to_string(shape[0]) + " frames but /time has " + std::to_string(frames));
   }
-  require_shape(file, dataset, {frames, hsize_t(n), 3}, "(T, n, 3)");
+  require_shape(file, dataset, { frames, hsize_t(n), 3 }, "(T, n, 3)");
   const h5::Dataset ds = file.dataset(dataset); // open once: its chunk cache serves every frame
   std::vector<Positions> out(frames, Positions(n, 3));
   for (hsize_t t = 0; t < frames; ++t) {
     ds.read(out[t].data(), t, 1);
-    check_finite(file.name() + ": " + dataset, out[t].data(), n,
-                 "frame " + std::to_string(t) + ": ");
+    check_finite(
+        file.name() + ": " + dataset, out[t].data(), n, "frame " + std::to_string(t) + ": ");
   }
   return out;
 }
@@ -335,23 +363,25 @@ TrajectoryData read_trajectory_h5(const std::filesystem::path& path) {
   check_format(file);
   TrajectoryData data;
 
-  const h5::Shape rest_shape = require_shape(file, "/rest_positions", {k_any, 3}, "(n, 3)");
+  const h5::Shape rest_shape = require_shape(file, "/rest_positions", { k_any, 3 }, "(n, 3)");
   const Eigen::Index n = Eigen::Index(rest_shape[0]);
-  if (n == 0) file.fail("/rest_positions", "no vertices");
+  if (n == 0)
+    file.fail("/rest_positions", "no vertices");
   data.rest_positions.resize(n, 3);
   file.read("/rest_positions", data.rest_positions.data());
   check_finite(file.name() + ": /rest_positions", data.rest_positions.data(), n);
 
-  const h5::Shape time_shape = require_shape(file, "/time", {k_any}, "(T,)");
+  const h5::Shape time_shape = require_shape(file, "/time", { k_any }, "(T,)");
   data.time.resize(time_shape[0]);
   file.read("/time", data.time.data());
   for (std::size_t t = 0; t < data.time.size(); ++t) {
     check_time(file.name() + ": /time", long(t), data.time[t],
-               t ? std::optional<double>(data.time[t - 1]) : std::nullopt);
+        t ? std::optional<double>(data.time[t - 1]) : std::nullopt);
   }
 
   data.positions = read_frames(file, "/positions", time_shape[0], n);
-  if (file.exists("/velocities")) data.velocities = read_frames(file, "/velocities", time_shape[0], n);
+  if (file.exists("/velocities"))
+    data.velocities = read_frames(file, "/velocities", time_shape[0], n);
   data.tets = read_table<Tets>(file, "/tets", n);
   data.edges = read_table<Edges>(file, "/edges", n);
   data.faces = read_table<Faces>(file, "/faces", n);

@@ -17,13 +17,13 @@ namespace elastolearn::io {
 
 /// A recorded motion of a mesh (tets) or mass-spring system (edges/faces).
 struct TrajectoryData {
-  Positions rest_positions;              ///< n×3 [m]
-  Tets tets;                             ///< m×4 (may be empty)
-  Edges edges;                           ///< e×2 springs (may be empty)
-  Faces faces;                           ///< f×3 triangles for viewing (may be empty)
-  std::vector<Positions> positions;      ///< T frames, each n×3 [m]
-  std::vector<Positions> velocities;     ///< empty or T frames [m/s]
-  std::vector<double> time;              ///< T times [s]
+  Positions rest_positions; ///< n×3 [m]
+  Tets tets; ///< m×4 (may be empty)
+  Edges edges; ///< e×2 springs (may be empty)
+  Faces faces; ///< f×3 triangles for viewing (may be empty)
+  std::vector<Positions> positions; ///< T frames, each n×3 [m]
+  std::vector<Positions> velocities; ///< empty or T frames [m/s]
+  std::vector<double> time; ///< T times [s]
   std::map<std::string, std::string> metadata; ///< string attributes on the root group
 };
 
@@ -37,12 +37,11 @@ void write_trajectory_h5(const std::filesystem::path& path, const TrajectoryData
 /// the frames before a divergence). Every frame is validated before it is written, so whatever
 /// lands on disk passes read_trajectory_h5(). `write_trajectory_h5` is this class in one call.
 class TrajectoryWriter {
-public:
+  public:
   /// Start the file with the rest state (n×3, n ≥ 1, finite) and the optional elements (indices
   /// in [0, n)). Throws InputError naming `path` on invalid data or when the file cannot be made.
   TrajectoryWriter(const std::filesystem::path& path, ConstRef<Positions> rest_positions,
-                   const Tets& tets = Tets(), const Edges& edges = Edges(),
-                   const Faces& faces = Faces());
+      const Tets& tets = Tets(), const Edges& edges = Edges(), const Faces& faces = Faces());
   ~TrajectoryWriter();
   TrajectoryWriter(TrajectoryWriter&&) noexcept;
   TrajectoryWriter& operator=(TrajectoryWriter&&) noexcept;
@@ -68,7 +67,7 @@ public:
   /// The target path.
   const std::filesystem::path& path() const;
 
-private:
+  private:
   struct Impl;
   std::unique_ptr<Impl> m_impl;
 };
@@ -81,7 +80,7 @@ TrajectoryData read_trajectory_h5(const std::filesystem::path& path);
 /// appended data not required: base64 inline) and `<stem>.pvd` indexing them with their times,
 /// into `directory`. Cells: tets (VTK_TETRA), else faces (VTK_TRIANGLE), else edges (VTK_LINE).
 /// Point data: displacement (and velocity when present). Returns the path of the .pvd.
-std::filesystem::path write_vtu_series(const std::filesystem::path& directory,
-                                       const std::string& stem, const TrajectoryData& data);
+std::filesystem::path write_vtu_series(
+    const std::filesystem::path& directory, const std::string& stem, const TrajectoryData& data);
 
 } // namespace elastolearn::io

@@ -18,8 +18,8 @@ enum class VtkCellType : unsigned char { vertex = 1, line = 3, triangle = 5, tet
 /// The cells of a VTU piece, all of one type, encoded once (connectivity, offsets, types) so that
 /// a series of frames reuses the same bytes. Converts implicitly from Tets, Faces and Edges.
 class VtuCells {
-public:
-  VtuCells(const Tets& tets);   ///< VTK_TETRA (10)
+  public:
+  VtuCells(const Tets& tets); ///< VTK_TETRA (10)
   VtuCells(const Faces& faces); ///< VTK_TRIANGLE (5)
   VtuCells(const Edges& edges); ///< VTK_LINE (3)
   /// One VTK_VERTEX (1) per point: a point cloud or a mesh without elements.
@@ -34,7 +34,7 @@ public:
   /// The encoded `<Cells>` element.
   const std::string& xml() const { return m_xml; }
 
-private:
+  private:
   VtuCells(const int* connectivity, Eigen::Index count, int nodes, VtkCellType type);
   Eigen::Index m_count = 0;
   VtkCellType m_type = VtkCellType::vertex;
@@ -52,12 +52,12 @@ struct VtuField {
 /// Throws InputError naming `path` if a field has the wrong row count, a cell references a
 /// missing point, or the file cannot be written.
 void write_vtu(const std::filesystem::path& path, ConstRef<Positions> positions,
-               const VtuCells& cells, const std::vector<VtuField>& point_data = {});
+    const VtuCells& cells, const std::vector<VtuField>& point_data = {});
 
 /// Write a .pvd collection atomically: one DataSet per (time, file); files are written relative to
 /// the .pvd's directory when they lie under it.
 void write_pvd(const std::filesystem::path& path, const std::vector<double>& times,
-               const std::vector<std::filesystem::path>& files);
+    const std::vector<std::filesystem::path>& files);
 
 /// Standard base64 (RFC 4648, with '=' padding) of `bytes`, appended to `out`.
 void append_base64(std::string& out, const void* bytes, std::size_t size);

@@ -97,8 +97,11 @@ SurfaceMesh read_stl(const std::filesystem::path& path) {
   std::string data = read_text_file(path);
   // A binary file may also begin with "solid"; its exact size decides.
   const bool binary_size = data.size() >= 84 && data.size() == 84 + 50 * static_cast<std::size_t>(le32(data, 80));
-  const bool starts_solid = data.compare(0, 5, "solid") == 0;
-  if (starts_solid && !binary_size) return read_ascii_stl(path, std::move(data));
+  // An ASCII file starts with "solid" and soon has a "facet" (or is an empty "endsolid").
+  const std::string_view head = std::string_view(data).substr(0, 1024);
+  const bool looks_ascii = head.starts_with("solid") &&
+                           (head.find("facet") != std::string_view::npos || head.find("endsolid") != std::string_view::npos);
+  if (looks_ascii && !binary_size) return read_ascii_stl(path, std::move(data));
   return read_binary_stl(path, data);
 }
 

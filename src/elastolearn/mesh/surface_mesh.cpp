@@ -76,8 +76,7 @@ void write_off(const std::filesystem::path& path, const SurfaceMesh& surface) {
   write_text_file_atomic(path, text);
 }
 
-bool is_closed(const SurfaceMesh& surface) {
-  if (surface.faces.rows() == 0) return false;
+EdgeDefects edge_defects(const SurfaceMesh& surface) {
   std::unordered_map<long long, int> edges;
   edges.reserve(static_cast<std::size_t>(surface.faces.rows()) * 3);
   for (Eigen::Index f = 0; f < surface.faces.rows(); ++f)
@@ -85,7 +84,17 @@ bool is_closed(const SurfaceMesh& surface) {
       const long long a = surface.faces(f, k), b = surface.faces(f, (k + 1) % 3);
       ++edges[std::min(a, b) << 32 | std::max(a, b)];
     }
-  return std::all_of(edges.begin(), edges.end(), [](const auto& e) { return e.second == 2; });
+  EdgeDefects d;
+  for (const auto& e : edges) {
+    d.boundary_edges += e.second == 1;
+    d.non_manifold_edges += e.second > 2;
+  }
+  return d;
+}
+
+bool is_closed(const SurfaceMesh& surface) {
+  const EdgeDefects d = edge_defects(surface);
+  return surface.faces.rows() > 0 && d.boundary_edges == 0 && d.non_manifold_edges == 0;
 }
 
 double enclosed_volume(const SurfaceMesh& surface) {

@@ -33,6 +33,13 @@ void write_off(const std::filesystem::path& path, const SurfaceMesh& surface);
 /// Orientation consistency is not checked here.
 bool is_closed(const SurfaceMesh& surface);
 
+/// Edges of the surface used by one face (open boundary) and by more than two (non-manifold).
+struct EdgeDefects {
+  int boundary_edges = 0;
+  int non_manifold_edges = 0;
+};
+EdgeDefects edge_defects(const SurfaceMesh& surface);
+
 /// Signed volume enclosed by the surface [m³]: Σ x0·(x1×x2)/6 over faces. Positive for a closed
 /// outward-oriented surface; meaningless for an open one.
 double enclosed_volume(const SurfaceMesh& surface);

@@ -3,6 +3,7 @@
 #include <elastolearn/config.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/mesh/external_program.hpp>
+#include <elastolearn/mesh/surface_repair.hpp>
 #include <elastolearn/mesh/surface_simplification.hpp>
 #include <elastolearn/mesh/tetgen_io.hpp>
 
@@ -71,12 +72,13 @@ public:
     return run(surface, max_volume, /*preserve_surface=*/true);
   }
 
-  /// Throws the error for the last failure, diagnosing self-intersections with `tetgen -d`.
+  /// Throws the error for the last failure, diagnosing self-intersections with `tetgen -d` (not
+  /// quiet: -Q would hide the count).
   [[noreturn]] void fail() {
     std::string message = m_failure;
     const auto off = m_dir.path() / "check.off";
     write_off(off, m_failed_surface);
-    const ProgramResult check = run_program(m_report.tetgen, {"-pdzQ", off.string()}, m_dir.path() / "check.log");
+    const ProgramResult check = run_program(m_report.tetgen, {"-pdz", off.string()}, m_dir.path() / "check.log");
     std::smatch match;
     if (std::regex_search(check.output, match, std::regex(R"(Found (\d+) pairs of faces are intersecting)")))
       message += "; the surface has " + match[1].str() +
@@ -159,9 +161,17 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const TetrahedralizeOption
                        TetrahedralizeReport* report_out, const std::string& source) {
   const auto start = Clock::now();
   options.validate();
-  if (!is_closed(surface_in))
-    throw InputError(source, "surface is not closed (some edge is not shared by exactly two faces)");
-  const SurfaceMesh surface = remove_unreferenced_vertices(surface_in);
+  int holes_filled = 0;
+  const SurfaceMesh surface = remove_unreferenced_vertices(
+      options.fill_holes && !is_closed(surface_in) ? fill_holes(surface_in, &holes_filled) : surface_in);
+  if (!is_closed(surface)) {
+    const EdgeDefects d = edge_defects(surface);
+    throw InputError(source, "surface is not closed: " + std::to_string(d.boundary_edges) +
+                                 " edges belong to one face (holes) and " +
+                                 std::to_string(d.non_manifold_edges) +
+                                 " to more than two; TetGen needs a closed surface" +
+                                 (options.fill_holes ? "" : " (filling holes is an option)"));
+  }
   const double volume = std::abs(enclosed_volume(surface));
   if (!(volume > 0)) throw InputError(source, "surface encloses no volume");
 
@@ -172,6 +182,7 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const TetrahedralizeOption
                      "TetGen program not found or not executable; install it (Debian package "
                      "'tetgen') or set ELASTOLEARN_TETGEN to its path");
   report.input_faces = static_cast<int>(surface.faces.rows());
+  report.holes_filled = holes_filled;
   TetgenRunner runner(options, report, source);
 
   std::optional<TetMesh> mesh;
@@ -184,6 +195,8 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const TetrahedralizeOption
     // A surface too detailed for the target is simplified first (tets grow ~7× the faces), and
     // again with a face budget scaled by (target / tets)^(2/3) while the unbounded mesh is too big.
     double face_budget = target / kTetsPerSurfaceFace;
+    // Only a clearly too fine surface is simplified before trying it as it is.
+    if (surface.faces.rows() <= 2 * face_budget) face_budget = static_cast<double>(surface.faces.rows());
     for (int attempt = 0; attempt < 4; ++attempt) {
       if (surface.faces.rows() > face_budget) {
         meshed = simplify_surface(surface, std::max(16, static_cast<int>(face_budget)));
@@ -191,8 +204,8 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const TetrahedralizeOption
       }
       auto unbounded = runner.run_with_fallback(meshed, options.max_volume);
       if (!unbounded) {
-        if (!report.simplified) break;
-        face_budget *= 0.8; // a different simplification may avoid the defect
+        // A (different) simplification may remove the defect, e.g. small self-intersections.
+        face_budget = std::min(face_budget, static_cast<double>(meshed.faces.rows())) * 0.8;
         continue;
       }
       const int count = unbounded->num_tets();

@@ -27,6 +27,9 @@ struct TetrahedralizeOptions {
   double min_dihedral_deg = 0;
   /// Number of TetGen runs allowed to hit max_tets.
   int max_iterations = 8;
+  /// Close holes (boundary loops) of an open surface before meshing (see fill_holes()); without
+  /// it an open surface is an error.
+  bool fill_holes = false;
   /// Pass TetGen's output through (to stderr) instead of running it quietly.
   bool verbose = false;
   /// TetGen program; empty = $ELASTOLEARN_TETGEN, else the one found at configure time.
@@ -53,6 +56,7 @@ struct TetrahedralizeReport {
   int input_faces = 0;         ///< faces of the given surface
   int surface_faces = 0;       ///< faces of the surface actually meshed (after simplification)
   bool simplified = false;     ///< the surface was simplified to reach max_tets
+  int holes_filled = 0;        ///< boundary loops closed (TetrahedralizeOptions::fill_holes)
   double max_volume = 0;       ///< the -a bound of the chosen run (0 = none)
   double seconds = 0;          ///< total wall time
   std::vector<TetgenRun> runs; ///< every TetGen run, in order
@@ -67,7 +71,7 @@ bool tetgen_available(const TetrahedralizeOptions& options = {});
 
 /// Tetrahedralizes a closed, non-self-intersecting triangle surface. `source` names the surface in
 /// errors. Throws InputError if the options are invalid, the surface is not closed or encloses no
-/// volume, TetGen is missing, or TetGen fails (the message then reports how many pairs of faces
+/// volume (unless fill_holes closes it), TetGen is missing, or TetGen fails (the message then reports how many pairs of faces
 /// TetGen found intersecting, from its `-d` check, when that is the cause).
 TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& options,
                        TetrahedralizeReport* report = nullptr, const std::string& source = "surface");

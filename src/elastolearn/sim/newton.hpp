@@ -1,7 +1,9 @@
 #pragma once
 /// \file One Newton solver with backtracking line search, shared by the dynamic step and the
-/// static equilibrium solve. The Jacobian is the projected (PSD) one, so the step is a descent
-/// direction for the incremental potential; the line search accepts a step that reduces ‖g‖.
+/// static equilibrium solve. The Jacobian is the projected (PSD) one. With an energy (statics of
+/// hyperelastic models) the step is an Armijo backtracking line search on it; without one
+/// (dynamics with damping or a correction) the full step is taken unless the state turns
+/// non-finite or the residual grows more than 1000-fold.
 #include <elastolearn/core/types.hpp>
 #include <elastolearn/fem/system_matrix.hpp>
 #include <elastolearn/sim/linear_solver.hpp>
@@ -15,7 +17,7 @@ struct NewtonOptions {
   double relative_tolerance = 1e-6; ///< stop when ‖g‖ ≤ tol · ‖g₀‖ …
   double absolute_tolerance = 0;    ///< … or ‖g‖ ≤ this [N] (0: chosen by the caller's scale)
   int max_iterations = 50;
-  int max_line_search = 12;         ///< step halvings before taking the best trial
+  int max_line_search = 12;         ///< step halvings
   /// Throws InputError naming the offending option.
   void validate() const;
 };
@@ -44,6 +46,8 @@ struct NewtonProblem {
   std::function<void(const VecX& u, VecX& g)> residual;
   /// g(u) and its (PSD) Jacobian written into A (A is zeroed by the callee).
   std::function<void(const VecX& u, VecX& g, fem::SystemMatrix& A)> residual_and_jacobian;
+  /// Optional energy E(u) with ∇E = g, used as the line-search merit function.
+  std::function<double(const VecX& u)> energy;
 };
 
 /// Solve g(u) = 0 starting from u. The solver's symbolic analysis must already be done on A's
