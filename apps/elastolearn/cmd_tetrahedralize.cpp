@@ -26,25 +26,28 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
     throw InputError(args.output, "output must be a TetGen .node/.ele path (or their common stem)");
   const mesh::SurfaceMesh surface = mesh::read_surface_mesh(args.input);
   std::printf("surface   %s: %d vertices, %d faces, enclosed volume %.6g\n", args.input.c_str(),
-              static_cast<int>(surface.vertices.rows()), static_cast<int>(surface.faces.rows()),
-              mesh::enclosed_volume(surface));
+      static_cast<int>(surface.vertices.rows()), static_cast<int>(surface.faces.rows()),
+      mesh::enclosed_volume(surface));
   mesh::TetrahedralizeReport report;
   const mesh::TetMesh tets = mesh::tetrahedralize(surface, args.options, &report, args.input);
-  if (report.holes_filled > 0) std::printf("filled %d holes of the surface\n", report.holes_filled);
+  if (report.holes_filled > 0)
+    std::printf("filled %d holes of the surface\n", report.holes_filled);
   if (report.simplified)
-    std::printf("simplified the surface to %d faces to reach the tet budget\n", report.surface_faces);
+    std::printf(
+        "simplified the surface to %d faces to reach the tet budget\n", report.surface_faces);
   for (const auto& run : report.runs)
     std::printf("  tetgen %-28s faces %6d -> %7d tets  (%.2f s)\n", run.switches.c_str(),
-                run.surface_faces, run.num_tets, run.seconds);
+        run.surface_faces, run.num_tets, run.seconds);
   const mesh::MeshQuality q = tets.quality();
   std::printf("tet mesh  %d tets, %d vertices, %d surface faces, volume %.6g\n", tets.num_tets(),
-              tets.num_vertices(), static_cast<int>(tets.surface_faces().rows()), tets.total_volume());
-  std::printf("quality   dihedral [%.2f, %.2f] deg, max radius ratio %.3g, tet volume [%.3g, %.3g]\n",
-              q.min_dihedral_deg, q.max_dihedral_deg, q.max_radius_ratio, q.min_volume, q.max_volume);
+      tets.num_vertices(), static_cast<int>(tets.surface_faces().rows()), tets.total_volume());
+  std::printf(
+      "quality   dihedral [%.2f, %.2f] deg, max radius ratio %.3g, tet volume [%.3g, %.3g]\n",
+      q.min_dihedral_deg, q.max_dihedral_deg, q.max_radius_ratio, q.min_volume, q.max_volume);
   const auto stem = mesh::tetgen_stem(out);
   mesh::write_tetgen(stem, tets);
   std::printf("wrote     %s.node, %s.ele (%.2f s)\n", stem.string().c_str(), stem.string().c_str(),
-              report.seconds);
+      report.seconds);
 }
 
 } // namespace
@@ -57,17 +60,17 @@ void add_tetrahedralize_command(CLI::App& root) {
   cmd->add_option("-o,--output", args->output, "output TetGen mesh (.node; .ele written beside it)")
       ->required();
   cmd->add_option("--max-tets", args->options.max_tets,
-                  "target tet count (not exceeded by more than 10%; 0 = no target)");
+      "target tet count (not exceeded by more than 10%; 0 = no target)");
   cmd->add_option("--max-volume", args->options.max_volume, "maximum tet volume (0 = none)");
-  cmd->add_option("--quality", args->options.min_radius_edge_ratio,
-                  "maximum radius-edge ratio (TetGen -q)")
+  cmd->add_option(
+         "--quality", args->options.min_radius_edge_ratio, "maximum radius-edge ratio (TetGen -q)")
       ->capture_default_str();
   cmd->add_option("--min-dihedral", args->options.min_dihedral_deg,
-                  "minimum dihedral angle in degrees (TetGen -q ratio/angle; 0 = default)");
+      "minimum dihedral angle in degrees (TetGen -q ratio/angle; 0 = default)");
   cmd->add_option("--tetgen", args->options.tetgen_executable,
-                  "TetGen program (default: $ELASTOLEARN_TETGEN or the one found at build time)");
+      "TetGen program (default: $ELASTOLEARN_TETGEN or the one found at build time)");
   cmd->add_flag("--fill-holes", args->options.fill_holes,
-                "close holes of an open surface (fan around each hole's centroid) before meshing");
+      "close holes of an open surface (fan around each hole's centroid) before meshing");
   cmd->add_flag("-v,--verbose", args->options.verbose, "show TetGen's output");
   cmd->callback([args] { run_tetrahedralize(*args); });
 }

@@ -16,13 +16,14 @@ namespace elastolearn::test {
 
 /// A fresh directory under the system temp dir, removed at the end of the test.
 class TempDir {
-public:
+  public:
   TempDir() {
     const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = std::string("elastolearn_mesh_") + std::to_string(::getpid()) + "_" +
-                       (info ? std::string(info->test_suite_name()) + "_" + info->name() : "x");
+    std::string name = std::string("elastolearn_mesh_") + std::to_string(::getpid()) + "_"
+        + (info ? std::string(info->test_suite_name()) + "_" + info->name() : "x");
     for (char& c : name)
-      if (c == '/') c = '_';
+      if (c == '/')
+        c = '_';
     m_path = std::filesystem::temp_directory_path() / name;
     std::filesystem::remove_all(m_path);
     std::filesystem::create_directories(m_path);
@@ -34,7 +35,7 @@ public:
   const std::filesystem::path& path() const { return m_path; }
   std::filesystem::path operator/(const std::string& name) const { return m_path / name; }
 
-private:
+  private:
   std::filesystem::path m_path;
 };
 
@@ -42,7 +43,9 @@ inline std::filesystem::path fixture(const std::string& name) {
   return std::filesystem::path(ELASTOLEARN_TEST_DATA_DIR) / "mesh" / name;
 }
 
-inline std::string read_fixture(const std::string& name) { return read_text_file(fixture(name)); }
+inline std::string read_fixture(const std::string& name) {
+  return read_text_file(fixture(name));
+}
 
 inline void write_file(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
@@ -53,20 +56,21 @@ inline void write_file(const std::filesystem::path& path, const std::string& tex
 inline std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto pos = text.find(from);
   EXPECT_NE(pos, std::string::npos) << "fixture lacks '" << from << "'";
-  if (pos != std::string::npos) text.replace(pos, from.size(), to);
+  if (pos != std::string::npos)
+    text.replace(pos, from.size(), to);
   return text;
 }
 
 /// Runs f, expects InputError whose message contains every fragment.
-template <typename F>
-void expect_input_error(F&& f, std::initializer_list<std::string> fragments) {
+template <typename F> void expect_input_error(F&& f, std::initializer_list<std::string> fragments) {
   try {
     f();
     ADD_FAILURE() << "expected InputError";
   } catch (const InputError& e) {
     const std::string msg = e.what();
     for (const auto& frag : fragments)
-      EXPECT_NE(msg.find(frag), std::string::npos) << "message '" << msg << "' lacks '" << frag << "'";
+      EXPECT_NE(msg.find(frag), std::string::npos)
+          << "message '" << msg << "' lacks '" << frag << "'";
   }
 }
 

@@ -27,7 +27,7 @@ TEST(TetMesh, SingleTetVolumeSurfaceAndOrientation) {
   const TetMesh m = unit_tet();
   EXPECT_DOUBLE_EQ(m.total_volume(), 1.0 / 6.0);
   ASSERT_EQ(m.surface_faces().rows(), 4);
-  EXPECT_EQ(m.surface_vertices(), (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(m.surface_vertices(), (std::vector<int> { 0, 1, 2, 3 }));
   // Every face normal points away from the opposite vertex (outward).
   const Vec3 centroid = m.rest_positions().colwise().mean();
   for (Eigen::Index f = 0; f < 4; ++f) {
@@ -63,7 +63,7 @@ TEST(TetMesh, QualityOfFlatTetIsBad) {
 
 TEST(TetMesh, BoxBarVolumeSurfaceAndOutwardFaces) {
   const Vec3 size(2.0, 0.5, 0.25);
-  const std::array<int, 3> cells{8, 3, 2};
+  const std::array<int, 3> cells { 8, 3, 2 };
   const TetMesh m = make_box_bar(size, cells);
   EXPECT_EQ(m.num_vertices(), 9 * 4 * 3);
   EXPECT_EQ(m.num_tets(), 6 * 8 * 3 * 2);
@@ -90,48 +90,49 @@ TEST(TetMesh, BoxBarVolumeSurfaceAndOutwardFaces) {
   EXPECT_TRUE(box.max().isApprox(size));
   EXPECT_NEAR(m.bounding_box_diagonal(), size.norm(), 1e-15);
   // Kuhn tets of a cube: dihedral angles 45°, 60°, 90° (on a non-cubic cell they vary).
-  const MeshQuality cube = make_box_bar(Vec3(1, 1, 1), {2, 2, 2}).quality();
+  const MeshQuality cube = make_box_bar(Vec3(1, 1, 1), { 2, 2, 2 }).quality();
   EXPECT_NEAR(cube.min_dihedral_deg, 45.0, 1e-9);
   EXPECT_NEAR(cube.max_dihedral_deg, 90.0, 1e-9);
 }
 
 TEST(TetMesh, RejectsEmptyMesh) {
-  test::expect_input_error([] { TetMesh(Positions(0, 3), Tets(0, 4), "empty.node"); },
-                           {"empty.node", "no vertices"});
+  test::expect_input_error(
+      [] { TetMesh(Positions(0, 3), Tets(0, 4), "empty.node"); }, { "empty.node", "no vertices" });
   Positions x(4, 3);
   x.setZero();
-  test::expect_input_error([&] { TetMesh(x, Tets(0, 4), "notets"); }, {"notets", "no tetrahedra"});
+  test::expect_input_error(
+      [&] { TetMesh(x, Tets(0, 4), "notets"); }, { "notets", "no tetrahedra" });
 }
 
 TEST(TetMesh, RejectsNonFiniteCoordinateNamingVertex) {
   Positions x = unit_tet().rest_positions();
   x(2, 1) = std::numeric_limits<double>::quiet_NaN();
-  test::expect_input_error([&] { TetMesh(x, unit_tet().tets(), "src"); },
-                           {"src", "vertex 2", "non-finite", "nan"});
+  test::expect_input_error(
+      [&] { TetMesh(x, unit_tet().tets(), "src"); }, { "src", "vertex 2", "non-finite", "nan" });
   x(2, 1) = std::numeric_limits<double>::infinity();
-  test::expect_input_error([&] { TetMesh(x, unit_tet().tets(), "src"); }, {"vertex 2", "inf"});
+  test::expect_input_error([&] { TetMesh(x, unit_tet().tets(), "src"); }, { "vertex 2", "inf" });
 }
 
 TEST(TetMesh, RejectsIndexOutOfRangeNamingTet) {
-  const TetMesh box = make_box_bar(Vec3(1, 1, 1), {1, 1, 1});
+  const TetMesh box = make_box_bar(Vec3(1, 1, 1), { 1, 1, 1 });
   Tets t = box.tets();
   t(4, 2) = 8;
   test::expect_input_error([&] { TetMesh(box.rest_positions(), t, "bar"); },
-                           {"bar", "tet 4", "index 8", "out of range"});
+      { "bar", "tet 4", "index 8", "out of range" });
   t(4, 2) = -1;
-  test::expect_input_error([&] { TetMesh(box.rest_positions(), t, "bar"); }, {"tet 4", "-1"});
+  test::expect_input_error([&] { TetMesh(box.rest_positions(), t, "bar"); }, { "tet 4", "-1" });
 }
 
 TEST(TetMesh, RejectsInvertedAndDegenerateTetsWithVolume) {
   const TetMesh m = unit_tet();
   Tets t = m.tets();
   std::swap(t(0, 1), t(0, 2));
-  test::expect_input_error([&] { TetMesh(m.rest_positions(), t, "inv"); },
-                           {"inv", "tet 0", "inverted", "-0.166667"});
-  test::expect_input_error([&] { unit_tet(Vec3(0.5, 0.5, 0)); }, {"unit", "tet 0", "degenerate"});
+  test::expect_input_error(
+      [&] { TetMesh(m.rest_positions(), t, "inv"); }, { "inv", "tet 0", "inverted", "-0.166667" });
+  test::expect_input_error([&] { unit_tet(Vec3(0.5, 0.5, 0)); }, { "unit", "tet 0", "degenerate" });
   Tets repeated = m.tets();
   repeated(0, 3) = 0;
-  test::expect_input_error([&] { TetMesh(m.rest_positions(), repeated, "rep"); }, {"degenerate"});
+  test::expect_input_error([&] { TetMesh(m.rest_positions(), repeated, "rep"); }, { "degenerate" });
 }
 
 TEST(TetMesh, UnreferencedVerticesAreAllowed) {
@@ -141,5 +142,5 @@ TEST(TetMesh, UnreferencedVerticesAreAllowed) {
   t << 0, 1, 2, 3;
   const TetMesh m(x, t);
   EXPECT_EQ(m.num_vertices(), 5);
-  EXPECT_EQ(m.surface_vertices(), (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(m.surface_vertices(), (std::vector<int> { 0, 1, 2, 3 }));
 }

@@ -13,11 +13,12 @@ namespace {
 
 SurfaceMesh sphere_surface(int target_tets) {
   const TetMesh ball = make_sphere(1.0, target_tets);
-  return remove_unreferenced_vertices({ball.rest_positions(), ball.surface_faces()});
+  return remove_unreferenced_vertices({ ball.rest_positions(), ball.surface_faces() });
 }
 
 #define REQUIRE_TETGEN()                                                                           \
-  if (!tetgen_available()) GTEST_SKIP() << "TetGen program not found: " << tetgen_executable()
+  if (!tetgen_available())                                                                         \
+  GTEST_SKIP() << "TetGen program not found: " << tetgen_executable()
 
 } // namespace
 
@@ -32,7 +33,8 @@ TEST(Tetrahedralize, FillsTheSurfaceExactly) {
   // TetGen keeps the input polyhedron (it may only split its faces), so the tets fill exactly
   // the enclosed volume, up to rounding.
   EXPECT_NEAR(m.total_volume(), enclosed_volume(surface), 1e-9);
-  EXPECT_NEAR(test::divergence_volume(m.rest_positions(), m.surface_faces()), m.total_volume(), 1e-12);
+  EXPECT_NEAR(
+      test::divergence_volume(m.rest_positions(), m.surface_faces()), m.total_volume(), 1e-12);
   EXPECT_EQ(m.quality().num_degenerate, 0);
 }
 
@@ -43,10 +45,10 @@ TEST(Tetrahedralize, LandsNearTheTargetCountWithoutExceedingIt) {
   options.max_tets = 5000;
   TetrahedralizeReport report;
   const TetMesh m = tetrahedralize(surface, options, &report);
-  std::printf("target 5000: %d tets after %zu TetGen runs (%.2f s)\n", m.num_tets(), report.runs.size(),
-              report.seconds);
-  EXPECT_LE(m.num_tets(), 5500);   // at most 10 % over
-  EXPECT_GE(m.num_tets(), 4000);   // and not far below
+  std::printf("target 5000: %d tets after %zu TetGen runs (%.2f s)\n", m.num_tets(),
+      report.runs.size(), report.seconds);
+  EXPECT_LE(m.num_tets(), 5500); // at most 10 % over
+  EXPECT_GE(m.num_tets(), 4000); // and not far below
   EXPECT_FALSE(report.simplified);
   EXPECT_GT(report.max_volume, 0); // reached by bounding the volume
   EXPECT_NEAR(m.total_volume(), enclosed_volume(surface), 1e-9);
@@ -69,20 +71,20 @@ TEST(Tetrahedralize, SimplifiesASurfaceTooFineForTheTarget) {
 TEST(Tetrahedralize, ClearErrors) {
   TetrahedralizeOptions bad;
   bad.min_radius_edge_ratio = 0.5;
-  test::expect_input_error([&] { bad.validate(); }, {"min_radius_edge_ratio", "0.5"});
+  test::expect_input_error([&] { bad.validate(); }, { "min_radius_edge_ratio", "0.5" });
   bad = {};
   bad.max_tets = -3;
-  test::expect_input_error([&] { bad.validate(); }, {"max_tets"});
+  test::expect_input_error([&] { bad.validate(); }, { "max_tets" });
 
   SurfaceMesh open = sphere_surface(750);
   open.faces.conservativeResize(open.faces.rows() - 1, 3);
   test::expect_input_error([&] { tetrahedralize(open, {}, nullptr, "open.off"); },
-                           {"open.off", "not closed", "3 edges belong to one face"});
+      { "open.off", "not closed", "3 edges belong to one face" });
 
   TetrahedralizeOptions missing;
   missing.tetgen_executable = "/nonexistent/tetgen";
   test::expect_input_error([&] { tetrahedralize(sphere_surface(750), missing); },
-                           {"/nonexistent/tetgen", "not found"});
+      { "/nonexistent/tetgen", "not found" });
 }
 
 TEST(Tetrahedralize, ReportsSelfIntersectingSurface) {
@@ -95,5 +97,5 @@ TEST(Tetrahedralize, ReportsSelfIntersectingSurface) {
   both.faces.resize(2 * a.faces.rows(), 3);
   both.faces << a.faces, (a.faces.array() + static_cast<int>(a.vertices.rows())).matrix();
   test::expect_input_error([&] { tetrahedralize(both, {}, nullptr, "two_balls.off"); },
-                           {"two_balls.off", "intersecting faces"});
+      { "two_balls.off", "intersecting faces" });
 }

@@ -36,59 +36,83 @@ ElasticForce::ElasticForce(const mesh::TetMesh& mesh, MaterialModel material)
     for (int a = 0; a < 4; ++a) m_vertex_sources[fill[m_tets(e, a)]++] = 4 * e + a;
 }
 
-void ElasticForce::evaluate(const ForceState& state, bool want_jacobian, double c_x, double c_v) {
+void ElasticForce::add_force(const ForceState& state, VecX& f) {
   const auto* elastic = m_material.elastic.get();
   const auto* correction = m_material.correction.get();
   const auto* damping = m_material.damping.get();
   const double density = m_material.density;
   const int m = static_cast<int>(m_tets.rows());
-  if (want_jacobian && m_matrix_buffer.size() != static_cast<size_t>(m) * 144)
-    m_matrix_buffer.assign(static_cast<size_t>(m) * 144, 0.0);
+  if (m_cache.size() != static_cast<size_t>(m)) m_cache.resize(m);
 
   tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
     for (int e = r.begin(); e < r.end(); ++e) {
       const TetRestData& rest = m_rest[e];
+      ElementCache& c = m_cache[e];
       const Eigen::Vector4i tet = m_tets.row(e).transpose();
       const auto xe = gather_tet(state.x, tet);
       const auto ve = gather_tet(state.v, tet);
-      const auto frame = material::principal_frame(deformation_gradient(xe, rest));
+      c.frame = material::principal_frame(deformation_gradient(xe, rest));
       Vec3 rates = Vec3::Zero();
-      if (correction) rates = material::stretch_rates(frame, deformation_gradient(ve, rest));
-      const auto stress =
-          material::corrected_principal_stress(*elastic, correction, frame.stretches, rates);
-      const Mat3 P = material::first_piola(frame, stress.stress);
+      const bool need_rate = correction || (damping != nullptr);
+      Mat3 F_rate;
+      if (need_rate) F_rate = deformation_gradient(ve, rest);
+      if (correction) rates = material::stretch_rates(c.frame, F_rate);
+      c.stress = material::corrected_principal_stress(*elastic, correction, c.frame.stretches, rates);
+      Mat3 P = material::first_piola(c.frame, c.stress.stress);
+      c.alpha = damping ? damping->coefficients(c.frame.stretches[0]) : material::RayleighCoefficients{};
+      c.has_tangent = false;
+      if (c.alpha.alpha1 != 0) {
+        // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 12×12.
+        c.tangent = material::first_piola_derivative(c.frame, c.stress.stress, c.stress.d_stretches,
+                                                     m_project_tangent);
+        c.has_tangent = true;
+        const Vec9 dP = c.tangent * Eigen::Map<const Vec9>(F_rate.data());
+        P += c.alpha.alpha1 * Eigen::Map<const Mat3>(dP.data());
+      }
       Eigen::Map<Eigen::Matrix<double, 3, 4>> force(m_force_buffer.data() + 12 * e);
       force.noalias() = -rest.volume * P * rest.gradients;
+      if (c.alpha.alpha0 != 0) force -= c.alpha.alpha0 * (density * rest.volume / 4.0) * ve;
+    }
+  });
+  m_cached_x = state.x;
+  m_cached_v = state.v;
+  gather_forces(f);
+}
 
-      material::RayleighCoefficients alpha;
-      if (damping) alpha = damping->coefficients(frame.stretches[0]);
-      const bool need_stiffness = want_jacobian || alpha.alpha1 != 0;
-      if (!need_stiffness && alpha.alpha0 == 0) continue;
+bool ElasticForce::cache_matches(const ForceState& state) const {
+  return m_cache.size() == static_cast<size_t>(m_tets.rows()) && m_cached_x.size() == state.x.size() &&
+         m_cached_v.size() == state.v.size() && m_cached_x == state.x && m_cached_v == state.v;
+}
 
-      const double vertex_mass = density * rest.volume / 4.0;
-      Eigen::Map<const Vec12> ve_flat(ve.data());
-      Eigen::Map<Vec12> force_flat(force.data());
-      force_flat -= alpha.alpha0 * vertex_mass * ve_flat;
-      if (!need_stiffness) continue;
-
-      const Mat9 H = material::first_piola_derivative(frame, stress.stress, stress.d_stretches,
-                                                         m_project_tangent);
-      const Mat12 K = element_matrix_from_tangent(H, rest);
-      if (alpha.alpha1 != 0) force_flat.noalias() -= alpha.alpha1 * (K * ve_flat);
-      if (!want_jacobian) continue;
-
+void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) {
+  if (!cache_matches(state)) {
+    VecX scratch = VecX::Zero(state.x.size());
+    add_force(state, scratch);
+  }
+  const auto* correction = m_material.correction.get();
+  const double density = m_material.density;
+  const int m = static_cast<int>(m_tets.rows());
+  if (m_matrix_buffer.size() != static_cast<size_t>(m) * 144)
+    m_matrix_buffer.assign(static_cast<size_t>(m) * 144, 0.0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
+    for (int e = r.begin(); e < r.end(); ++e) {
+      const TetRestData& rest = m_rest[e];
+      const ElementCache& c = m_cache[e];
       Eigen::Map<Mat12> J(m_matrix_buffer.data() + 144 * e);
-      J = (c_x + c_v * alpha.alpha1) * K;
-      J.diagonal().array() += c_v * alpha.alpha0 * vertex_mass;
+      const Mat9 H = c.has_tangent ? c.tangent
+                                   : material::first_piola_derivative(c.frame, c.stress.stress,
+                                                                      c.stress.d_stretches, m_project_tangent);
+      J = element_matrix_from_tangent(H, rest);
+      J *= c_x + c_v * c.alpha.alpha1;
+      if (c.alpha.alpha0 != 0) J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
       if (correction && c_v != 0) {
-        const Mat3 d_rates =
-            m_project_tangent ? symmetric_psd(stress.d_stretch_rates) : stress.d_stretch_rates;
+        const Mat3 d_rates = m_project_tangent ? symmetric_psd(c.stress.d_stretch_rates) : c.stress.d_stretch_rates;
         if (!d_rates.isZero(0))
-          J += c_v * element_matrix_from_tangent(
-                         material::first_piola_rate_derivative(frame, d_rates), rest);
+          J += c_v * element_matrix_from_tangent(material::first_piola_rate_derivative(c.frame, d_rates), rest);
       }
     }
   });
+  A.add_element_blocks(m_matrix_buffer);
 }
 
 void ElasticForce::gather_forces(VecX& f) const {
@@ -101,18 +125,6 @@ void ElasticForce::gather_forces(VecX& f) const {
       f.segment<3>(3 * v) += sum;
     }
   });
-}
-
-void ElasticForce::add_force(const ForceState& state, VecX& f) {
-  evaluate(state, false, 0, 0);
-  gather_forces(f);
-}
-
-void ElasticForce::add_force_and_jacobian(const ForceState& state, double c_x, double c_v, VecX& f,
-                                          SystemMatrix& A) {
-  evaluate(state, true, c_x, c_v);
-  gather_forces(f);
-  A.add_element_blocks(m_matrix_buffer);
 }
 
 double ElasticForce::elastic_energy(const VecX& x) const {

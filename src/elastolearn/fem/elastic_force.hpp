@@ -6,6 +6,7 @@
 #include <elastolearn/material/correction.hpp>
 #include <elastolearn/material/damping_model.hpp>
 #include <elastolearn/material/elastic_model.hpp>
+#include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/mesh/tet_mesh.hpp>
 
 #include <memory>
@@ -33,9 +34,10 @@ class ElasticForce final : public ForceTerm {
 public:
   ElasticForce(const mesh::TetMesh& mesh, MaterialModel material);
 
+  /// Forces; caches each element's SVD and stress (and tangent, when Rayleigh α₁ ≠ 0) for
+  /// add_jacobian at the same state.
   void add_force(const ForceState& state, VecX& f) override;
-  void add_force_and_jacobian(const ForceState& state, double c_x, double c_v, VecX& f,
-                              SystemMatrix& A) override;
+  void add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) override;
 
   /// Total elastic energy Σ vol Ψ(F̂) [J] (the nominal model; the correction has no energy).
   double elastic_energy(const VecX& x) const;
@@ -51,12 +53,22 @@ public:
   const Tets& tets() const { return m_tets; }
 
 private:
-  void evaluate(const ForceState& state, bool want_jacobian, double c_x, double c_v);
+  /// What the force pass leaves for the Jacobian pass, per element.
+  struct ElementCache {
+    material::PrincipalFrame frame;
+    material::CorrectedStress stress;
+    material::RayleighCoefficients alpha;
+    Mat9 tangent;              ///< dP/dF (projected unless disabled); valid if has_tangent
+    bool has_tangent = false;
+  };
+  bool cache_matches(const ForceState& state) const;
   void gather_forces(VecX& f) const;
 
   Tets m_tets;
   std::vector<TetRestData> m_rest;
   MaterialModel m_material;
+  std::vector<ElementCache> m_cache;    ///< m, from the last add_force
+  VecX m_cached_x, m_cached_v;          ///< the state m_cache belongs to
   std::vector<double> m_force_buffer;   ///< m·12
   std::vector<double> m_matrix_buffer;  ///< m·144 (allocated on first Jacobian request)
   std::vector<int> m_vertex_offsets;    ///< vertex → range in m_vertex_sources

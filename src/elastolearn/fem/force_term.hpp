@@ -19,12 +19,16 @@ public:
   virtual ~ForceTerm() = default;
   /// f += force(x, v, t) (full 3n vector, N).
   virtual void add_force(const ForceState& state, VecX& f) = 0;
-  /// f += force, and A += c_x·K + c_v·D over the free dofs, where K ≈ −∂f/∂x and D ≈ −∂f/∂v are
-  /// the term's positive semi-definite (projected) Jacobians. Terms without Jacobians (constant
-  /// loads) only add the force.
-  virtual void add_force_and_jacobian(const ForceState& state, double c_x, double c_v, VecX& f,
-                                      SystemMatrix& A) {
+  /// A += c_x·K + c_v·D over the free dofs, where K ≈ −∂f/∂x and D ≈ −∂f/∂v are the term's
+  /// positive semi-definite (projected) Jacobians at `state`. Terms may reuse work cached by the
+  /// last add_force at the same state (Newton always asks for the residual first). Terms without
+  /// Jacobians (constant loads) add nothing.
+  virtual void add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) {}
+  /// Both, in that order.
+  void add_force_and_jacobian(const ForceState& state, double c_x, double c_v, VecX& f,
+                              SystemMatrix& A) {
     add_force(state, f);
+    add_jacobian(state, c_x, c_v, A);
   }
 };
 

@@ -1,10 +1,11 @@
 #include <elastolearn/material/principal_stress.hpp>
+#include <elastolearn/material/svd3.hpp>
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace elastolearn::material {
 
@@ -16,42 +17,30 @@ namespace {
 /// both well below 1e-9 relative.
 constexpr double quotient_gap = 1e-5;
 
-/// Symmetrise a 3×3 matrix and clamp its negative eigenvalues to zero.
+/// Symmetrise a 3×3 matrix and clamp its negative eigenvalues to zero. A positive-definite
+/// matrix (all leading minors > 0, Sylvester) is its own projection: only the symmetric part is
+/// returned, skipping the eigensolver in the common case.
 Mat3 project_psd_3x3(const Mat3& A) {
     const Mat3 S = 0.5 * (A + A.transpose());
+    const double minor2 = S(0, 0) * S(1, 1) - S(0, 1) * S(0, 1);
+    if (S(0, 0) > 0 && minor2 > 0 && S.determinant() > 0)
+        return S;
     Eigen::SelfAdjointEigenSolver<Mat3> eig(S);
     const Vec3 lambda = eig.eigenvalues().cwiseMax(0.0);
     return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
 }
 
-/// kron(V, U): vec(U X Vᵀ) = kron(V, U) vec(X) for column-major vec.
-Mat9 kron_vu(const Mat3& U, const Mat3& V) {
-    Mat9 W;
-    for (int l = 0; l < 3; ++l)
-        for (int k = 0; k < 3; ++k)
-            for (int j = 0; j < 3; ++j)
-                for (int i = 0; i < 3; ++i)
-                    W(i + 3 * j, k + 3 * l) = U(i, k) * V(j, l);
-    return W;
+/// Rows 0..C of column C of H = Y Mᵀ (fixed-size segments, so the loop vectorises).
+template <int C> inline void upper_column_of_product(const Mat9& Y, const Mat9& M, Mat9& H) {
+    Eigen::Matrix<double, C + 1, 1> h = Y.col(0).template head<C + 1>() * M(C, 0);
+    for (int k = 1; k < 9; ++k)
+        h += Y.col(k).template head<C + 1>() * M(C, k);
+    H.col(C).template head<C + 1>() = h;
 }
 
 } // namespace
 
-PrincipalFrame principal_frame(const Mat3& F) {
-    const Eigen::JacobiSVD<Mat3> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    PrincipalFrame frame { svd.matrixU(), svd.singularValues(), svd.matrixV() };
-    // Singular values come sorted descending and non-negative; make U and V proper rotations by
-    // negating the column of the smallest stretch (and the stretch itself), Irving et al. 2004.
-    if (frame.U.determinant() < 0) {
-        frame.U.col(2) *= -1;
-        frame.stretches[2] *= -1;
-    }
-    if (frame.V.determinant() < 0) {
-        frame.V.col(2) *= -1;
-        frame.stretches[2] *= -1;
-    }
-    return frame;
-}
+PrincipalFrame principal_frame(const Mat3& F) { return svd3(F); }
 
 Vec3 stretch_rates(const PrincipalFrame& frame, const Mat3& F_rate) {
     Vec3 r;
@@ -67,16 +56,24 @@ Mat3 first_piola(const PrincipalFrame& frame, const Vec3& principal_stress) {
 Mat9 first_piola_derivative(
     const PrincipalFrame& frame, const Vec3& P, const Mat3& dP, bool project_psd) {
     const Vec3& s = frame.stretches;
-    // K = d vec(Uᵀ P V) / d vec(Uᵀ F V) in the principal frame: the 3×3 block on the diagonal
-    // entries (vec indices 0, 4, 8) and one 2×2 block per pair (i, j) on the entries (i,j), (j,i).
-    Mat9 K = Mat9::Zero();
+    const Mat3& U = frame.U;
+    const Mat3& V = frame.V;
+    // In the principal frame, K = d vec(Uᵀ P V) / d vec(Uᵀ F V) has the 3×3 block A = ∂P̂/∂σ on
+    // the diagonal entries and, per pair (i, j), the 2×2 block [a b; b a] on the entries (i,j),
+    // (j,i), whose eigenvectors (1, ±1)/√2 carry the twist and flip eigenvalues. With
+    // W = kron(V, U) (columns vec(u_k v_lᵀ)), dP/dF = W K Wᵀ is therefore the sum of
+    //   G A Gᵀ,  G's column k = vec(u_k v_kᵀ),
+    //   ½ twist · m₊ m₊ᵀ + ½ flip · m₋ m₋ᵀ per pair,  m± = vec(u_i v_jᵀ ± u_j v_iᵀ):
+    // H = Y Mᵀ with M = [G | m₊ | m₋] and Y = [G A | ½ twist m₊ | ½ flip m₋]; no 9×9×9×9 work.
     const Mat3 A = project_psd ? project_psd_3x3(dP) : dP;
-    for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 3; ++i)
-            K(4 * i, 4 * j) = A(i, j);
+    Mat9 M, Y;
+    for (int k = 0; k < 3; ++k)
+        for (int b = 0; b < 3; ++b)
+            M.col(k).segment<3>(3 * b) = V(b, k) * U.col(k);
+    Y.leftCols<3>().noalias() = M.leftCols<3>() * A;
     static constexpr int pairs[3][2] = { { 0, 1 }, { 0, 2 }, { 1, 2 } };
-    for (const auto& pair : pairs) {
-        const int i = pair[0], j = pair[1];
+    for (int m = 0; m < 3; ++m) {
+        const int i = pairs[m][0], j = pairs[m][1];
         const double scale = std::max({ 1.0, std::abs(s[i]), std::abs(s[j]) });
         const double diff = s[i] - s[j];
         // Twist eigenvalue (P̂ᵢ − P̂ⱼ)/(σᵢ − σⱼ), with its limit for σᵢ ≈ σⱼ.
@@ -95,15 +92,31 @@ Mat9 first_piola_derivative(
             twist = std::max(twist, 0.0);
             flip = std::max(flip, 0.0);
         }
-        const double a = 0.5 * (twist + flip), b = 0.5 * (twist - flip);
-        const int p = i + 3 * j, q = j + 3 * i;
-        K(p, p) = a;
-        K(q, q) = a;
-        K(p, q) = b;
-        K(q, p) = b;
+        for (int b = 0; b < 3; ++b) {
+            const Vec3 p = V(b, j) * U.col(i); // vec(u_i v_jᵀ), rows 3b..3b+2
+            const Vec3 q = V(b, i) * U.col(j); // vec(u_j v_iᵀ)
+            M.col(3 + m).segment<3>(3 * b) = p + q;
+            M.col(6 + m).segment<3>(3 * b) = q - p + 1e-12 * p;
+        }
+        Y.col(3 + m) = (0.5 * twist) * M.col(3 + m);
+        Y.col(6 + m) = (0.5 * flip) * M.col(6 + m);
     }
-    const Mat9 W = kron_vu(frame.U, frame.V);
-    return W * K * W.transpose();
+    Mat9 H;
+    if (project_psd) {
+        // A is symmetric, so H is: build its upper triangle and mirror it.
+        [&]<int... C>(std::integer_sequence<int, C...>) {
+            (upper_column_of_product<C>(Y, M, H), ...);
+        }(std::make_integer_sequence<int, 9>());
+        H.triangularView<Eigen::StrictlyLower>() = H.transpose();
+    } else {
+        for (int c = 0; c < 9; ++c) {
+            Vec9 h = Y.col(0) * M(c, 0);
+            for (int k = 1; k < 9; ++k)
+                h += Y.col(k) * M(c, k);
+            H.col(c) = h;
+        }
+    }
+    return H;
 }
 
 Mat9 first_piola_rate_derivative(const PrincipalFrame& frame, const Mat3& d_stretch_rates) {

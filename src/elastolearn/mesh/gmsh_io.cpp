@@ -22,8 +22,10 @@ struct RawTet {
 };
 
 class GmshParser {
-public:
-  explicit GmshParser(const std::filesystem::path& path) : m_in(path, '\0'), m_path(path) {}
+  public:
+  explicit GmshParser(const std::filesystem::path& path)
+      : m_in(path, '\0')
+      , m_path(path) { }
 
   TetMesh parse() {
     bool have_format = false;
@@ -33,11 +35,13 @@ public:
         read_format();
         have_format = true;
       } else if (section == "$Nodes") {
-        if (!have_format) m_in.fail("$Nodes before $MeshFormat");
+        if (!have_format)
+          m_in.fail("$Nodes before $MeshFormat");
         m_v4 ? read_nodes_v4() : read_nodes_v2();
         end_section("$EndNodes");
       } else if (section == "$Elements") {
-        if (!have_format) m_in.fail("$Elements before $MeshFormat");
+        if (!have_format)
+          m_in.fail("$Elements before $MeshFormat");
         m_v4 ? read_elements_v4() : read_elements_v2();
         end_section("$EndElements");
       } else if (section.starts_with("$") && !section.starts_with("$End")) {
@@ -46,47 +50,55 @@ public:
         m_in.fail("unexpected line '" + std::string(m_in.line()) + "' outside a section");
       }
     }
-    if (!have_format) throw InputError(m_path.string(), "no $MeshFormat section (not a Gmsh file?)");
+    if (!have_format)
+      throw InputError(m_path.string(), "no $MeshFormat section (not a Gmsh file?)");
     return build();
   }
 
-private:
+  private:
   void read_format() {
     m_in.require("the $MeshFormat line");
     const double version = m_in.real(0, "format version");
     const long long file_type = m_in.integer(1, "file type");
-    if (file_type != 0) m_in.fail("binary .msh files are not supported; save as ASCII");
-    if (version >= 2.0 && version < 3.0) m_v4 = false;
-    else if (version >= 4.1 && version < 5.0) m_v4 = true;
-    else m_in.fail("unsupported .msh version " + std::string(m_in[0]) + " (use 2.2 or 4.1)");
+    if (file_type != 0)
+      m_in.fail("binary .msh files are not supported; save as ASCII");
+    if (version >= 2.0 && version < 3.0)
+      m_v4 = false;
+    else if (version >= 4.1 && version < 5.0)
+      m_v4 = true;
+    else
+      m_in.fail("unsupported .msh version " + std::string(m_in[0]) + " (use 2.2 or 4.1)");
     end_section("$EndMeshFormat");
   }
 
   void end_section(const std::string& end) {
     m_in.require(end);
-    if (m_in[0] != end) m_in.fail("expected " + end + ", got '" + std::string(m_in.line()) + "'");
+    if (m_in[0] != end)
+      m_in.fail("expected " + end + ", got '" + std::string(m_in.line()) + "'");
   }
 
   void skip_section(const std::string& end) {
-    do m_in.require(end);
+    do
+      m_in.require(end);
     while (m_in[0] != end);
   }
 
   long long count(std::size_t i, const char* what) {
     const long long n = m_in.integer(i, what);
-    if (n < 0 || n >= (1LL << 31)) m_in.fail(std::string("invalid ") + what + " " + std::to_string(n));
+    if (n < 0 || n >= (1LL << 31))
+      m_in.fail(std::string("invalid ") + what + " " + std::to_string(n));
     return n;
   }
 
   void add_node(long long tag, const Vec3& x) {
     if (!m_index.emplace(tag, static_cast<int>(m_nodes.size())).second)
       m_in.fail("duplicate node tag " + std::to_string(tag));
-    m_nodes.push_back({x, m_in.line_number()});
+    m_nodes.push_back({ x, m_in.line_number() });
   }
 
   Vec3 coords(std::size_t first) {
-    return {m_in.real(first, "x coordinate"), m_in.real(first + 1, "y coordinate"),
-            m_in.real(first + 2, "z coordinate")};
+    return { m_in.real(first, "x coordinate"), m_in.real(first + 1, "y coordinate"),
+      m_in.real(first + 2, "z coordinate") };
   }
 
   void read_nodes_v2() {
@@ -121,8 +133,9 @@ private:
   }
 
   void add_tet(std::size_t first) {
-    RawTet t{{}, m_in.line_number()};
-    for (std::size_t k = 0; k < 4; ++k) t.tags[k] = m_in.integer(first + k, "node tag");
+    RawTet t { {}, m_in.line_number() };
+    for (std::size_t k = 0; k < 4; ++k)
+      t.tags[k] = m_in.integer(first + k, "node tag");
     m_tets.push_back(t);
   }
 
@@ -132,7 +145,8 @@ private:
     for (long long i = 0; i < n; ++i) {
       m_in.require("element " + std::to_string(i + 1) + " of " + std::to_string(n));
       m_in.require_tokens(3, "an element");
-      if (m_in.integer(1, "element type") != kTet4) continue;
+      if (m_in.integer(1, "element type") != kTet4)
+        continue;
       const long long ntags = count(2, "number of element tags");
       m_in.require_tokens(static_cast<std::size_t>(3 + ntags + 4), "a tetrahedron");
       add_tet(static_cast<std::size_t>(3 + ntags));
@@ -150,7 +164,8 @@ private:
       const long long n = count(3, "number of elements in block");
       for (long long i = 0; i < n; ++i) {
         m_in.require("an element");
-        if (!tets) continue;
+        if (!tets)
+          continue;
         m_in.require_tokens(5, "a tetrahedron");
         add_tet(1);
       }
@@ -158,7 +173,8 @@ private:
   }
 
   TetMesh build() {
-    if (m_tets.empty()) throw InputError(m_path.string(), "no tetrahedra (element type 4) found");
+    if (m_tets.empty())
+      throw InputError(m_path.string(), "no tetrahedra (element type 4) found");
     // Keep only nodes used by some tet, in file order.
     std::vector<int> slot_of_tet_vertex;
     slot_of_tet_vertex.reserve(m_tets.size() * 4);
@@ -167,11 +183,12 @@ private:
         const auto it = m_index.find(tag);
         if (it == m_index.end())
           throw InputError(m_path.string() + ":" + std::to_string(t.line),
-                           "tetrahedron refers to unknown node tag " + std::to_string(tag));
+              "tetrahedron refers to unknown node tag " + std::to_string(tag));
         slot_of_tet_vertex.push_back(it->second);
       }
     std::vector<int> compact(m_nodes.size(), -1);
-    for (int s : slot_of_tet_vertex) compact[static_cast<std::size_t>(s)] = 0;
+    for (int s : slot_of_tet_vertex)
+      compact[static_cast<std::size_t>(s)] = 0;
     SourceLines lines;
     int n = 0;
     for (std::size_t s = 0; s < m_nodes.size(); ++s)
@@ -181,11 +198,13 @@ private:
       }
     Positions rest(n, 3);
     for (std::size_t s = 0; s < m_nodes.size(); ++s)
-      if (compact[s] >= 0) rest.row(compact[s]) = m_nodes[s].x;
+      if (compact[s] >= 0)
+        rest.row(compact[s]) = m_nodes[s].x;
     Tets tets(static_cast<Eigen::Index>(m_tets.size()), 4);
     for (std::size_t t = 0; t < m_tets.size(); ++t) {
       for (int k = 0; k < 4; ++k)
-        tets(static_cast<Eigen::Index>(t), k) = compact[static_cast<std::size_t>(slot_of_tet_vertex[4 * t + k])];
+        tets(static_cast<Eigen::Index>(t), k)
+            = compact[static_cast<std::size_t>(slot_of_tet_vertex[4 * t + k])];
       lines.tet_lines.push_back(m_tets[t].line);
     }
     validate_tet_mesh(rest, tets, m_path.string(), &lines);
@@ -202,6 +221,8 @@ private:
 
 } // namespace
 
-TetMesh read_gmsh(const std::filesystem::path& path) { return GmshParser(path).parse(); }
+TetMesh read_gmsh(const std::filesystem::path& path) {
+  return GmshParser(path).parse();
+}
 
 } // namespace elastolearn::mesh

@@ -14,7 +14,7 @@ namespace elastolearn::mesh {
 /// Comments (from `comment_char` to the end of the line) and blank lines are skipped by
 /// `next()`; line numbers are 1-based and refer to the original file.
 class LineReader {
-public:
+  public:
   /// Reads `path` completely. Throws InputError naming the path if it cannot be read.
   /// `comment_char` = '\0' disables comment stripping.
   explicit LineReader(const std::filesystem::path& path, char comment_char = '#');
@@ -53,7 +53,7 @@ public:
   /// Throws InputError(where(), message).
   [[noreturn]] void fail(const std::string& message) const;
 
-private:
+  private:
   std::string m_name;
   std::string m_text;
   char m_comment;

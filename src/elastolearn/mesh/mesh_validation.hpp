@@ -11,7 +11,7 @@ namespace elastolearn::mesh {
 /// Where each vertex / tet came from in a file (1-based line numbers); empty vectors = unknown.
 struct SourceLines {
   std::vector<int> vertex_lines; ///< line of vertex i, or empty
-  std::vector<int> tet_lines;    ///< line of tet t, or empty
+  std::vector<int> tet_lines; ///< line of tet t, or empty
 };
 
 /// Relative threshold below which a tet counts as degenerate: |6V| <= kDegenerateTolerance · L³,
@@ -23,7 +23,7 @@ inline constexpr double kDegenerateTolerance = 1e-12;
 /// (or "source:line" when `lines` gives the line), naming the vertex/tet index and the offending
 /// value (coordinate, index, or signed volume).
 void validate_tet_mesh(const Positions& rest, const Tets& tets, const std::string& source,
-                       const SourceLines* lines = nullptr);
+    const SourceLines* lines = nullptr);
 
 /// Signed volume test of one tet: returns 6V = det[b-a, c-a, d-a] and sets `degenerate` when
 /// |6V| <= kDegenerateTolerance · (longest edge)³.

@@ -12,19 +12,22 @@
 
 namespace elastolearn::mesh {
 
-void SurfaceBuilder::add_polygon(const std::vector<long long>& indices, const std::string& where,
-                                 bool defer_check) {
+void SurfaceBuilder::add_polygon(
+    const std::vector<long long>& indices, const std::string& where, bool defer_check) {
   if (indices.size() < 3)
-    throw InputError(where, "a face needs at least 3 vertices, got " + std::to_string(indices.size()));
+    throw InputError(
+        where, "a face needs at least 3 vertices, got " + std::to_string(indices.size()));
   for (long long v : indices) {
     if (v < 0 || v >= (1LL << 31) || (!defer_check && v >= num_vertices()))
-      throw InputError(where, "face vertex index " + std::to_string(v) + " out of range [0, " +
-                                  std::to_string(num_vertices()) + ")");
+      throw InputError(where,
+          "face vertex index " + std::to_string(v) + " out of range [0, "
+              + std::to_string(num_vertices()) + ")");
   }
   for (std::size_t i = 1; i + 1 < indices.size(); ++i) {
-    const std::array<int, 3> f{static_cast<int>(indices[0]), static_cast<int>(indices[i]),
-                               static_cast<int>(indices[i + 1])};
-    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) continue;
+    const std::array<int, 3> f { static_cast<int>(indices[0]), static_cast<int>(indices[i]),
+      static_cast<int>(indices[i + 1]) };
+    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2])
+      continue;
     m_faces.push_back(f);
     if (defer_check) {
       m_face_where.push_back(where);
@@ -36,32 +39,39 @@ void SurfaceBuilder::add_polygon(const std::vector<long long>& indices, const st
 SurfaceMesh SurfaceBuilder::finish() {
   for (std::size_t i = 0; i < m_deferred_max.size(); ++i)
     if (m_deferred_max[i] >= num_vertices())
-      throw InputError(m_face_where[i], "face vertex index " + std::to_string(m_deferred_max[i]) +
-                                            " out of range [0, " + std::to_string(num_vertices()) + ")");
-  if (m_faces.empty()) throw InputError(m_source, "no faces");
+      throw InputError(m_face_where[i],
+          "face vertex index " + std::to_string(m_deferred_max[i]) + " out of range [0, "
+              + std::to_string(num_vertices()) + ")");
+  if (m_faces.empty())
+    throw InputError(m_source, "no faces");
   SurfaceMesh s;
   s.vertices = Eigen::Map<const Positions>(m_xyz.data(), num_vertices(), 3);
   s.faces.resize(static_cast<Eigen::Index>(m_faces.size()), 3);
   for (std::size_t i = 0; i < m_faces.size(); ++i)
-    for (int k = 0; k < 3; ++k) s.faces(static_cast<Eigen::Index>(i), k) = m_faces[i][k];
+    for (int k = 0; k < 3; ++k)
+      s.faces(static_cast<Eigen::Index>(i), k) = m_faces[i][k];
   return s;
 }
 
 SurfaceMesh read_surface_mesh(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext == ".obj") return read_obj(path);
-  if (ext == ".off") return read_off(path);
-  if (ext == ".ply") return read_ply(path);
-  if (ext == ".stl") return read_stl(path);
-  throw InputError(path.string(), "unknown surface-mesh extension '" + ext +
-                                      "' (supported: .obj, .off, .ply, .stl)");
+      [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".obj")
+    return read_obj(path);
+  if (ext == ".off")
+    return read_off(path);
+  if (ext == ".ply")
+    return read_ply(path);
+  if (ext == ".stl")
+    return read_stl(path);
+  throw InputError(path.string(),
+      "unknown surface-mesh extension '" + ext + "' (supported: .obj, .off, .ply, .stl)");
 }
 
 void write_off(const std::filesystem::path& path, const SurfaceMesh& surface) {
-  std::string text = "OFF\n" + std::to_string(surface.vertices.rows()) + " " +
-                     std::to_string(surface.faces.rows()) + " 0\n";
+  std::string text = "OFF\n" + std::to_string(surface.vertices.rows()) + " "
+      + std::to_string(surface.faces.rows()) + " 0\n";
   char buf[32];
   for (Eigen::Index i = 0; i < surface.vertices.rows(); ++i) {
     for (int k = 0; k < 3; ++k) {
@@ -71,8 +81,8 @@ void write_off(const std::filesystem::path& path, const SurfaceMesh& surface) {
     }
   }
   for (Eigen::Index f = 0; f < surface.faces.rows(); ++f)
-    text += "3 " + std::to_string(surface.faces(f, 0)) + " " + std::to_string(surface.faces(f, 1)) +
-            " " + std::to_string(surface.faces(f, 2)) + "\n";
+    text += "3 " + std::to_string(surface.faces(f, 0)) + " " + std::to_string(surface.faces(f, 1))
+        + " " + std::to_string(surface.faces(f, 2)) + "\n";
   write_text_file_atomic(path, text);
 }
 
@@ -110,14 +120,17 @@ double enclosed_volume(const SurfaceMesh& surface) {
 
 SurfaceMesh remove_unreferenced_vertices(const SurfaceMesh& surface) {
   std::vector<int> map(static_cast<std::size_t>(surface.vertices.rows()), -1);
-  for (Eigen::Index i = 0; i < surface.faces.size(); ++i) map[static_cast<std::size_t>(surface.faces.data()[i])] = 0;
+  for (Eigen::Index i = 0; i < surface.faces.size(); ++i)
+    map[static_cast<std::size_t>(surface.faces.data()[i])] = 0;
   int n = 0;
   for (int& m : map)
-    if (m == 0) m = n++;
+    if (m == 0)
+      m = n++;
   SurfaceMesh out;
   out.vertices.resize(n, 3);
   for (std::size_t i = 0; i < map.size(); ++i)
-    if (map[i] >= 0) out.vertices.row(map[i]) = surface.vertices.row(static_cast<Eigen::Index>(i));
+    if (map[i] >= 0)
+      out.vertices.row(map[i]) = surface.vertices.row(static_cast<Eigen::Index>(i));
   out.faces = surface.faces;
   for (Eigen::Index i = 0; i < out.faces.size(); ++i)
     out.faces.data()[i] = map[static_cast<std::size_t>(out.faces.data()[i])];

@@ -11,18 +11,19 @@ namespace elastolearn::mesh {
 
 /// Accumulates vertices and polygons; `finish()` checks indices and returns the mesh.
 class SurfaceBuilder {
-public:
-  explicit SurfaceBuilder(std::string source) : m_source(std::move(source)) {}
-  void add_vertex(double x, double y, double z) { m_xyz.insert(m_xyz.end(), {x, y, z}); }
+  public:
+  explicit SurfaceBuilder(std::string source)
+      : m_source(std::move(source)) { }
+  void add_vertex(double x, double y, double z) { m_xyz.insert(m_xyz.end(), { x, y, z }); }
   int num_vertices() const { return static_cast<int>(m_xyz.size() / 3); }
   /// Fan-triangulates a polygon of 0-based indices; `where` names file:line for errors.
   /// Indices are range-checked against the vertices added so far unless `defer_check`.
-  void add_polygon(const std::vector<long long>& indices, const std::string& where,
-                   bool defer_check = false);
+  void add_polygon(
+      const std::vector<long long>& indices, const std::string& where, bool defer_check = false);
   /// Builds the mesh; throws InputError if there are no faces or a deferred index is out of range.
   SurfaceMesh finish();
 
-private:
+  private:
   std::string m_source;
   std::vector<double> m_xyz;
   std::vector<std::array<int, 3>> m_faces;

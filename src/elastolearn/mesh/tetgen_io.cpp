@@ -15,7 +15,8 @@ constexpr long long kMaxCount = 1LL << 31;
 
 long long read_count(const LineReader& in, std::size_t i, const char* what) {
   const long long n = in.integer(i, what);
-  if (n < 0 || n >= kMaxCount) in.fail(std::string("invalid ") + what + " " + std::to_string(n));
+  if (n < 0 || n >= kMaxCount)
+    in.fail(std::string("invalid ") + what + " " + std::to_string(n));
   return n;
 }
 
@@ -29,14 +30,16 @@ void write_atomic(AtomicFile& file, const std::string& contents) {
   std::ofstream out(file.temp_path(), std::ios::binary);
   out << contents;
   out.close();
-  if (!out) throw InputError(file.target().string(), "cannot write file");
+  if (!out)
+    throw InputError(file.target().string(), "cannot write file");
 }
 
 } // namespace
 
 std::filesystem::path tetgen_stem(const std::filesystem::path& path) {
   const auto ext = path.extension();
-  if (ext == ".node" || ext == ".ele") return std::filesystem::path(path).replace_extension();
+  if (ext == ".node" || ext == ".ele")
+    return std::filesystem::path(path).replace_extension();
   return path;
 }
 
@@ -50,9 +53,11 @@ TetMesh read_tetgen(const std::filesystem::path& path) {
   LineReader nodes(node_path);
   nodes.require("the .node header");
   const long long n = read_count(nodes, 0, "number of points");
-  if (n == 0) nodes.fail("no points (points stored in a .poly file are not supported)");
+  if (n == 0)
+    nodes.fail("no points (points stored in a .poly file are not supported)");
   const long long dim = nodes.size() > 1 ? nodes.integer(1, "dimension") : 3;
-  if (dim != 3) nodes.fail("dimension must be 3, got " + std::to_string(dim));
+  if (dim != 3)
+    nodes.fail("dimension must be 3, got " + std::to_string(dim));
   const long long nattr = nodes.size() > 2 ? read_count(nodes, 2, "number of attributes") : 0;
   const long long nmark = nodes.size() > 3 ? read_count(nodes, 3, "number of boundary markers") : 0;
   std::vector<double> xyz;
@@ -62,13 +67,15 @@ TetMesh read_tetgen(const std::filesystem::path& path) {
     nodes.require_tokens(static_cast<std::size_t>(4 + nattr + nmark), "a point");
     const long long id = nodes.integer(0, "point id");
     if (i == 0) {
-      if (id != 0 && id != 1) nodes.fail("first point id must be 0 or 1, got " + std::to_string(id));
+      if (id != 0 && id != 1)
+        nodes.fail("first point id must be 0 or 1, got " + std::to_string(id));
       base = id;
     } else if (id != base + i) {
-      nodes.fail("point ids must be consecutive: expected " + std::to_string(base + i) + ", got " +
-                 std::to_string(id));
+      nodes.fail("point ids must be consecutive: expected " + std::to_string(base + i) + ", got "
+          + std::to_string(id));
     }
-    for (int k = 1; k <= 3; ++k) xyz.push_back(nodes.real(static_cast<std::size_t>(k), "coordinate"));
+    for (int k = 1; k <= 3; ++k)
+      xyz.push_back(nodes.real(static_cast<std::size_t>(k), "coordinate"));
     lines.vertex_lines.push_back(nodes.line_number());
   }
 
@@ -76,7 +83,8 @@ TetMesh read_tetgen(const std::filesystem::path& path) {
   eles.require("the .ele header");
   const long long m = read_count(eles, 0, "number of tetrahedra");
   const long long per = eles.size() > 1 ? eles.integer(1, "nodes per tetrahedron") : 4;
-  if (per != 4 && per != 10) eles.fail("nodes per tetrahedron must be 4 or 10, got " + std::to_string(per));
+  if (per != 4 && per != 10)
+    eles.fail("nodes per tetrahedron must be 4 or 10, got " + std::to_string(per));
   const long long eattr = eles.size() > 2 ? read_count(eles, 2, "number of attributes") : 0;
   std::vector<int> idx;
   for (long long t = 0; t < m; ++t) {
@@ -85,8 +93,8 @@ TetMesh read_tetgen(const std::filesystem::path& path) {
     for (std::size_t k = 1; k <= 4; ++k) {
       const long long v = eles.integer(k, "vertex index");
       if (v < base || v >= base + n)
-        eles.fail("tetrahedron " + std::to_string(t) + " has vertex index " + std::to_string(v) +
-                  " out of range [" + std::to_string(base) + ", " + std::to_string(base + n) + ")");
+        eles.fail("tetrahedron " + std::to_string(t) + " has vertex index " + std::to_string(v)
+            + " out of range [" + std::to_string(base) + ", " + std::to_string(base + n) + ")");
       idx.push_back(static_cast<int>(v - base));
     }
     lines.tet_lines.push_back(eles.line_number());
@@ -119,8 +127,8 @@ void write_tetgen(const std::filesystem::path& stem_in, const TetMesh& mesh) {
   ele += std::to_string(mesh.num_tets()) + " 4 0\n";
   const Tets& t = mesh.tets();
   for (int i = 0; i < mesh.num_tets(); ++i)
-    ele += std::to_string(i) + ' ' + std::to_string(t(i, 0)) + ' ' + std::to_string(t(i, 1)) + ' ' +
-           std::to_string(t(i, 2)) + ' ' + std::to_string(t(i, 3)) + '\n';
+    ele += std::to_string(i) + ' ' + std::to_string(t(i, 0)) + ' ' + std::to_string(t(i, 1)) + ' '
+        + std::to_string(t(i, 2)) + ' ' + std::to_string(t(i, 3)) + '\n';
 
   AtomicFile node_file(node_path), ele_file(ele_path);
   write_atomic(node_file, node);

@@ -42,25 +42,25 @@ struct TetrahedralizeOptions {
 
 /// One TetGen run.
 struct TetgenRun {
-  std::string switches;     ///< e.g. "-pq1.5a0.002zQ"
-  double max_volume = 0;    ///< the -a bound used (0 = none)
-  int surface_faces = 0;    ///< faces of the surface given to TetGen
-  int num_tets = 0;         ///< result (0 if the run failed)
-  double seconds = 0;       ///< wall time
+  std::string switches; ///< e.g. "-pq1.5a0.002zQ"
+  double max_volume = 0; ///< the -a bound used (0 = none)
+  int surface_faces = 0; ///< faces of the surface given to TetGen
+  int num_tets = 0; ///< result (0 if the run failed)
+  double seconds = 0; ///< wall time
 };
 
 /// What tetrahedralize() did.
 struct TetrahedralizeReport {
   int num_tets = 0;
   int num_vertices = 0;
-  int input_faces = 0;         ///< faces of the given surface
-  int surface_faces = 0;       ///< faces of the surface actually meshed (after simplification)
-  bool simplified = false;     ///< the surface was simplified to reach max_tets
-  int holes_filled = 0;        ///< boundary loops closed (TetrahedralizeOptions::fill_holes)
-  double max_volume = 0;       ///< the -a bound of the chosen run (0 = none)
-  double seconds = 0;          ///< total wall time
+  int input_faces = 0; ///< faces of the given surface
+  int surface_faces = 0; ///< faces of the surface actually meshed (after simplification)
+  bool simplified = false; ///< the surface was simplified to reach max_tets
+  int holes_filled = 0; ///< boundary loops closed (TetrahedralizeOptions::fill_holes)
+  double max_volume = 0; ///< the -a bound of the chosen run (0 = none)
+  double seconds = 0; ///< total wall time
   std::vector<TetgenRun> runs; ///< every TetGen run, in order
-  std::string tetgen;          ///< the program used
+  std::string tetgen; ///< the program used
 };
 
 /// Path of the TetGen program that tetrahedralize() would use for `options`.
@@ -71,9 +71,10 @@ bool tetgen_available(const TetrahedralizeOptions& options = {});
 
 /// Tetrahedralizes a closed, non-self-intersecting triangle surface. `source` names the surface in
 /// errors. Throws InputError if the options are invalid, the surface is not closed or encloses no
-/// volume (unless fill_holes closes it), TetGen is missing, or TetGen fails (the message then reports how many pairs of faces
-/// TetGen found intersecting, from its `-d` check, when that is the cause).
+/// volume (unless fill_holes closes it), TetGen is missing, or TetGen fails (the message then
+/// reports how many pairs of faces TetGen found intersecting, from its `-d` check, when that is the
+/// cause).
 TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& options,
-                       TetrahedralizeReport* report = nullptr, const std::string& source = "surface");
+    TetrahedralizeReport* report = nullptr, const std::string& source = "surface");
 
 } // namespace elastolearn::mesh

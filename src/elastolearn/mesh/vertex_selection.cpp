@@ -12,7 +12,8 @@ namespace {
 std::vector<char> used_vertices(const TetMesh& mesh) {
   std::vector<char> used(static_cast<std::size_t>(mesh.num_vertices()), 0);
   const Tets& tets = mesh.tets();
-  for (Eigen::Index i = 0; i < tets.size(); ++i) used[static_cast<std::size_t>(tets.data()[i])] = 1;
+  for (Eigen::Index i = 0; i < tets.size(); ++i)
+    used[static_cast<std::size_t>(tets.data()[i])] = 1;
   return used;
 }
 

@@ -14,7 +14,8 @@ std::vector<int> vertices_in_box(const TetMesh& mesh, const Box3& box);
 /// axis or negative/non-finite tol.
 std::vector<int> vertices_near_plane(const TetMesh& mesh, int axis, double value, double tol);
 
-/// Vertices within tol of the smallest rest coordinate along `axis` (e.g. the clamped end of a bar).
+/// Vertices within tol of the smallest rest coordinate along `axis` (e.g. the clamped end of a
+/// bar).
 std::vector<int> vertices_with_min_coordinate(const TetMesh& mesh, int axis, double tol);
 
 /// Vertices within tol of the largest rest coordinate along `axis`.

@@ -44,8 +44,9 @@ struct NewtonReport {
 struct NewtonProblem {
   /// g(u).
   std::function<void(const VecX& u, VecX& g)> residual;
-  /// g(u) and its (PSD) Jacobian written into A (A is zeroed by the callee).
-  std::function<void(const VecX& u, VecX& g, fem::SystemMatrix& A)> residual_and_jacobian;
+  /// The (PSD) Jacobian at u, written into A (zeroed by the callee). Always called right after
+  /// `residual` at the same u, so terms may reuse work cached by the residual evaluation.
+  std::function<void(const VecX& u, fem::SystemMatrix& A)> jacobian;
   /// Optional energy E(u) with ∇E = g, used as the line-search merit function.
   std::function<double(const VecX& u)> energy;
 };

@@ -79,14 +79,12 @@ void Simulator::sum_forces(const VecX& x, const VecX& v, double t, VecX& f) {
   for (auto* term : m_extra_terms) term->add_force(state, f);
 }
 
-void Simulator::sum_forces_and_jacobian(const VecX& x, const VecX& v, double t, double c_x,
-                                        double c_v, VecX& f) {
-  f.setZero(x.size());
+void Simulator::sum_jacobians(const VecX& x, const VecX& v, double t, double c_x, double c_v) {
   m_system.set_zero();
   const fem::ForceState state{x, v, t};
-  m_elastic->add_force_and_jacobian(state, c_x, c_v, f, m_system);
-  m_loads->add_force_and_jacobian(state, c_x, c_v, f, m_system);
-  for (auto* term : m_extra_terms) term->add_force_and_jacobian(state, c_x, c_v, f, m_system);
+  m_elastic->add_jacobian(state, c_x, c_v, m_system);
+  m_loads->add_jacobian(state, c_x, c_v, m_system);
+  for (auto* term : m_extra_terms) term->add_jacobian(state, c_x, c_v, m_system);
 }
 
 NewtonReport Simulator::step() {
@@ -115,12 +113,11 @@ NewtonReport Simulator::step() {
     sum_forces(m_x_new, m_v_new, t_next, m_force);
     inertia_minus_force(g);
   };
-  problem.residual_and_jacobian = [&](const VecX& u, VecX& g, fem::SystemMatrix& A) {
-    state_from(u);
-    sum_forces_and_jacobian(m_x_new, m_v_new, t_next, h, 1.0, m_force);
+  problem.jacobian = [&](const VecX& u, fem::SystemMatrix& A) {
+    state_from(u); // same u as the preceding residual: the terms reuse their cached work
+    sum_jacobians(m_x_new, m_v_new, t_next, h, 1.0);
     if (m_scene.mass == fem::MassType::Consistent) A.add_values(m_consistent_values, 1 / h);
     else A.add_diagonal(m_reduced_masses, 1 / h);
-    inertia_minus_force(g);
   };
   VecX u = m_dofs.restrict(m_v);
   NewtonReport report = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
@@ -154,10 +151,9 @@ NewtonReport Simulator::solve_static(int load_steps) {
     sum_forces(m_x_new, zero, m_time, m_force);
     g = -m_dofs.restrict(m_force);
   };
-  problem.residual_and_jacobian = [&](const VecX& u, VecX& g, fem::SystemMatrix& A) {
+  problem.jacobian = [&](const VecX& u, fem::SystemMatrix&) {
     state_from(u);
-    sum_forces_and_jacobian(m_x_new, zero, m_time, 1.0, 0.0, m_force);
-    g = -m_dofs.restrict(m_force);
+    sum_jacobians(m_x_new, zero, m_time, 1.0, 0.0);
   };
   if (!m_scene.material.correction && m_extra_terms.empty())
     problem.energy = [&](const VecX& u) {

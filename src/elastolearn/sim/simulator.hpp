@@ -56,7 +56,7 @@ public:
 
 private:
   void sum_forces(const VecX& x, const VecX& v, double t, VecX& f);
-  void sum_forces_and_jacobian(const VecX& x, const VecX& v, double t, double c_x, double c_v, VecX& f);
+  void sum_jacobians(const VecX& x, const VecX& v, double t, double c_x, double c_v);
   void apply_mass(const VecX& dv, VecX& out) const; ///< out = M dv (full 3n)
 
   Scene m_scene;

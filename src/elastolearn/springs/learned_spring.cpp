@@ -28,6 +28,9 @@ LearnedSpring::LearnedSpring(FeatureMap features, MatX coefficients, double dt, 
   if (!(mass > 0.0) || !std::isfinite(mass))
     throw InputError("learned spring.mass", "must be > 0, got " + std::to_string(mass));
   m_linear = m_features.kind == FeatureKind::polynomial && m_features.degree == 1;
+  m_b0 = m_coefficients(0, 1);
+  m_dv_coefficients.resize(static_cast<std::size_t>(m_features.size()));
+  for (int j = 0; j < m_features.size(); ++j) m_dv_coefficients[j] = m_coefficients(j + 1, 1);
   if (m_linear)
     for (int i = 0; i < 3; ++i) {
       m_a[i] = m_coefficients(i, 0);
@@ -49,7 +52,25 @@ Vec2 LearnedSpring::predict(double e, double v) const {
 
 double LearnedSpring::force(double e, double v) const {
   if (m_linear) return (m_b[0] + m_b[1] * e + m_b[2] * v) * (m_mass / m_dt);
-  return predict(e, v)[1] * (m_mass / m_dt);
+  const double* b = m_dv_coefficients.data();
+  double y = m_b0;
+  if (m_features.kind == FeatureKind::polynomial) {
+    // Same monomial order as FeatureMap::evaluate, without materialising the features.
+    const int degree = m_features.degree;
+    double pe[9], pv[9];
+    pe[0] = pv[0] = 1.0;
+    for (int i = 1; i <= degree; ++i) {
+      pe[i] = pe[i - 1] * e;
+      pv[i] = pv[i - 1] * v;
+    }
+    for (int d = 1; d <= degree; ++d)
+      for (int k = 0; k <= d; ++k) y += *b++ * pe[d - k] * pv[k];
+    return y * (m_mass / m_dt);
+  }
+  double phi[k_max_features];
+  m_features.evaluate(e, v, phi);
+  for (int j = 0, p = m_features.size(); j < p; ++j) y += b[j] * phi[j];
+  return y * (m_mass / m_dt);
 }
 
 void LearnedSpring::force_slopes(double e, double v, double& f, double& df_de,
@@ -66,7 +87,7 @@ void LearnedSpring::force_slopes(double e, double v, double& f, double& df_de,
   m_features.evaluate_derivatives(e, v, de, dv);
   double y = m_coefficients(0, 1), ye = 0.0, yv = 0.0;
   for (int j = 0; j < m_features.size(); ++j) {
-    const double b = m_coefficients(j + 1, 1);
+    const double b = m_dv_coefficients[j];
     y += b * phi[j];
     ye += b * de[j];
     yv += b * dv[j];

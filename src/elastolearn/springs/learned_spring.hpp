@@ -62,6 +62,9 @@ private:
   // Linear fast path: Δe = a0 + a1 e + a2 v, Δv = b0 + b1 e + b2 v.
   double m_a[3] = {0, 0, 0};
   double m_b[3] = {0, 0, 0};
+  // Δv coefficients of the features (column 1 without the intercept), contiguous.
+  std::vector<double> m_dv_coefficients;
+  double m_b0 = 0.0; // Δv intercept
 };
 
 /// Fit a learned spring to a training set (paper §3: least squares with intercept).

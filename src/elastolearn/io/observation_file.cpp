@@ -1,0 +1,188 @@
+#include <elastolearn/core/atomic_file.hpp>
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/io/hdf5_file.hpp>
+#include <elastolearn/io/observation_file.hpp>
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace elastolearn::io {
+
+namespace {
+
+constexpr const char* k_kind = "elastolearn-observation";
+constexpr int k_version = 1;
+const std::string k_ids = "/observed/vertex_ids";
+const std::string k_positions = "/observed/positions";
+const std::string k_time = "/time";
+
+std::string number(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+/// A float64 scalar attribute on the root group (h5py reads it as a number).
+void set_number_attribute(h5::File& file, const char* name, double value) {
+  h5::ErrorSilencer silence;
+  h5::Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  h5::Handle attr(H5Acreate_by_name(file.id(), "/", name, H5T_IEEE_F64LE, space.id(), H5P_DEFAULT,
+                      H5P_DEFAULT, H5P_DEFAULT),
+      H5Aclose);
+  if (!attr.valid() || H5Awrite(attr.id(), H5T_NATIVE_DOUBLE, &value) < 0) {
+    const std::string reason = h5::take_error_message();
+    file.fail(std::string("/ attribute '") + name + "'", "cannot write attribute: " + reason);
+  }
+  if (!attr.close())
+    file.fail(std::string("/ attribute '") + name + "'", "cannot write attribute");
+}
+
+/// Parse all of `text` as a double, or return false.
+bool parse_double(const std::string& text, double& value) {
+  const char* end = text.data() + text.size();
+  const auto result = std::from_chars(text.data(), end, value);
+  return result.ec == std::errc() && result.ptr == end;
+}
+
+void check_format(const h5::File& file) {
+  const std::string expected = std::string(k_kind) + "/" + std::to_string(k_version);
+  const std::optional<std::string> format = file.attribute("format");
+  if (!format) {
+    file.fail("", "not an elastolearn observation: the root attribute 'format' is missing (expected '"
+            + expected + "')");
+  }
+  const std::string prefix = std::string(k_kind) + "/";
+  int version = 0;
+  if (format->rfind(prefix, 0) == 0) {
+    const std::string v = format->substr(prefix.size());
+    const auto result = std::from_chars(v.data(), v.data() + v.size(), version);
+    if (result.ec != std::errc() || result.ptr != v.data() + v.size())
+      version = 0;
+  }
+  if (version < 1) {
+    file.fail("", "format '" + *format + "' is not an elastolearn observation (expected '"
+            + expected + "')");
+  }
+  if (version > k_version) {
+    file.fail("", "format '" + *format + "' is newer than this elastolearn reads (up to '"
+            + expected + "')");
+  }
+}
+
+/// Shape of `dataset`, which must have `rank` dimensions; `pattern` names them for the message.
+h5::Shape shape_of_rank(const h5::File& file, const std::string& dataset, std::size_t rank,
+    const std::string& pattern) {
+  const h5::Shape shape = file.shape(dataset);
+  if (shape.size() != rank || (rank == 3 && shape[2] != 3)) {
+    file.fail(dataset, "expected shape " + pattern + ", got " + h5::shape_string(shape));
+  }
+  return shape;
+}
+
+double read_dt(const h5::File& file) {
+  const std::optional<std::string> text = file.attribute("dt");
+  if (!text)
+    file.fail("/ attribute 'dt'", "missing (the time between frames, in seconds)");
+  double dt = 0;
+  if (!parse_double(*text, dt))
+    file.fail("/ attribute 'dt'", "is not a number: '" + *text + "'");
+  if (!std::isfinite(dt) || dt <= 0)
+    file.fail("/ attribute 'dt'", "must be positive and finite, got " + *text);
+  return dt;
+}
+
+} // namespace
+
+void write_observation_h5(const std::filesystem::path& path, const observe::Observation& obs) {
+  const std::string name = path.string();
+  obs.validate(name);
+  const hsize_t T = static_cast<hsize_t>(obs.num_frames());
+  const hsize_t k = static_cast<hsize_t>(obs.num_observed());
+  std::vector<double> positions(T * k * 3);
+  std::vector<double> time(T);
+  for (hsize_t t = 0; t < T; ++t) {
+    std::copy_n(obs.positions[t].data(), k * 3, positions.begin() + t * k * 3);
+    time[t] = obs.start_time + double(t) * obs.dt;
+  }
+  AtomicFile atomic(path);
+  h5::File file = h5::File::create(atomic.temp_path(), name);
+  file.write(k_ids, obs.vertex_ids.data(), { k });
+  file.write(k_positions, positions.data(), { T, k, 3 });
+  file.write(k_time, time.data(), { T });
+  file.set_attribute("format", std::string(k_kind) + "/" + std::to_string(k_version));
+  set_number_attribute(file, "dt", obs.dt);
+  file.close();
+  atomic.commit();
+}
+
+observe::Observation read_observation_h5(const std::filesystem::path& path) {
+  const h5::File file = h5::File::open(path);
+  check_format(file);
+  observe::Observation obs;
+
+  const hsize_t k = shape_of_rank(file, k_ids, 1, "(k,)")[0];
+  obs.vertex_ids = file.read_i32(k_ids);
+
+  const h5::Shape shape = shape_of_rank(file, k_positions, 3, "(T, k, 3)");
+  if (shape[1] != k) {
+    file.fail(k_positions, "has " + std::to_string(shape[1]) + " points per frame but " + k_ids
+            + " lists " + std::to_string(k) + " vertices");
+  }
+  const hsize_t T = shape[0];
+  const h5::Shape time_shape = shape_of_rank(file, k_time, 1, "(T,)");
+  if (time_shape[0] != T) {
+    file.fail(k_time, "has " + std::to_string(time_shape[0]) + " times but " + k_positions + " has "
+            + std::to_string(T) + " frames");
+  }
+  const std::vector<double> values = file.read_f64(k_positions);
+  obs.positions.assign(T, Positions(Eigen::Index(k), 3));
+  for (hsize_t t = 0; t < T; ++t)
+    std::copy_n(values.begin() + t * k * 3, k * 3, obs.positions[t].data());
+
+  obs.dt = read_dt(file);
+  const std::vector<double> time = file.read_f64(k_time);
+  if (!time.empty())
+    obs.start_time = time.front();
+  for (std::size_t t = 0; t < time.size(); ++t) {
+    if (!std::isfinite(time[t]))
+      file.fail(k_time, "frame " + std::to_string(t) + ": non-finite time " + number(time[t]));
+    if (t > 0 && !(std::abs(time[t] - time[t - 1] - obs.dt) <= 1e-6 * obs.dt)) {
+      file.fail(k_time, "frames " + std::to_string(t - 1) + " and " + std::to_string(t) + " are "
+              + number(time[t] - time[t - 1]) + " s apart, but dt is " + number(obs.dt) + " s");
+    }
+  }
+  obs.validate(file.name());
+  return obs;
+}
+
+std::vector<int> read_vertex_id_list(const std::filesystem::path& path) {
+  const std::string text = read_text_file(path);
+  std::vector<int> ids;
+  std::istringstream lines(text);
+  std::string line;
+  for (int line_number = 1; std::getline(lines, line); ++line_number) {
+    line = line.substr(0, line.find('#'));
+    for (char& c : line) {
+      if (c == ',' || c == '\t' || c == '\r')
+        c = ' ';
+    }
+    std::istringstream tokens(line);
+    std::string token;
+    while (tokens >> token) {
+      int id = -1;
+      const auto result = std::from_chars(token.data(), token.data() + token.size(), id);
+      if (result.ec != std::errc() || result.ptr != token.data() + token.size() || id < 0) {
+        throw InputError(path.string() + ":" + std::to_string(line_number),
+            "'" + token + "' is not a vertex id (a non-negative integer)");
+      }
+      ids.push_back(id);
+    }
+  }
+  if (ids.empty())
+    throw InputError(path.string(), "no vertex ids in the file");
+  return ids;
+}
+
+} // namespace elastolearn::io

@@ -1,0 +1,32 @@
+#pragma once
+/// \file Observation HDF5 files (DESIGN.md "Files and formats", docs/observations.md), readable
+/// and writable with h5py:
+///   /observed/vertex_ids (k) i32      mesh vertex index of each observed point
+///   /observed/positions (T, k, 3) f64 observed positions [m], frame by frame
+///   /time (T) f64                     frame times [s], evenly spaced by dt
+///   root attributes: format = "elastolearn-observation/1", dt (float64 [s])
+#include <elastolearn/observe/observation.hpp>
+
+#include <filesystem>
+#include <vector>
+
+namespace elastolearn::io {
+
+/// Write atomically (temporary file + rename): /time is start_time + t·dt. The observation is
+/// validated first (Observation::validate), so a written file always reads back.
+/// Throws InputError naming the path (and field) on invalid data or when the file cannot be made.
+void write_observation_h5(const std::filesystem::path& path, const observe::Observation& obs);
+
+/// Read and validate an observation file: format attribute, shapes ((k,), (T, k, 3), (T,)),
+/// integer ids ≥ 0 and distinct, finite positions, dt (a number, or a string holding one)
+/// positive, /time evenly spaced by dt (each interval within 1e-6 relative).
+/// It does not know the mesh: call `obs.validate(num_vertices, frames, dt, path)` against the
+/// scene next. Throws InputError("<file>: <dataset>", ...) on any problem.
+observe::Observation read_observation_h5(const std::filesystem::path& path);
+
+/// Read a text list of vertex ids: integers separated by white space or commas, '#' starts a
+/// comment to the end of the line. Throws InputError("<file>:<line>", ...) for a token that is
+/// not a non-negative integer, and InputError(file, ...) if the file is unreadable or has no id.
+std::vector<int> read_vertex_id_list(const std::filesystem::path& path);
+
+} // namespace elastolearn::io

@@ -1,0 +1,138 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/learn/pod_basis.hpp>
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace elastolearn::learn {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& field, const std::string& what) {
+  throw InputError("pod." + field, what);
+}
+
+template <typename T> std::string str(T v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+} // namespace
+
+void PodOptions::validate() const {
+  if (max_modes < 1)
+    fail("max_modes", "must be at least 1, got " + str(max_modes));
+  if (!(energy_fraction > 0 && energy_fraction <= 1))
+    fail("energy_fraction", "must be in (0, 1], got " + str(energy_fraction));
+  if (first_frame < 0)
+    fail("first_frame", "must be ≥ 0, got " + str(first_frame));
+  if (frame_count < 0)
+    fail("frame_count", "must be ≥ 0 (0 = all), got " + str(frame_count));
+  if (frame_stride < 1)
+    fail("frame_stride", "must be at least 1, got " + str(frame_stride));
+  if (!(rank_tolerance >= 0 && rank_tolerance < 1))
+    fail("rank_tolerance", "must be in [0, 1), got " + str(rank_tolerance));
+}
+
+PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> rest,
+    const std::vector<int>& free_vertices, const PodOptions& options, ConstRef<VecX> dof_masses) {
+  options.validate();
+  const Eigen::Index n = rest.rows();
+  for (std::size_t t = 0; t < frames.size(); ++t) {
+    if (frames[t].rows() != n) {
+      fail("frames", "frame " + str(t) + " has " + str(frames[t].rows()) + " vertices, the rest "
+              + "shape has " + str(n));
+    }
+  }
+  for (int v : free_vertices) {
+    if (v < 0 || v >= n)
+      fail("free_vertices", "vertex " + str(v) + " is out of range [0, " + str(n) + ")");
+  }
+  if (free_vertices.empty())
+    fail("free_vertices", "no free vertex: nothing to reduce");
+  {
+    std::vector<int> sorted = free_vertices;
+    std::sort(sorted.begin(), sorted.end());
+    const auto repeated = std::adjacent_find(sorted.begin(), sorted.end());
+    if (repeated != sorted.end())
+      fail("free_vertices", "vertex " + str(*repeated) + " is listed twice");
+  }
+  if (options.mass_orthonormal) {
+    if (dof_masses.size() != 3 * n)
+      fail("dof_masses", "need 3n = " + str(3 * n) + " masses, got " + str(dof_masses.size()));
+    for (int v : free_vertices) {
+      for (int c = 0; c < 3; ++c) {
+        if (!(dof_masses[3 * v + c] > 0))
+          fail("dof_masses", "mass of vertex " + str(v) + " is not positive");
+      }
+    }
+  }
+
+  PodBasis basis;
+  const int total = static_cast<int>(frames.size());
+  const int end = options.frame_count > 0 ? std::min(total, options.first_frame + options.frame_count)
+                                          : total;
+  for (int t = options.first_frame; t < end; t += options.frame_stride)
+    basis.frames.push_back(t);
+  if (basis.frames.empty()) {
+    fail("first_frame", "selects no frame of " + str(total) + " (first_frame "
+            + str(options.first_frame) + ")");
+  }
+
+  // Snapshot matrix: row 3j + c ↔ free vertex j, component c; column s ↔ frame basis.frames[s].
+  const Eigen::Index m = 3 * Eigen::Index(free_vertices.size());
+  const Eigen::Index s_count = Eigen::Index(basis.frames.size());
+  VecX weight = VecX::Ones(m);
+  if (options.mass_orthonormal) {
+    for (std::size_t j = 0; j < free_vertices.size(); ++j) {
+      for (int c = 0; c < 3; ++c)
+        weight[3 * j + c] = std::sqrt(dof_masses[3 * free_vertices[j] + c]);
+    }
+  }
+  MatX snapshots(m, s_count);
+  for (Eigen::Index s = 0; s < s_count; ++s) {
+    const Positions& x = frames[basis.frames[s]];
+    for (std::size_t j = 0; j < free_vertices.size(); ++j) {
+      const int v = free_vertices[j];
+      for (int c = 0; c < 3; ++c)
+        snapshots(3 * j + c, s) = weight[3 * j + c] * (x(v, c) - rest(v, c));
+    }
+  }
+  if (!snapshots.allFinite())
+    fail("frames", "non-finite displacement in the snapshots");
+
+  const Eigen::BDCSVD<MatX> svd(snapshots, Eigen::ComputeThinU);
+  basis.singular_values = svd.singularValues();
+  const VecX& sv = basis.singular_values;
+  const double total_energy = sv.squaredNorm();
+  if (sv.size() == 0 || !(sv[0] > 0))
+    fail("frames", "the selected frames do not move (all displacements are zero): no mode");
+  int rank = 0;
+  while (rank < sv.size() && sv[rank] > options.rank_tolerance * sv[0])
+    ++rank;
+  int r = 0;
+  double captured = 0;
+  while (r < std::min(rank, options.max_modes)) {
+    captured += sv[r] * sv[r];
+    ++r;
+    if (options.energy_fraction < 1 && captured >= options.energy_fraction * total_energy)
+      break;
+  }
+  basis.captured_energy = captured / total_energy;
+
+  basis.modes = MatX::Zero(3 * n, r);
+  const MatX& u = svd.matrixU();
+  for (std::size_t j = 0; j < free_vertices.size(); ++j) {
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Index row = 3 * Eigen::Index(j) + c;
+      basis.modes.row(3 * Eigen::Index(free_vertices[j]) + c) = u.row(row).head(r) / weight[row];
+    }
+  }
+  return basis;
+}
+
+} // namespace elastolearn::learn

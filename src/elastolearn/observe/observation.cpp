@@ -1,0 +1,113 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/observe/observation.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace elastolearn::observe {
+
+namespace {
+
+const std::string k_ids = "/observed/vertex_ids";
+const std::string k_positions = "/observed/positions";
+
+std::string number(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+} // namespace
+
+void Observation::validate(const std::string& source) const {
+  const auto where = [&](const std::string& field) { return source + ": " + field; };
+  const Eigen::Index k = static_cast<Eigen::Index>(vertex_ids.size());
+  if (k == 0)
+    throw InputError(where(k_ids), "no observed vertices");
+  for (Eigen::Index j = 0; j < k; ++j) {
+    if (vertex_ids[j] < 0) {
+      throw InputError(where(k_ids),
+          "vertex id " + std::to_string(vertex_ids[j]) + " (entry " + std::to_string(j)
+              + ") is negative");
+    }
+  }
+  std::vector<std::pair<int, Eigen::Index>> sorted(vertex_ids.size());
+  for (Eigen::Index j = 0; j < k; ++j)
+    sorted[j] = { vertex_ids[j], j };
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t j = 1; j < sorted.size(); ++j) {
+    if (sorted[j].first == sorted[j - 1].first) {
+      throw InputError(where(k_ids),
+          "vertex id " + std::to_string(sorted[j].first) + " appears twice (entries "
+              + std::to_string(sorted[j - 1].second) + " and " + std::to_string(sorted[j].second)
+              + ")");
+    }
+  }
+  if (positions.empty())
+    throw InputError(where(k_positions), "no frames");
+  for (std::size_t t = 0; t < positions.size(); ++t) {
+    const Positions& x = positions[t];
+    if (x.rows() != k) {
+      throw InputError(where(k_positions),
+          "frame " + std::to_string(t) + " has " + std::to_string(x.rows())
+              + " rows, expected one per observed vertex (" + std::to_string(k) + ")");
+    }
+    for (Eigen::Index i = 0; i < x.size(); ++i) {
+      if (!std::isfinite(x.data()[i])) {
+        throw InputError(where(k_positions),
+            "frame " + std::to_string(t) + ": non-finite value " + number(x.data()[i])
+                + " for vertex " + std::to_string(vertex_ids[i / 3]) + " (component "
+                + std::to_string(i % 3) + ")");
+      }
+    }
+  }
+  if (!std::isfinite(dt) || dt <= 0)
+    throw InputError(where("dt"), "time step must be positive and finite, got " + number(dt));
+  if (!std::isfinite(start_time))
+    throw InputError(where("/time"), "non-finite start time " + number(start_time));
+}
+
+void Observation::validate(int num_vertices, int expected_frames, double expected_dt,
+    const std::string& source) const {
+  validate(source);
+  for (std::size_t j = 0; j < vertex_ids.size(); ++j) {
+    if (vertex_ids[j] >= num_vertices) {
+      throw InputError(source + ": " + k_ids,
+          "vertex id " + std::to_string(vertex_ids[j]) + " (entry " + std::to_string(j)
+              + ") is out of range [0, " + std::to_string(num_vertices) + ") of the mesh");
+    }
+  }
+  if (expected_frames >= 0 && num_frames() != expected_frames) {
+    throw InputError(source + ": " + k_positions,
+        "has " + std::to_string(num_frames()) + " frames, the scene expects "
+            + std::to_string(expected_frames));
+  }
+  if (expected_dt > 0 && std::abs(dt - expected_dt) > 1e-9 * expected_dt) {
+    throw InputError(source + ": dt",
+        "observation time step " + number(dt) + " s does not match the scene's " + number(expected_dt)
+            + " s");
+  }
+}
+
+double uniform_time_step(const std::vector<double>& time, const std::string& source) {
+  if (time.size() < 2) {
+    throw InputError(source,
+        "cannot derive a time step from " + std::to_string(time.size()) + " frame(s)");
+  }
+  const double dt = time[1] - time[0];
+  if (!std::isfinite(dt) || dt <= 0)
+    throw InputError(source, "times do not increase: " + number(time[0]) + ", " + number(time[1]));
+  for (std::size_t t = 2; t < time.size(); ++t) {
+    const double step = time[t] - time[t - 1];
+    if (!(std::abs(step - dt) <= 1e-6 * dt)) {
+      throw InputError(source,
+          "frames are not evenly spaced: interval " + std::to_string(t - 1) + " is "
+              + number(step) + " s, the first is " + number(dt) + " s");
+    }
+  }
+  return dt;
+}
+
+} // namespace elastolearn::observe

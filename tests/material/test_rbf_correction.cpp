@@ -1,0 +1,172 @@
+// RbfCorrection (paper 000 Eqs. 1, 10, 13): exact gradients (finite differences), permutation
+// symmetry, the split into elastic and damping parts, the smoothed kernel at a centre, and
+// parameter validation.
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/material/corotated.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
+
+#include <support/finite_difference.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace elastolearn;
+using namespace elastolearn::material;
+using namespace elastolearn::test;
+
+namespace {
+
+/// m = 6 centres around rest, random weights of realistic size (elastic ~1e3 Pa, damping ~1e-2 s),
+/// linear tails, and the damping tangent of a corotated nominal (E = 5e4 Pa, ν = 0.4).
+RbfCorrection::Parameters test_parameters(double epsilon) {
+  std::mt19937 rng(17);
+  std::normal_distribution<double> g(0.0, 1.0);
+  RbfCorrection::Parameters p;
+  p.centres.resize(6, 3);
+  p.centres << 1.0, 1.0, 1.0, 1.2, 1.0, 0.9, 1.1, 1.05, 0.8, 0.95, 0.9, 0.85, 1.3, 1.1, 1.0, 1.05,
+      1.0, 0.7;
+  p.weights.resize(6, 3);
+  for (Eigen::Index i = 0; i < p.weights.size(); ++i)
+    p.weights.data()[i] = 1e3 * g(rng);
+  p.damping_weights.resize(6);
+  for (auto& v : p.damping_weights)
+    v = 1e-2 * g(rng);
+  p.linear = 5e3 * Mat3::Random();
+  p.constant = Vec3(10, -20, 5);
+  p.damping_linear = Vec3(0.01, -0.02, 0.005);
+  p.damping_constant = 0.03;
+  p.damping_tangent = rest_principal_tangent(CorotatedModel(Lame::from_young_poisson(5e4, 0.4)));
+  p.epsilon = epsilon;
+  return p;
+}
+
+/// Analytic [∂N/∂σ ∂N/∂ḟ] (3×6) vs 4th-order central differences of N over (σ, ḟ).
+void expect_gradient_matches_fd(const RbfCorrection& n, const Vec3& s, const Vec3& r, double tol) {
+  Mat3 ds, dr;
+  n.correction_gradient(s, r, ds, dr);
+  Eigen::MatrixXd J(3, 6);
+  J << ds, dr;
+  Eigen::VectorXd in(6);
+  in << s, r;
+  const FdFunction f = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+    return n.correction(y.head<3>(), y.tail<3>());
+  };
+  expect_jacobian_matches(J, f, in, tol, 1e-5);
+}
+
+} // namespace
+
+TEST(RbfCorrection, GradientMatchesFiniteDifference) {
+  // States at least 0.04 from every centre, so the kernel is smooth across the FD stencil
+  // (4·1e-5): the O(h⁴) truncation error is ~ (h/r)⁴ ≈ 1e-13 relative; round-off in the FD
+  // quotient of values ~1e4 Pa is ~1e-16·1e4/1e-5 ≈ 1e-7 Pa against gradients ~1e4–1e5: 1e-9.
+  const RbfCorrection n(test_parameters(1e-3));
+  const std::vector<Vec3> stretches { Vec3(1.15, 0.97, 0.88), Vec3(1.4, 1.2, 0.6),
+    Vec3(0.9, 1.25, 1.02), Vec3(1.1, 0.95, -0.2) /* inverted */ };
+  for (const Vec3& s : stretches) {
+    for (const Vec3& r : { Vec3(0.3, -0.5, 0.1), Vec3::Zero().eval() }) {
+      SCOPED_TRACE(testing::Message() << "stretches " << s.transpose() << " rates " << r.transpose());
+      expect_gradient_matches_fd(n, s, r, 1e-7);
+    }
+  }
+}
+
+TEST(RbfCorrection, SmoothedKernelIsDifferentiableAtACentre) {
+  // With ε = 0.05 the kernel √(r² + ε²) is smooth through a centre: FD agrees there too (curvature
+  // scale ε ≫ FD step, truncation (h/ε)⁴ ≈ 2e-15).
+  const RbfCorrection smooth(test_parameters(0.05));
+  const Vec3 centre = smooth.parameters().centres.row(1).transpose(); // (1.2, 1.0, 0.9)
+  expect_gradient_matches_fd(smooth, centre, Vec3(0.2, 0.1, -0.3), 1e-7);
+  expect_gradient_matches_fd(smooth, centre + Vec3(1e-3, -2e-3, 0), Vec3(0.2, 0.1, -0.3), 1e-7);
+
+  // ε = 0 (the paper's ‖σ − c‖): finite values and the documented subgradient 0 at the centre.
+  const RbfCorrection kinked(test_parameters(0.0));
+  Mat3 ds, dr;
+  kinked.correction_gradient(centre, Vec3::Zero(), ds, dr);
+  EXPECT_TRUE(ds.allFinite());
+  EXPECT_TRUE(kinked.correction(centre, Vec3::Zero()).allFinite());
+}
+
+TEST(RbfCorrection, PermutationSymmetric) {
+  const RbfCorrection n(test_parameters(1e-3));
+  const Vec3 s(1.15, 0.97, 0.88), r(0.3, -0.5, 0.1);
+  const Vec3 ns = n.correction(s, r);
+  Mat3 ds, dr;
+  n.correction_gradient(s, r, ds, dr);
+  Eigen::Matrix3i perms;
+  perms << 1, 0, 2, 2, 0, 1, 2, 1, 0;
+  for (int k = 0; k < 3; ++k) {
+    // Input i of the permuted call is input p[i] of the sorted one: N(Pσ, Pḟ) = P N(σ, ḟ), and
+    // the gradients permute on both sides. Exact: the same arithmetic runs on the same numbers.
+    Eigen::PermutationMatrix<3> P;
+    P.indices() = perms.row(k).transpose();
+    const Vec3 ps = P.transpose() * s, pr = P.transpose() * r;
+    EXPECT_EQ(n.correction(ps, pr), P.transpose() * ns);
+    Mat3 pds, pdr;
+    n.correction_gradient(ps, pr, pds, pdr);
+    EXPECT_EQ(pds, P.transpose() * ds * P);
+    EXPECT_EQ(pdr, P.transpose() * dr * P);
+  }
+}
+
+TEST(RbfCorrection, SplitsIntoElasticAndDampingParts) {
+  const RbfCorrection n(test_parameters(1e-3));
+  const auto& p = n.parameters();
+  const Vec3 s(1.15, 0.97, 0.88), r(0.3, -0.5, 0.1);
+  // N(σ, ḟ) − N(σ, 0) = Δα₁(σ) D ḟ, and Δα₁ is the documented RBF + linear tail.
+  const double alpha = n.damping_correction(s);
+  double expected_alpha = p.damping_linear.dot(s - Vec3::Ones()) + p.damping_constant;
+  Vec3 expected_elastic = p.linear * (s - Vec3::Ones()) + p.constant;
+  for (int i = 0; i < 6; ++i) {
+    const double phi = rbf_kernel((s - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
+    expected_alpha += p.damping_weights[i] * phi;
+    expected_elastic += phi * p.weights.row(i).transpose();
+  }
+  EXPECT_NEAR(alpha, expected_alpha, 1e-14);
+  EXPECT_LE((n.elastic_correction(s) - expected_elastic).norm(), 1e-10);
+  const Vec3 damping = n.correction(s, r) - n.correction(s, Vec3::Zero());
+  EXPECT_LE((damping - alpha * p.damping_tangent * r).norm(), 1e-9 * damping.norm());
+  Mat3 ds, dr;
+  n.correction_gradient(s, r, ds, dr);
+  EXPECT_LE((dr - alpha * p.damping_tangent).norm(), 1e-12 * dr.norm());
+  // The corotated tangent is 2μI + λ11ᵀ.
+  const Lame lame = Lame::from_young_poisson(5e4, 0.4);
+  EXPECT_LE((p.damping_tangent - (2 * lame.mu * Mat3::Identity()
+                 + lame.lambda * Mat3::Ones())).norm(), 1e-9 * lame.lambda);
+}
+
+TEST(RbfCorrection, ZeroWithoutWeightsAndWithoutDampingPart) {
+  RbfCorrection::Parameters p = test_parameters(1e-3);
+  p.weights.setZero();
+  p.linear.setZero();
+  p.constant.setZero();
+  p.damping_weights.resize(0); // no damping RBF; the damping tail alone remains
+  p.damping_linear.setZero();
+  p.damping_constant = 0;
+  const RbfCorrection n(p);
+  EXPECT_EQ(n.correction(Vec3(1.2, 1.0, 0.7), Vec3(1, 2, 3)), Vec3::Zero());
+  EXPECT_EQ(n.damping_correction(Vec3(1.2, 1.0, 0.7)), 0.0);
+  EXPECT_EQ(n.name(), "rbf");
+  const auto copy = n.clone();
+  EXPECT_EQ(copy->correction(Vec3(1.2, 1.0, 0.7), Vec3(1, 2, 3)), Vec3::Zero());
+}
+
+TEST(RbfCorrection, RejectsInconsistentParameters) {
+  auto expect_error = [](const std::function<void(RbfCorrection::Parameters&)>& breaker,
+                          const std::string& field) {
+    RbfCorrection::Parameters p = test_parameters(1e-3);
+    breaker(p);
+    try {
+      RbfCorrection n(p);
+      ADD_FAILURE() << "no error for " << field;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where(), "rbf_correction." + field) << e.what();
+    }
+  };
+  expect_error([](auto& p) { p.weights.conservativeResize(5, 3); }, "weights");
+  expect_error([](auto& p) { p.damping_weights.conservativeResize(4); }, "damping_weights");
+  expect_error([](auto& p) { p.centres(2, 1) = std::nan(""); }, "centres");
+  expect_error([](auto& p) { p.epsilon = -1; }, "epsilon");
+  expect_error([](auto& p) { p.damping_tangent(0, 0) = INFINITY; }, "damping_tangent");
+}
