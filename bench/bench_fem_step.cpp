@@ -46,7 +46,7 @@ void step_benchmark(benchmark::State& state, material::ElasticModelType type, si
   sim::Simulator simulator(bar(type, resolution, solver));
   // Warm up past the first steps (whose Newton solves start far from the answer) as Vega's would.
   for (int i = 0; i < 3; ++i) simulator.step();
-  long newton = 0, steps = 0;
+  long newton = 0, linear = 0, steps = 0;
   sim::SolverTimings timings;
   double seconds = 0;
   for (auto _ : state) {
@@ -55,12 +55,14 @@ void step_benchmark(benchmark::State& state, material::ElasticModelType type, si
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!report.converged) state.SkipWithError(report.message.c_str());
     newton += report.iterations;
+    linear += report.linear_iterations;
     timings += report.timings;
     ++steps;
   }
   state.counters["tets"] = simulator.scene().mesh.num_tets();
   state.counters["ms/step"] = 1e3 * seconds / steps;
   state.counters["newton/step"] = double(newton) / steps;
+  if (solver == sim::LinearSolverType::ConjugateGradient) state.counters["cg_it/step"] = double(linear) / steps;
   state.counters["assembly%"] = 100 * timings.assembly / seconds;
   state.counters["factor%"] = 100 * timings.factorization / seconds;
   state.counters["solve%"] = 100 * timings.solve / seconds;

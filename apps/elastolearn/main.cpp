@@ -3,6 +3,7 @@
 
 #include <elastolearn/config.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/interrupt.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -27,6 +28,7 @@ int main(int argc, char** argv) {
                 " - learn how elastic solids move, and simulate them"};
   root.set_version_flag("--version", ELASTOLEARN_VERSION);
   root.require_subcommand(1);
+  install_interrupt_handler();
   auto& registry = app::command_registry();
   std::sort(registry.begin(), registry.end(),
             [](const auto& a, const auto& b) { return a.order < b.order; });

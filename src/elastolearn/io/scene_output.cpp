@@ -29,7 +29,7 @@ sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutp
       {"scene", scene.name},
       {"material", scene.material.elastic->name()},
       {"dt", std::to_string(scene.dt * every)},
-      {"status", report.completed ? "completed" : "diverged: " + report.message}};
+      {"status", report.completed ? "completed" : "stopped: " + report.message}};
   if (writer.frames() > 0) writer.finish(metadata);
   if (options.vtu_directory && !series.positions.empty()) {
     series.metadata = metadata;

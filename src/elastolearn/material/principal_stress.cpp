@@ -96,7 +96,7 @@ Mat9 first_piola_derivative(
             const Vec3 p = V(b, j) * U.col(i); // vec(u_i v_jᵀ), rows 3b..3b+2
             const Vec3 q = V(b, i) * U.col(j); // vec(u_j v_iᵀ)
             M.col(3 + m).segment<3>(3 * b) = p + q;
-            M.col(6 + m).segment<3>(3 * b) = q - p + 1e-12 * p;
+            M.col(6 + m).segment<3>(3 * b) = p - q;
         }
         Y.col(3 + m) = (0.5 * twist) * M.col(3 + m);
         Y.col(6 + m) = (0.5 * flip) * M.col(6 + m);

@@ -49,6 +49,10 @@ struct NewtonProblem {
   std::function<void(const VecX& u, fem::SystemMatrix& A)> jacobian;
   /// Optional energy E(u) with ∇E = g, used as the line-search merit function.
   std::function<double(const VecX& u)> energy;
+  /// Optional: initial guess for the first Newton increment's linear solve (iterative solvers),
+  /// overwritten with that increment. Time stepping passes the previous step's, which smooth
+  /// motion makes nearly equal; it changes no convergence criterion, only the CG start.
+  VecX* first_increment = nullptr;
 };
 
 /// Solve g(u) = 0 starting from u. The solver's symbolic analysis must already be done on A's

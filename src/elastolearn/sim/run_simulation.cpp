@@ -1,3 +1,4 @@
+#include <elastolearn/core/interrupt.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 
 #include <chrono>
@@ -27,6 +28,10 @@ SimulationReport run_simulation(Simulator& simulator, int frames, const FrameSin
   if (sink) sink(0, simulator.time(), simulator.positions(), simulator.velocities());
   report.frames_written = 1;
   for (int frame = 1; frame <= frames; ++frame) {
+    if (interrupt_requested()) {
+      report.message = "interrupted before frame " + std::to_string(frame) + "; kept frames 0.." + std::to_string(frame - 1);
+      break;
+    }
     const NewtonReport step = simulator.step();
     report.newton_iterations += step.iterations;
     report.linear_iterations += step.linear_iterations;

@@ -119,6 +119,7 @@ NewtonReport Simulator::step() {
     if (m_scene.mass == fem::MassType::Consistent) A.add_values(m_consistent_values, 1 / h);
     else A.add_diagonal(m_reduced_masses, 1 / h);
   };
+  if (m_solver->type() == LinearSolverType::ConjugateGradient) problem.first_increment = &m_first_increment;
   VecX u = m_dofs.restrict(m_v);
   NewtonReport report = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
   if (!report.converged) return report;

@@ -75,6 +75,7 @@ private:
   int m_step = 0;
   // Work vectors (no allocation per Newton iteration).
   VecX m_x_new, m_v_new, m_force, m_dv, m_mass_dv, m_x_prescribed;
+  VecX m_first_increment; ///< previous step's first Newton increment (warm start for CG)
 };
 
 } // namespace elastolearn::sim

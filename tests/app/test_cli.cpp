@@ -1,0 +1,141 @@
+// End-to-end tests of the `elastolearn` executable: what a user sees.
+#include <elastolearn/io/trajectory_file.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <gtest/gtest.h>
+#include <string>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int exit_code;
+  std::string output; // stdout + stderr
+};
+
+Run run(const std::string& arguments) {
+  const std::string command = std::string(ELASTOLEARN_EXECUTABLE) + " " + arguments + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  Run r{-1, ""};
+  std::array<char, 4096> buffer{};
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) r.output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class CliTest : public ::testing::Test {
+protected:
+  void SetUp() override {
+    m_dir = fs::temp_directory_path() / ("elastolearn_cli_" + std::to_string(::getpid()) + "_" +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(m_dir);
+    fs::create_directories(m_dir);
+  }
+  void TearDown() override { fs::remove_all(m_dir); }
+  fs::path write(const std::string& name, const std::string& text) {
+    std::ofstream(m_dir / name) << text;
+    return m_dir / name;
+  }
+  fs::path m_dir;
+};
+
+const char* kSmallScene = R"({
+  "format": "elastolearn-scene/1",
+  "mesh": {"type": "box", "size": [0.2, 0.05, 0.05], "cells": [4, 1, 1]},
+  "material": {"model": "corotated", "young": 1e5, "poisson": 0.3, "density": 1000,
+               "damping": {"alpha0": 0.1, "alpha1": 0.001}},
+  "gravity": [0, -9.81, 0],
+  "fixed": [{"min": "x"}],
+  "time": {"dt": 0.002, "frames": 20}
+})";
+
+} // namespace
+
+TEST_F(CliTest, SimulateWritesATrajectoryAndAParaViewSeries) {
+  const auto scene = write("bar.json", kSmallScene);
+  const auto out = m_dir / "bar.h5";
+  const auto r = run("simulate " + scene.string() + " -o " + out.string() + " --vtu " + (m_dir / "vtu").string() + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto t = elastolearn::io::read_trajectory_h5(out);
+  EXPECT_EQ(t.positions.size(), 21u);
+  EXPECT_NEAR(t.time.back(), 0.04, 1e-12);
+  EXPECT_LT(t.positions.back().col(1).minCoeff(), -1e-4); // it sags
+  EXPECT_TRUE(fs::exists(m_dir / "vtu" / "bar.pvd"));
+  EXPECT_NE(r.output.find("bar.h5"), std::string::npos);
+}
+
+TEST_F(CliTest, BadSceneGivesOneLineNamingTheFieldAndNoOutput) {
+  std::string text = kSmallScene;
+  text.replace(text.find("\"young\": 1e5"), 12, "\"young\": -3");
+  const auto scene = write("bad.json", text);
+  const auto r = run("simulate " + scene.string() + " -o " + (m_dir / "x.h5").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("bad.json"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("material.young"), std::string::npos) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_FALSE(fs::exists(m_dir / "x.h5"));
+}
+
+TEST_F(CliTest, UnknownKeyAndBrokenJsonAreReportedWithTheirPlace) {
+  std::string typo = kSmallScene;
+  typo.replace(typo.find("\"poisson\""), 9, "\"poison\"");
+  auto r = run("simulate " + write("typo.json", typo).string() + " -o " + (m_dir / "x.h5").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("poison"), std::string::npos) << r.output;
+  r = run("simulate " + write("broken.json", "{\"format\": ").string() + " -o " + (m_dir / "x.h5").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("broken.json"), std::string::npos) << r.output;
+}
+
+TEST_F(CliTest, DivergenceNamesTheFrameAndKeepsEarlierFrames) {
+  // One Newton iteration to 1e-12 cannot converge once the bar moves: the run must stop, say
+  // at which frame, exit non-zero, and keep the frames before it in a readable file.
+  std::string text = kSmallScene;
+  text.replace(text.find("\"time\""), 6, "\"solver\": {\"max_newton_iterations\": 1, \"newton_tolerance\": 1e-12}, \"time\"");
+  const auto out = m_dir / "div.h5";
+  const auto r = run("simulate " + write("div.json", text).string() + " -o " + out.string() + " -q");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("diverged at frame"), std::string::npos) << r.output;
+  const auto t = elastolearn::io::read_trajectory_h5(out);
+  EXPECT_GE(t.positions.size(), 1u);
+  EXPECT_NE(t.metadata.at("status").find("diverged at frame"), std::string::npos);
+}
+
+TEST_F(CliTest, InfoDescribesMeshesTrajectoriesAndScenes) {
+  const auto scene = write("bar.json", kSmallScene);
+  ASSERT_EQ(run("simulate " + scene.string() + " -o " + (m_dir / "bar.h5").string() + " -q").exit_code, 0);
+  const auto r = run("info " + scene.string() + " " + (m_dir / "bar.h5").string() + " " +
+                     std::string(ELASTOLEARN_EXAMPLES_DIR) + "/03_real_mesh/elephant.node");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("21 frames"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("2830 tets"), std::string::npos) << r.output;
+  EXPECT_EQ(run("info " + (m_dir / "missing.node").string()).exit_code, 2);
+}
+
+TEST_F(CliTest, ExampleScenesParse) {
+  for (const char* example : {"01_cantilever/cantilever.json", "02_sphere/sphere.json", "03_real_mesh/elephant.json"}) {
+    const auto r = run(std::string("info ") + ELASTOLEARN_EXAMPLES_DIR + "/" + example);
+    EXPECT_EQ(r.exit_code, 0) << example << ": " << r.output;
+  }
+}
+
+TEST_F(CliTest, InterruptKeepsTheFramesSoFarAndLeavesNoTemporaryFile) {
+  std::string text = kSmallScene;
+  text.replace(text.find("\"frames\": 20"), 12, "\"frames\": 100000");
+  const auto out = m_dir / "long.h5";
+  const std::string command = std::string(ELASTOLEARN_EXECUTABLE) + " simulate " + write("long.json", text).string() +
+                              " -o " + out.string() + " -q > /dev/null 2>&1 & pid=$!; sleep 1.5; kill -INT $pid; wait $pid";
+  const int status = std::system(("bash -c '" + command + "'").c_str());
+  EXPECT_NE(status, 0);
+  const auto t = elastolearn::io::read_trajectory_h5(out);
+  EXPECT_GE(t.positions.size(), 2u);
+  EXPECT_NE(t.metadata.at("status").find("interrupted"), std::string::npos);
+  for (const auto& entry : fs::directory_iterator(m_dir))
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
+}
