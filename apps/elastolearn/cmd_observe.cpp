@@ -37,11 +37,18 @@ void run_observe(const ObserveOptions& opts) {
   std::vector<int> ids;
   if (!opts.vertices.empty()) {
     ids = io::read_vertex_id_list(opts.vertices);
+    for (int id : ids) {
+      if (id >= mesh.num_vertices()) {
+        throw InputError(opts.vertices,
+            "vertex id " + std::to_string(id) + " is out of range [0, "
+                + std::to_string(mesh.num_vertices()) + ") of the mesh in " + opts.trajectory);
+      }
+    }
   } else {
     ids = observe::select_visible_vertices(mesh, opts.fraction, opts.seed);
   }
-  const observe::Observation obs
-      = observe::observe_vertices(traj.positions, dt, ids, opts.noise, opts.seed, traj.time.front());
+  const observe::Observation obs = observe::observe_vertices(
+      traj.positions, dt, ids, opts.noise, opts.seed, traj.time.front());
   io::write_observation_h5(opts.output, obs);
 
   const int surface = static_cast<int>(mesh.surface_vertices().size());

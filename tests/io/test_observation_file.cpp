@@ -199,10 +199,12 @@ TEST(ObservationFile, RejectsEachKindOfBadFile) {
     r.f64["/time"] = { { 0.0, 0.01, NAN }, { 3 } };
     expect_rejected(dir, r, { "/time", "non-finite" });
   }
-  expect_input_error([&] { read_observation_h5(dir / "missing.h5"); }, { "missing.h5", "no such file" });
+  expect_input_error(
+      [&] { read_observation_h5(dir / "missing.h5"); }, { "missing.h5", "no such file" });
   {
     std::ofstream(dir / "text.h5") << "not hdf5\n";
-    expect_input_error([&] { read_observation_h5(dir / "text.h5"); }, { "text.h5", "not an HDF5 file" });
+    expect_input_error(
+        [&] { read_observation_h5(dir / "text.h5"); }, { "text.h5", "not an HDF5 file" });
   }
 }
 
@@ -229,6 +231,7 @@ TEST(VertexIdList, ParsesCommentsCommasAndLines) {
   std::ofstream(dir / "neg.txt") << "-3\n";
   expect_input_error([&] { read_vertex_id_list(dir / "neg.txt"); }, { "neg.txt:1", "'-3'" });
   std::ofstream(dir / "empty.txt") << "# nothing\n";
-  expect_input_error([&] { read_vertex_id_list(dir / "empty.txt"); }, { "empty.txt", "no vertex ids" });
+  expect_input_error(
+      [&] { read_vertex_id_list(dir / "empty.txt"); }, { "empty.txt", "no vertex ids" });
   EXPECT_THROW(read_vertex_id_list(dir / "absent.txt"), InputError);
 }

@@ -101,5 +101,5 @@ TEST(BandedBlockCholesky, ReportsTheBlockThatIsNotPositiveDefinite) {
     EXPECT_NE(std::string(e.what()).find("pivot block 4"), std::string::npos) << e.what();
   }
   BlockBandedMatrix zero(3, 2); // singular
-  EXPECT_THROW(BandedBlockCholesky{ zero }, NotPositiveDefiniteError);
+  EXPECT_THROW(BandedBlockCholesky { zero }, NotPositiveDefiniteError);
 }

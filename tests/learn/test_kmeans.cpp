@@ -42,7 +42,8 @@ TEST(KMeans, FindsSeparatedClusters) {
   std::set<int> matched;
   for (Eigen::Index c = 0; c < truth.rows(); ++c) {
     Eigen::Index best = 0;
-    const double distance = (result.centres.rowwise() - truth.row(c)).rowwise().norm().minCoeff(&best);
+    const double distance
+        = (result.centres.rowwise() - truth.row(c)).rowwise().norm().minCoeff(&best);
     // The mean of 200 samples of std 0.01 lies within ~0.01/√200·√3 ≈ 1.2e-3 of the truth.
     EXPECT_LT(distance, 5e-3) << "cluster " << c;
     matched.insert(int(best));

@@ -36,7 +36,8 @@ LowRankMotion low_rank_motion(int n = 40, int T = 60) {
       shapes(d, k) = g(rng);
   }
   for (int t = 0; t < T; ++t) {
-    const Eigen::Vector3d a(0.1 * std::sin(0.3 * t), 0.03 * std::cos(0.7 * t), 0.01 * std::sin(1.9 * t + 1));
+    const Eigen::Vector3d a(
+        0.1 * std::sin(0.3 * t), 0.03 * std::cos(0.7 * t), 0.01 * std::sin(1.9 * t + 1));
     VecX x = flatten(m.rest) + shapes * a;
     m.frames.emplace_back(unflatten(x));
   }

@@ -57,7 +57,8 @@ double relative_error(const material::Correction& n, const StressSamples& test) 
   double e = 0, t = 0;
   for (Eigen::Index j = 0; j < test.stretches.rows(); ++j) {
     const Vec3 y = test.targets.row(j).transpose();
-    e += (n.correction(test.stretches.row(j).transpose(), test.stretch_rates.row(j).transpose()) - y)
+    e += (n.correction(test.stretches.row(j).transpose(), test.stretch_rates.row(j).transpose())
+        - y)
              .squaredNorm();
     t += y.squaredNorm();
   }
@@ -68,7 +69,8 @@ double relative_error(const material::Correction& n, const StressSamples& test) 
 
 TEST(RbfFit, RecoversAnRbfCorrectionExactly) {
   const Mat3 D = corotated_tangent();
-  const StressSamples probe = make_samples(500, 1, [](const Vec3&, const Vec3&) { return Vec3(Vec3::Zero()); });
+  const StressSamples probe
+      = make_samples(500, 1, [](const Vec3&, const Vec3&) { return Vec3(Vec3::Zero()); });
   const MatX centres = centres_for(probe, 12);
   RbfFitOptions options;
   options.damping_tangent = D;
@@ -130,7 +132,8 @@ TEST(RbfFit, ErrorShrinksWithMoreKernels) {
   RbfFitOptions options;
   options.fit_damping = false;
   const auto error = [&](int m) {
-    return relative_error(fit_rbf_correction(RbfDesign(centres_for(train, m), options), train).correction, test);
+    return relative_error(
+        fit_rbf_correction(RbfDesign(centres_for(train, m), options), train).correction, test);
   };
   const double coarse = error(20), fine = error(80);
   EXPECT_LT(fine, 0.6 * coarse);
@@ -156,7 +159,8 @@ TEST(RbfFit, ElasticOnlyFitIgnoresRatesAndSortsSamples) {
   options.fit_damping = false;
   const RbfDesign design(centres_for(train, 20), options);
   EXPECT_EQ(design.num_unknowns(), 3 * 24);
-  const RbfFitResult a = fit_rbf_correction(design, train), b = fit_rbf_correction(design, shuffled);
+  const RbfFitResult a = fit_rbf_correction(design, train),
+                     b = fit_rbf_correction(design, shuffled);
   EXPECT_LE((a.unknowns - b.unknowns).norm(), 1e-9 * a.unknowns.norm());
   EXPECT_EQ(a.correction.parameters().damping_weights.size(), 0);
   // Exact up to the (default, 1e-9) Tikhonov bias and round-off: measured 3e-8.

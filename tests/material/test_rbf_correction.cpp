@@ -66,7 +66,8 @@ TEST(RbfCorrection, GradientMatchesFiniteDifference) {
     Vec3(0.9, 1.25, 1.02), Vec3(1.1, 0.95, -0.2) /* inverted */ };
   for (const Vec3& s : stretches) {
     for (const Vec3& r : { Vec3(0.3, -0.5, 0.1), Vec3::Zero().eval() }) {
-      SCOPED_TRACE(testing::Message() << "stretches " << s.transpose() << " rates " << r.transpose());
+      SCOPED_TRACE(
+          testing::Message() << "stretches " << s.transpose() << " rates " << r.transpose());
       expect_gradient_matches_fd(n, s, r, 1e-7);
     }
   }
@@ -132,8 +133,9 @@ TEST(RbfCorrection, SplitsIntoElasticAndDampingParts) {
   EXPECT_LE((dr - alpha * p.damping_tangent).norm(), 1e-12 * dr.norm());
   // The corotated tangent is 2μI + λ11ᵀ.
   const Lame lame = Lame::from_young_poisson(5e4, 0.4);
-  EXPECT_LE((p.damping_tangent - (2 * lame.mu * Mat3::Identity()
-                 + lame.lambda * Mat3::Ones())).norm(), 1e-9 * lame.lambda);
+  EXPECT_LE(
+      (p.damping_tangent - (2 * lame.mu * Mat3::Identity() + lame.lambda * Mat3::Ones())).norm(),
+      1e-9 * lame.lambda);
 }
 
 TEST(RbfCorrection, ZeroWithoutWeightsAndWithoutDampingPart) {

@@ -23,9 +23,8 @@ Observation valid_observation() {
 }
 
 /// Expect validate(10 vertices, 5 frames, dt 0.01) to throw an InputError containing every part.
-void expect_rejected(
-    const std::function<void(Observation&)>& breaker, const std::vector<std::string>& parts,
-    int frames = 5, double dt = 0.01) {
+void expect_rejected(const std::function<void(Observation&)>& breaker,
+    const std::vector<std::string>& parts, int frames = 5, double dt = 0.01) {
   Observation obs = valid_observation();
   breaker(obs);
   try {

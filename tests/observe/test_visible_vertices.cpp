@@ -1,5 +1,5 @@
-// Visible-vertex selection spreads over the surface and is deterministic; observe_vertices() copies the
-// right vertices and adds seeded Gaussian noise of the requested size.
+// Visible-vertex selection spreads over the surface and is deterministic; observe_vertices() copies
+// the right vertices and adds seeded Gaussian noise of the requested size.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/mesh/primitives.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>

@@ -102,7 +102,8 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
       const Mat9 H = c.has_tangent ? c.tangent
                                    : material::first_piola_derivative(c.frame, c.stress.stress,
                                                                       c.stress.d_stretches, m_project_tangent);
-      J = element_matrix_from_tangent(H, rest);
+      // The projected tangent is symmetric; the exact one need not be (non-symmetric corrections).
+      J = element_matrix_from_tangent(H, rest, m_project_tangent);
       J *= c_x + c_v * c.alpha.alpha1;
       if (c.alpha.alpha0 != 0) J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
       if (correction && c_v != 0) {

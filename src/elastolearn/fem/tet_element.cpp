@@ -19,19 +19,23 @@ std::vector<TetRestData> precompute_rest_data(const mesh::TetMesh& mesh) {
   return out;
 }
 
-Mat12 element_matrix_from_tangent(const Mat9& H, const TetRestData& rest) {
+Mat12 element_matrix_from_tangent(const Mat9& H, const TetRestData& rest, bool symmetric) {
   const auto& g = rest.gradients;
   // W = H B: column (3b + k) of B has g_b[l] at row (k + 3l).
   Eigen::Matrix<double, 9, 12> W;
   for (int b = 0; b < 4; ++b)
     for (int k = 0; k < 3; ++k)
       W.col(3 * b + k) = H.col(k) * g(0, b) + H.col(k + 3) * g(1, b) + H.col(k + 6) * g(2, b);
-  // K = Bᵀ W: row (3a + i) = Σ_j g_a[j] W.row(i + 3j).
+  // K = Bᵀ W: row (3a + i) = Σ_j g_a[j] W.row(i + 3j). For symmetric H only the upper triangle
+  // is computed and mirrored.
   Mat12 K;
   for (int a = 0; a < 4; ++a)
-    for (int i = 0; i < 3; ++i)
-      K.row(3 * a + i) = rest.volume * (g(0, a) * W.row(i) + g(1, a) * W.row(i + 3) +
-                                        g(2, a) * W.row(i + 6));
+    for (int i = 0; i < 3; ++i) {
+      const int row = 3 * a + i;
+      for (int col = symmetric ? row : 0; col < 12; ++col)
+        K(row, col) = rest.volume * (g(0, a) * W(i, col) + g(1, a) * W(i + 3, col) + g(2, a) * W(i + 6, col));
+    }
+  if (symmetric) K.triangularView<Eigen::StrictlyLower>() = K.transpose();
   return K;
 }
 

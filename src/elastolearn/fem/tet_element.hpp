@@ -30,7 +30,8 @@ inline Mat3 deformation_gradient(const Eigen::Matrix<double, 3, 4>& x, const Tet
 }
 
 /// Element 12×12 matrix vol · Bᵀ H B with B = ∂vec(F)/∂x_e (column-major vec(F); x_e ordered
-/// x0,y0,z0,x1,...). Exploits B's Kronecker structure: ~750 multiply-adds instead of ~2300.
-Mat12 element_matrix_from_tangent(const Mat9& H, const TetRestData& rest);
+/// x0,y0,z0,x1,...). Exploits B's Kronecker structure: ~750 multiply-adds instead of ~2300, and
+/// with `symmetric` (H symmetric, e.g. a projected tangent) computes only the upper triangle.
+Mat12 element_matrix_from_tangent(const Mat9& H, const TetRestData& rest, bool symmetric = false);
 
 } // namespace elastolearn::fem

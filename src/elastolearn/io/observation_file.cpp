@@ -50,7 +50,8 @@ void check_format(const h5::File& file) {
   const std::string expected = std::string(k_kind) + "/" + std::to_string(k_version);
   const std::optional<std::string> format = file.attribute("format");
   if (!format) {
-    file.fail("", "not an elastolearn observation: the root attribute 'format' is missing (expected '"
+    file.fail("",
+        "not an elastolearn observation: the root attribute 'format' is missing (expected '"
             + expected + "')");
   }
   const std::string prefix = std::string(k_kind) + "/";
@@ -62,12 +63,12 @@ void check_format(const h5::File& file) {
       version = 0;
   }
   if (version < 1) {
-    file.fail("", "format '" + *format + "' is not an elastolearn observation (expected '"
-            + expected + "')");
+    file.fail("",
+        "format '" + *format + "' is not an elastolearn observation (expected '" + expected + "')");
   }
   if (version > k_version) {
-    file.fail("", "format '" + *format + "' is newer than this elastolearn reads (up to '"
-            + expected + "')");
+    file.fail("",
+        "format '" + *format + "' is newer than this elastolearn reads (up to '" + expected + "')");
   }
 }
 
@@ -127,13 +128,15 @@ observe::Observation read_observation_h5(const std::filesystem::path& path) {
 
   const h5::Shape shape = shape_of_rank(file, k_positions, 3, "(T, k, 3)");
   if (shape[1] != k) {
-    file.fail(k_positions, "has " + std::to_string(shape[1]) + " points per frame but " + k_ids
-            + " lists " + std::to_string(k) + " vertices");
+    file.fail(k_positions,
+        "has " + std::to_string(shape[1]) + " points per frame but " + k_ids + " lists "
+            + std::to_string(k) + " vertices");
   }
   const hsize_t T = shape[0];
   const h5::Shape time_shape = shape_of_rank(file, k_time, 1, "(T,)");
   if (time_shape[0] != T) {
-    file.fail(k_time, "has " + std::to_string(time_shape[0]) + " times but " + k_positions + " has "
+    file.fail(k_time,
+        "has " + std::to_string(time_shape[0]) + " times but " + k_positions + " has "
             + std::to_string(T) + " frames");
   }
   const std::vector<double> values = file.read_f64(k_positions);
@@ -149,7 +152,8 @@ observe::Observation read_observation_h5(const std::filesystem::path& path) {
     if (!std::isfinite(time[t]))
       file.fail(k_time, "frame " + std::to_string(t) + ": non-finite time " + number(time[t]));
     if (t > 0 && !(std::abs(time[t] - time[t - 1] - obs.dt) <= 1e-6 * obs.dt)) {
-      file.fail(k_time, "frames " + std::to_string(t - 1) + " and " + std::to_string(t) + " are "
+      file.fail(k_time,
+          "frames " + std::to_string(t - 1) + " and " + std::to_string(t) + " are "
               + number(time[t] - time[t - 1]) + " s apart, but dt is " + number(obs.dt) + " s");
     }
   }

@@ -88,7 +88,8 @@ void BandedBlockCholesky::compute(const BlockBandedMatrix& a) {
       throw NotPositiveDefiniteError(j,
           "the matrix is not positive definite: pivot block " + std::to_string(j) + " of "
               + std::to_string(m_blocks) + " (unknowns " + std::to_string(Eigen::Index(j) * r)
-              + ".." + std::to_string(Eigen::Index(j + 1) * r - 1) + ") lost positive definiteness");
+              + ".." + std::to_string(Eigen::Index(j + 1) * r - 1)
+              + ") lost positive definiteness");
     }
     pivot.triangularView<Eigen::StrictlyUpper>().setZero();
     const auto ljj_t = pivot.transpose().triangularView<Eigen::Upper>();

@@ -20,18 +20,29 @@ template <typename T> std::string str(T v) {
 }
 
 /// Label and squared distance of every point to its nearest centre (ties: lowest index).
-void assign(ConstRef<MatX> points, const MatX& centres, std::vector<int>& labels, VecX& distance) {
-  const Eigen::Index n = points.rows();
-  const Eigen::Index k = centres.rows();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 1024),
+/// `points_t` and `centres_t` are d × n and d × k (column-major: each point contiguous); the
+/// distance of a point does not depend on how the range is split, so the result is deterministic.
+template <int D>
+void assign_fixed(
+    const MatX& points_t, const MatX& centres_t, std::vector<int>& labels, VecX& distance) {
+  const Eigen::Index n = points_t.cols();
+  const Eigen::Index k = centres_t.cols();
+  const Eigen::Index d = points_t.rows();
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 4096),
       [&](const tbb::blocked_range<Eigen::Index>& range) {
         for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
+          const double* p = points_t.data() + i * d;
           double best = std::numeric_limits<double>::infinity();
           int label = 0;
           for (Eigen::Index c = 0; c < k; ++c) {
-            const double d = (points.row(i) - centres.row(c)).squaredNorm();
-            if (d < best) {
-              best = d;
+            const double* q = centres_t.data() + c * d;
+            double sum = 0;
+            for (Eigen::Index j = 0; j < (D > 0 ? D : d); ++j) {
+              const double diff = p[j] - q[j];
+              sum += diff * diff;
+            }
+            if (sum < best) {
+              best = sum;
               label = static_cast<int>(c);
             }
           }
@@ -41,16 +52,38 @@ void assign(ConstRef<MatX> points, const MatX& centres, std::vector<int>& labels
       });
 }
 
-/// k-means++ seeding.
-MatX seed_centres(ConstRef<MatX> points, int k, std::mt19937_64& rng) {
-  const Eigen::Index n = points.rows();
-  MatX centres(k, points.cols());
+void assign(const MatX& points_t, const MatX& centres_t, std::vector<int>& labels, VecX& distance) {
+  switch (points_t.rows()) { // the common dimensions get an unrolled inner loop
+  case 3:
+    return assign_fixed<3>(points_t, centres_t, labels, distance);
+  case 6:
+    return assign_fixed<6>(points_t, centres_t, labels, distance);
+  default:
+    return assign_fixed<0>(points_t, centres_t, labels, distance);
+  }
+}
+
+/// Squared distance of every point (columns of the d × n `points_t`) to `centre` (length d).
+void squared_distances(const MatX& points_t, const VecX& centre, VecX& out) {
+  const Eigen::Index d = points_t.rows();
+  for (Eigen::Index i = 0; i < points_t.cols(); ++i) {
+    const double* p = points_t.data() + i * d;
+    double sum = 0;
+    for (Eigen::Index j = 0; j < d; ++j)
+      sum += (p[j] - centre[j]) * (p[j] - centre[j]);
+    out[i] = sum;
+  }
+}
+
+/// k-means++ seeding on the d × n points; returns k × d centres.
+MatX seed_centres(const MatX& points_t, int k, std::mt19937_64& rng) {
+  const Eigen::Index n = points_t.cols();
+  MatX centres(k, points_t.rows());
   std::uniform_int_distribution<Eigen::Index> uniform(0, n - 1);
-  centres.row(0) = points.row(uniform(rng));
-  VecX nearest = (points.rowwise() - centres.row(0)).rowwise().squaredNorm();
-  for (int c = 1; c < k; ++c) {
-    const double total = nearest.sum();
+  VecX nearest(n), candidate(n);
+  for (int c = 0; c < k; ++c) {
     Eigen::Index pick = 0;
+    const double total = c == 0 ? 0.0 : nearest.sum();
     if (total > 0) {
       const double target = std::uniform_real_distribution<double>(0.0, total)(rng);
       double cumulative = 0;
@@ -66,10 +99,12 @@ MatX seed_centres(ConstRef<MatX> points, int k, std::mt19937_64& rng) {
         for (pick = n - 1; pick > 0 && nearest[pick] <= 0; --pick) { }
       }
     } else {
-      pick = uniform(rng); // all points coincide with chosen centres
+      pick = uniform(rng); // first centre, or all points coincide with chosen centres
     }
-    centres.row(c) = points.row(pick);
-    nearest = nearest.cwiseMin((points.rowwise() - centres.row(c)).rowwise().squaredNorm());
+    const VecX centre = points_t.col(pick);
+    centres.row(c) = centre.transpose();
+    squared_distances(points_t, centre, candidate);
+    nearest = c == 0 ? candidate : nearest.cwiseMin(candidate);
   }
   return centres;
 }
@@ -90,34 +125,36 @@ KMeansResult kmeans(ConstRef<MatX> points, const KMeansOptions& options) {
   const Eigen::Index n = points.rows();
   const int k = options.clusters;
   if (n < k) {
-    throw InputError("kmeans.clusters",
-        str(k) + " clusters need at least as many points, got " + str(n));
+    throw InputError(
+        "kmeans.clusters", str(k) + " clusters need at least as many points, got " + str(n));
   }
   if (!points.allFinite())
     throw InputError("kmeans", "points contain a non-finite value");
 
+  const MatX points_t = points.transpose();
   std::mt19937_64 rng(options.seed);
   KMeansResult result;
-  result.centres = seed_centres(points, k, rng);
+  result.centres = seed_centres(points_t, k, rng);
   result.labels.assign(n, 0);
   VecX distance(n);
-  const double spread = std::sqrt(
-      (points.rowwise() - points.colwise().mean()).rowwise().squaredNorm().mean());
+  // RMS distance of the points from their mean (the mean is evaluated once, not per row).
+  const VecX mean = points_t.rowwise().mean();
+  const double spread = std::sqrt((points_t.colwise() - mean).colwise().squaredNorm().mean());
 
-  MatX sums(k, points.cols());
+  MatX sums(points.cols(), k); // d × k, column c = sum of the points of cluster c
   for (int it = 0; it < options.max_iterations; ++it) {
-    assign(points, result.centres, result.labels, distance);
+    assign(points_t, result.centres.transpose(), result.labels, distance);
     sums.setZero();
     result.cluster_sizes = VecX::Zero(k);
     for (Eigen::Index i = 0; i < n; ++i) {
-      sums.row(result.labels[i]) += points.row(i);
+      sums.col(result.labels[i]) += points_t.col(i);
       result.cluster_sizes[result.labels[i]] += 1;
     }
     double shift = 0;
     for (int c = 0; c < k; ++c) {
       Eigen::RowVectorXd centre;
       if (result.cluster_sizes[c] > 0) {
-        centre = sums.row(c) / result.cluster_sizes[c];
+        centre = sums.col(c).transpose() / result.cluster_sizes[c];
       } else { // re-seed an empty cluster at the worst-served point
         Eigen::Index far = 0;
         distance.maxCoeff(&far);
@@ -133,7 +170,7 @@ KMeansResult kmeans(ConstRef<MatX> points, const KMeansOptions& options) {
       break;
     }
   }
-  assign(points, result.centres, result.labels, distance);
+  assign(points_t, result.centres.transpose(), result.labels, distance);
   result.cluster_sizes = VecX::Zero(k);
   for (Eigen::Index i = 0; i < n; ++i)
     result.cluster_sizes[result.labels[i]] += 1;

@@ -44,7 +44,8 @@ PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> res
   const Eigen::Index n = rest.rows();
   for (std::size_t t = 0; t < frames.size(); ++t) {
     if (frames[t].rows() != n) {
-      fail("frames", "frame " + str(t) + " has " + str(frames[t].rows()) + " vertices, the rest "
+      fail("frames",
+          "frame " + str(t) + " has " + str(frames[t].rows()) + " vertices, the rest "
               + "shape has " + str(n));
     }
   }
@@ -74,13 +75,14 @@ PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> res
 
   PodBasis basis;
   const int total = static_cast<int>(frames.size());
-  const int end = options.frame_count > 0 ? std::min(total, options.first_frame + options.frame_count)
-                                          : total;
+  const int end = options.frame_count > 0
+      ? std::min(total, options.first_frame + options.frame_count)
+      : total;
   for (int t = options.first_frame; t < end; t += options.frame_stride)
     basis.frames.push_back(t);
   if (basis.frames.empty()) {
-    fail("first_frame", "selects no frame of " + str(total) + " (first_frame "
-            + str(options.first_frame) + ")");
+    fail("first_frame",
+        "selects no frame of " + str(total) + " (first_frame " + str(options.first_frame) + ")");
   }
 
   // Snapshot matrix: row 3j + c ↔ free vertex j, component c; column s ↔ frame basis.frames[s].

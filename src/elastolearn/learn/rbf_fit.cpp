@@ -51,8 +51,8 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options)
     : m_options(options) {
   options.validate();
   if (centres.rows() < 1 || centres.cols() != 3) {
-    fail("centres", "expected m × 3 with m ≥ 1, got " + str(centres.rows()) + " × "
-            + str(centres.cols()));
+    fail("centres",
+        "expected m × 3 with m ≥ 1, got " + str(centres.rows()) + " × " + str(centres.cols()));
   }
   if (!centres.allFinite())
     fail("centres", "contains a non-finite value");
@@ -103,8 +103,9 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
   if (n == 0)
     fail("samples", "no samples to fit");
   if (samples.stretch_rates.rows() != n || samples.targets.rows() != n) {
-    fail("samples", str(n) + " stretch samples but " + str(samples.stretch_rates.rows())
-            + " stretch rates and " + str(samples.targets.rows()) + " targets");
+    fail("samples",
+        str(n) + " stretch samples but " + str(samples.stretch_rates.rows()) + " stretch rates and "
+            + str(samples.targets.rows()) + " targets");
   }
   if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite()
       || !samples.targets.allFinite()) {
@@ -177,8 +178,9 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
   scaled.diagonal().array() += design.options().regularization;
   const Eigen::LLT<MatX> llt(scaled);
   if (llt.info() != Eigen::Success) {
-    fail("regularization", "the normal equations are singular (" + str(n) + " samples, "
-            + str(u) + " unknowns); increase the regularisation or give more varied samples");
+    fail("regularization",
+        "the normal equations are singular (" + str(n) + " samples, " + str(u)
+            + " unknowns); increase the regularisation or give more varied samples");
   }
   const VecX x = (llt.solve(rhs.cwiseQuotient(scale))).cwiseQuotient(scale);
   if (!x.allFinite())

@@ -30,11 +30,13 @@ RbfCorrection::RbfCorrection(Parameters p)
     : m_p(std::move(p)) {
   const Eigen::Index m = m_p.centres.rows();
   if (m_p.weights.rows() != m) {
-    fail("weights", "has " + std::to_string(m_p.weights.rows()) + " rows, one per centre ("
-            + std::to_string(m) + ") expected");
+    fail("weights",
+        "has " + std::to_string(m_p.weights.rows()) + " rows, one per centre (" + std::to_string(m)
+            + ") expected");
   }
   if (m_p.damping_weights.size() != 0 && m_p.damping_weights.size() != m) {
-    fail("damping_weights", "has " + std::to_string(m_p.damping_weights.size())
+    fail("damping_weights",
+        "has " + std::to_string(m_p.damping_weights.size())
             + " entries, expected none or one per centre (" + std::to_string(m) + ")");
   }
   const auto finite = [](const char* field, bool ok) {

@@ -17,8 +17,9 @@ inline double rbf_kernel(double squared_distance, double epsilon) {
 }
 
 /// N(σ, ḟ) = N_e(σ) + Δα₁(σ) · D ḟ with, for centres c_i (i = 1..m) and φ_i = φ(‖σ − c_i‖):
-///   elastic    N_e(σ) = Σ_i w_i φ_i + A (σ − 1) + b                     [Pa]   (Eq. 10 + linear term)
-///   damping    Δα₁(σ) = Σ_i v_i φ_i + aᵀ(σ − 1) + a₀                     [s]    (Eq. 13's RBF)
+///   elastic    N_e(σ) = Σ_i w_i φ_i + A (σ − 1) + b                     [Pa]   (Eq. 10 + linear
+///   term) damping    Δα₁(σ) = Σ_i v_i φ_i + aᵀ(σ − 1) + a₀                     [s]    (Eq. 13's
+///   RBF)
 /// where w_i ∈ R³ are the elastic weights, v_i the damping weights (the same centres), A, b and
 /// a, a₀ optional linear polynomial tails (zero unless fitted), and D the 3×3 principal damping
 /// tangent [Pa]: the Rayleigh stiffness-damping stress α₁ K ẋ of an element, restricted to the

@@ -69,8 +69,8 @@ void Observation::validate(const std::string& source) const {
     throw InputError(where("/time"), "non-finite start time " + number(start_time));
 }
 
-void Observation::validate(int num_vertices, int expected_frames, double expected_dt,
-    const std::string& source) const {
+void Observation::validate(
+    int num_vertices, int expected_frames, double expected_dt, const std::string& source) const {
   validate(source);
   for (std::size_t j = 0; j < vertex_ids.size(); ++j) {
     if (vertex_ids[j] >= num_vertices) {
@@ -86,15 +86,15 @@ void Observation::validate(int num_vertices, int expected_frames, double expecte
   }
   if (expected_dt > 0 && std::abs(dt - expected_dt) > 1e-9 * expected_dt) {
     throw InputError(source + ": dt",
-        "observation time step " + number(dt) + " s does not match the scene's " + number(expected_dt)
-            + " s");
+        "observation time step " + number(dt) + " s does not match the scene's "
+            + number(expected_dt) + " s");
   }
 }
 
 double uniform_time_step(const std::vector<double>& time, const std::string& source) {
   if (time.size() < 2) {
-    throw InputError(source,
-        "cannot derive a time step from " + std::to_string(time.size()) + " frame(s)");
+    throw InputError(
+        source, "cannot derive a time step from " + std::to_string(time.size()) + " frame(s)");
   }
   const double dt = time[1] - time[0];
   if (!std::isfinite(dt) || dt <= 0)
@@ -103,8 +103,8 @@ double uniform_time_step(const std::vector<double>& time, const std::string& sou
     const double step = time[t] - time[t - 1];
     if (!(std::abs(step - dt) <= 1e-6 * dt)) {
       throw InputError(source,
-          "frames are not evenly spaced: interval " + std::to_string(t - 1) + " is "
-              + number(step) + " s, the first is " + number(dt) + " s");
+          "frames are not evenly spaced: interval " + std::to_string(t - 1) + " is " + number(step)
+              + " s, the first is " + number(dt) + " s");
     }
   }
   return dt;

@@ -31,8 +31,8 @@ struct Observation {
   /// validate(source), then check against the scene it is used with: ids < num_vertices,
   /// T == expected_frames (skipped if expected_frames < 0), and |dt − expected_dt| ≤ 1e-9·dt
   /// (skipped if expected_dt ≤ 0). Throws InputError naming `source` and the field.
-  void validate(int num_vertices, int expected_frames, double expected_dt,
-      const std::string& source) const;
+  void validate(
+      int num_vertices, int expected_frames, double expected_dt, const std::string& source) const;
 };
 
 /// The constant spacing of `time` (T ≥ 2 increasing times [s]): time[1] − time[0], after

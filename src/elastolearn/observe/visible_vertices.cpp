@@ -9,8 +9,8 @@
 
 namespace elastolearn::observe {
 
-std::vector<int> farthest_point_sample(ConstRef<Positions> points,
-    const std::vector<int>& candidates, int count, std::uint64_t seed) {
+std::vector<int> farthest_point_sample(
+    ConstRef<Positions> points, const std::vector<int>& candidates, int count, std::uint64_t seed) {
   const int n = static_cast<int>(candidates.size());
   if (count < 1 || count > n) {
     throw InputError("farthest-point sampling",
@@ -39,7 +39,8 @@ std::vector<int> farthest_point_sample(ConstRef<Positions> points,
     for (int j = 0; j < n; ++j) {
       if (distance[j] < 0)
         continue;
-      distance[j] = std::min(distance[j], (points.row(candidates[j]).transpose() - p).squaredNorm());
+      distance[j]
+          = std::min(distance[j], (points.row(candidates[j]).transpose() - p).squaredNorm());
       if (distance[j] > best_distance) {
         best_distance = distance[j];
         best = j;
@@ -70,8 +71,8 @@ std::vector<int> select_visible_vertices(
   return farthest_point_sample(mesh.rest_positions(), surface, count, seed);
 }
 
-Observation observe_vertices(const std::vector<Positions>& frames, double dt, const std::vector<int>& ids,
-    double noise_sigma, std::uint64_t seed, double start_time) {
+Observation observe_vertices(const std::vector<Positions>& frames, double dt,
+    const std::vector<int>& ids, double noise_sigma, std::uint64_t seed, double start_time) {
   if (!std::isfinite(noise_sigma) || noise_sigma < 0) {
     std::ostringstream s;
     s << "noise standard deviation must be finite and non-negative, got " << noise_sigma;

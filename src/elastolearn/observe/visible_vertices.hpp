@@ -16,8 +16,8 @@ namespace elastolearn::observe {
 /// the earlier candidate, so the result depends only on the inputs and the seed.
 /// Returns the chosen indices sorted ascending. O(count · |candidates|).
 /// Throws InputError if count ∉ [1, |candidates|] or a candidate is not a row of `points`.
-std::vector<int> farthest_point_sample(ConstRef<Positions> points,
-    const std::vector<int>& candidates, int count, std::uint64_t seed);
+std::vector<int> farthest_point_sample(
+    ConstRef<Positions> points, const std::vector<int>& candidates, int count, std::uint64_t seed);
 
 /// Number of vertices a fraction selects: round(fraction · n_surface), at least 1.
 /// Throws InputError("visible fraction", ...) unless 0 < fraction ≤ 1.
@@ -35,7 +35,7 @@ std::vector<int> select_visible_vertices(
 /// by vertex, x-y-z; no noise and no draws when noise_sigma = 0).
 /// The result passes Observation::validate(n, T, dt, ...). Throws InputError if an id is out of
 /// range, duplicated, the frames disagree in size, or noise_sigma is negative or not finite.
-Observation observe_vertices(const std::vector<Positions>& frames, double dt, const std::vector<int>& ids,
-    double noise_sigma, std::uint64_t seed, double start_time = 0);
+Observation observe_vertices(const std::vector<Positions>& frames, double dt,
+    const std::vector<int>& ids, double noise_sigma, std::uint64_t seed, double start_time = 0);
 
 } // namespace elastolearn::observe

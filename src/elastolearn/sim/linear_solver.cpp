@@ -67,6 +67,13 @@ public:
   void analyze(const fem::SparseMatrix&) override {}
   bool factorize(const fem::SparseMatrix& A) override {
     m_matrix = &A;
+    // multiply() relies on vertex triplets sharing their column pattern (true for SystemMatrix).
+    const int* outer = A.outerIndexPtr();
+    ELASTOLEARN_CHECK(A.cols() % 3 == 0, "CG needs whole-vertex unknown triplets");
+    for (Eigen::Index J = 0; J < A.cols() / 3; ++J)
+      ELASTOLEARN_CHECK(outer[3 * J + 1] - outer[3 * J] == outer[3 * J + 2] - outer[3 * J + 1] &&
+                            outer[3 * J + 2] - outer[3 * J + 1] == outer[3 * J + 3] - outer[3 * J + 2],
+                        "CG needs vertex triplets with a shared column pattern");
     m_inverse_diagonal = A.diagonal().cwiseInverse();
     return (A.diagonal().array() > 0).all();
   }
@@ -104,19 +111,29 @@ public:
   LinearSolverType type() const override { return LinearSolverType::ConjugateGradient; }
 
 private:
+  /// y = A x. Unknowns come in whole-vertex triplets, so columns 3J, 3J+1, 3J+2 share one row
+  /// pattern: walking them together loads each row index and x entry once for three
+  /// multiply-adds (measured: the product is ~40 % of all instructions of a CG-based step).
   void multiply(const VecX& x, VecX& y) const {
     const auto& A = *m_matrix;
     const int* outer = A.outerIndexPtr();
     const int* inner = A.innerIndexPtr();
     const double* values = A.valuePtr();
-    tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(A.cols()), 2048),
-                      [&](const tbb::blocked_range<int>& r) {
-                        for (int c = r.begin(); c < r.end(); ++c) {
-                          double sum = 0;
-                          for (int k = outer[c]; k < outer[c + 1]; ++k) sum += values[k] * x[inner[k]];
-                          y[c] = sum;
-                        }
-                      });
+    const int blocks = static_cast<int>(A.cols() / 3);
+    tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 512), [&](const tbb::blocked_range<int>& r) {
+      for (int J = r.begin(); J < r.end(); ++J) {
+        const int c0 = outer[3 * J], c1 = outer[3 * J + 1], c2 = outer[3 * J + 2];
+        const int length = c1 - c0;
+        double y0 = 0, y1 = 0, y2 = 0;
+        for (int k = 0; k < length; ++k) {
+          const double xk = x[inner[c0 + k]];
+          y0 += values[c0 + k] * xk;
+          y1 += values[c1 + k] * xk;
+          y2 += values[c2 + k] * xk;
+        }
+        y[3 * J] = y0, y[3 * J + 1] = y1, y[3 * J + 2] = y2;
+      }
+    });
   }
 
   const fem::SparseMatrix* m_matrix = nullptr;
