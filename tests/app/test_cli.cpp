@@ -1,4 +1,5 @@
 // End-to-end tests of the `elastolearn` executable: what a user sees.
+#include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 
 #include <array>
@@ -138,4 +139,26 @@ TEST_F(CliTest, InterruptKeepsTheFramesSoFarAndLeavesNoTemporaryFile) {
   EXPECT_NE(t.metadata.at("status").find("interrupted"), std::string::npos);
   for (const auto& entry : fs::directory_iterator(m_dir))
     EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
+}
+
+TEST_F(CliTest, ObserveSamplesSurfaceVerticesReproducibly) {
+  const auto scene = write("bar.json", kSmallScene);
+  const auto traj = m_dir / "bar.h5";
+  ASSERT_EQ(run("simulate " + scene.string() + " -o " + traj.string() + " -q").exit_code, 0);
+  const auto a = m_dir / "a.h5", b = m_dir / "b.h5";
+  for (const auto& out : {a, b}) {
+    const auto r = run("observe " + traj.string() + " --visible-fraction 0.3 --noise 1e-4 --seed 7 -o " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const auto oa = elastolearn::io::read_observation_h5(a), ob = elastolearn::io::read_observation_h5(b);
+  EXPECT_EQ(oa.positions.size(), 21u);
+  EXPECT_EQ(oa.vertex_ids, ob.vertex_ids);
+  EXPECT_EQ((oa.positions.back() - ob.positions.back()).norm(), 0.0); // same seed, same noise
+  EXPECT_NEAR(oa.dt, 0.002, 1e-12);
+  // Ids outside the mesh are refused with the file named.
+  std::ofstream(m_dir / "ids.txt") << "0\n99999\n";
+  const auto r = run("observe " + traj.string() + " --vertices " + (m_dir / "ids.txt").string() + " -o " + (m_dir / "c.h5").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("ids.txt"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(m_dir / "c.h5"));
 }
