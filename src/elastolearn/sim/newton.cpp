@@ -77,7 +77,7 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
     // solve to 1e-3 (the step's nonlinearity leaves about that anyway), later ones to a tenth
     // of what the target still needs.
     const double linear_tol =
-        std::clamp(std::max(0.1 * target / norm, 1e-3 * norm / report.initial_residual), 1e-12, 1e-2);
+        std::clamp(std::max(0.3 * target / norm, 1e-3 * norm / report.initial_residual), 1e-12, 1e-2);
     const bool solved = solver.solve(-g, du, linear_tol);
     report.timings.solve += seconds_since(t0);
     report.linear_iterations += solver.last_iterations();
