@@ -15,13 +15,14 @@ DofMap::DofMap(int num_vertices, const std::vector<int>& prescribed_vertices)
 }
 
 VecX DofMap::restrict(const VecX& full) const {
-  VecX out(num_free());
-  for (int i = 0; i < num_free(); ++i) out[i] = full[m_free_dofs[i]];
+  VecX out;
+  restrict_into(full, out);
   return out;
 }
 
-void DofMap::add_expanded(const VecX& reduced, double scale, VecX& full) const {
-  for (int i = 0; i < num_free(); ++i) full[m_free_dofs[i]] += scale * reduced[i];
+void DofMap::restrict_into(const VecX& full, VecX& reduced) const {
+  reduced.resize(num_free());
+  for (int i = 0; i < num_free(); ++i) reduced[i] = full[m_free_dofs[i]];
 }
 
 } // namespace elastolearn::fem

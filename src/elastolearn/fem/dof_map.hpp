@@ -23,8 +23,8 @@ public:
 
   /// Restrict a full 3n vector to the unknowns.
   VecX restrict(const VecX& full) const;
-  /// full[free_dofs[i]] += scale · reduced[i].
-  void add_expanded(const VecX& reduced, double scale, VecX& full) const;
+  /// Same, into an existing vector (no allocation once sized).
+  void restrict_into(const VecX& full, VecX& reduced) const;
 
 private:
   std::vector<int> m_free_index;

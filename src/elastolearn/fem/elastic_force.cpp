@@ -138,13 +138,4 @@ double ElasticForce::elastic_energy(const VecX& x) const {
   return energy;
 }
 
-VecX ElasticForce::max_stretches(const VecX& x) const {
-  VecX out(m_tets.rows());
-  for (Eigen::Index e = 0; e < m_tets.rows(); ++e)
-    out[e] = material::principal_frame(
-                 deformation_gradient(gather_tet(x, m_tets.row(e).transpose()), m_rest[e]))
-                 .stretches[0];
-  return out;
-}
-
 } // namespace elastolearn::fem

@@ -41,8 +41,6 @@ public:
 
   /// Total elastic energy Σ vol Ψ(F̂) [J] (the nominal model; the correction has no energy).
   double elastic_energy(const VecX& x) const;
-  /// Largest principal stretch of every element at x (length m).
-  VecX max_stretches(const VecX& x) const;
 
   /// Use the exact tangent instead of the PSD projection (for derivative tests; Newton wants
   /// the projection, which is the default).

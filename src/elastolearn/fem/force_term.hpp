@@ -32,15 +32,4 @@ public:
   }
 };
 
-/// A constant external force (gravity, or any fixed nodal load): f += value.
-class ConstantForce final : public ForceTerm {
-public:
-  explicit ConstantForce(VecX value) : m_value(std::move(value)) {}
-  void add_force(const ForceState&, VecX& f) override { f += m_value; }
-  const VecX& value() const { return m_value; }
-
-private:
-  VecX m_value;
-};
-
 } // namespace elastolearn::fem

@@ -42,7 +42,6 @@ Simulator::Simulator(const Scene& scene) : m_scene(scene) {
     m_scene.newton.absolute_tolerance =
         1e-12 * max_diagonal * mesh.bounding_box_diagonal() * std::sqrt(double(m_dofs.num_free()));
   }
-  m_x_prescribed = prescribed_positions(0);
 }
 
 VecX Simulator::prescribed_positions(double t) const {
@@ -90,14 +89,11 @@ void Simulator::sum_jacobians(const VecX& x, const VecX& v, double t, double c_x
 NewtonReport Simulator::step() {
   const double h = m_scene.dt;
   const double t_next = (m_step + 1) * h;
-  m_x_prescribed = prescribed_positions(t_next);
-  // Unknowns: free end-of-step velocities; prescribed velocities follow the keyframes.
+  // Unknowns: free end-of-step velocities. Prescribed velocities follow the keyframes; they are
+  // set once per step here (free entries are overwritten by each Newton iterate).
+  m_v_new = (prescribed_positions(t_next) - m_x) / h;
+  const auto& free = m_dofs.free_dofs();
   auto state_from = [&](const VecX& u) {
-    m_v_new = m_v;
-    for (int v = 0; v < m_scene.mesh.num_vertices(); ++v)
-      if (m_dofs.is_prescribed_vertex(v))
-        m_v_new.segment<3>(3 * v) = (m_x_prescribed.segment<3>(3 * v) - m_x.segment<3>(3 * v)) / h;
-    const auto& free = m_dofs.free_dofs();
     for (size_t i = 0; i < free.size(); ++i) m_v_new[free[i]] = u[i];
     m_x_new = m_x + h * m_v_new;
   };
@@ -105,7 +101,7 @@ NewtonReport Simulator::step() {
     m_dv = m_v_new - m_v;
     apply_mass(m_dv, m_mass_dv);
     m_force = m_mass_dv / h - m_force;
-    g = m_dofs.restrict(m_force);
+    m_dofs.restrict_into(m_force, g);
   };
   NewtonProblem problem;
   problem.residual = [&](const VecX& u, VecX& g) {
