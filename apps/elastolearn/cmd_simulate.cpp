@@ -1,7 +1,8 @@
-// elastolearn simulate scene.json -o traj.h5 [--vtu DIR]
+// elastolearn simulate scene.json -o traj.h5 [--vtu DIR] [--material learned.json]
 #include "command.hpp"
 
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/scene_output.hpp>
 
@@ -14,6 +15,7 @@ struct SimulateOptions {
   std::string output;
   std::string vtu;
   std::string solver;
+  std::string material;
   int frames = 0;
   int every = 0;
   bool quiet = false;
@@ -26,6 +28,8 @@ void add_simulate_command(CLI::App& root) {
   cmd->add_option("-o,--output", opts->output, "trajectory HDF5 (default: the scene's output.trajectory)");
   cmd->add_option("--vtu", opts->vtu, "also write a VTU per frame + PVD into this folder");
   cmd->add_option("--solver", opts->solver, "linear solver: cholmod | cg | eigen-ldlt (overrides the scene)");
+  cmd->add_option("--material", opts->material,
+                  "learned material file (elastolearn-material/1 JSON): replaces the scene's material");
   cmd->add_option("--frames", opts->frames, "number of steps (overrides the scene)");
   cmd->add_option("--every", opts->every, "record every k-th frame (overrides the scene)");
   cmd->add_flag("-q,--quiet", opts->quiet, "no progress line");
@@ -34,6 +38,11 @@ void add_simulate_command(CLI::App& root) {
     auto file = io::read_scene_file(opts->scene);
     if (!opts->solver.empty()) file.scene.linear_solver = sim::linear_solver_type_from_string(opts->solver);
     if (opts->frames > 0) file.scene.frames = opts->frames;
+    std::string material_source = "the scene";
+    if (!opts->material.empty()) {
+      file.scene.material = io::material_model(io::read_material_file(opts->material), opts->material);
+      material_source = opts->material;
+    }
     io::SceneOutputOptions out;
     if (!opts->output.empty()) out.trajectory = opts->output;
     else if (file.outputs.trajectory) out.trajectory = *file.outputs.trajectory;
@@ -45,6 +54,7 @@ void add_simulate_command(CLI::App& root) {
     std::printf("scene %s: %d vertices, %d tets, %s, %d frames of dt = %g s, solver %s\n", s.name.c_str(),
                 s.mesh.num_vertices(), s.mesh.num_tets(), s.material.elastic->name().c_str(), s.frames, s.dt,
                 sim::to_string(s.linear_solver).c_str());
+    std::printf("material: %s (from %s)\n", io::describe_material_model(s.material).c_str(), material_source.c_str());
     std::filesystem::path pvd;
     const auto report = io::simulate_to_files(s, out, opts->quiet ? ProgressCallback{} : terminal_progress("simulate"), &pvd);
     std::printf("%s: %d frames in %.2f s (%.1f ms/step, %.2f Newton iterations/step)\n",

@@ -49,7 +49,7 @@ MatX centres_for(const StressSamples& s, int m) {
   KMeansOptions options;
   options.clusters = m;
   options.seed = 5;
-  return kmeans(s.stretches, options).centres;
+  return kmeans(stretch_views(s.stretches), options).centres;
 }
 
 /// RMS of N(σ, ḟ) − truth over held-out samples, relative to the RMS of the truth.
@@ -75,19 +75,20 @@ TEST(RbfFit, RecoversAnRbfCorrectionExactly) {
   RbfFitOptions options;
   options.damping_tangent = D;
   options.regularization = 0; // exact data: no bias wanted
+  options.damping_regularization = 0;
   const RbfDesign design(centres, options);
   std::mt19937 rng(2);
   std::normal_distribution<double> g(0.0, 1.0);
   VecX x(design.num_unknowns());
   for (auto& v : x)
     v = g(rng);
-  x.head(3 * design.elastic_features()) *= 1e3; // elastic weights [Pa]
-  x.tail(design.damping_features()) *= 1e-2; // damping weights [s]
+  x.head(design.elastic_unknowns()) *= 1e3; // elastic weights [Pa]
+  x.tail(design.damping_unknowns()) *= 1e-2; // damping weights [s]
   const material::RbfCorrection truth = design.correction(x);
   const Truth f = [&](const Vec3& s, const Vec3& r) { return truth.correction(s, r); };
 
   const RbfFitResult fit = fit_rbf_correction(design, make_samples(3000, 3, f));
-  // Exact data, a full-rank design (3000 samples ≫ 64 unknowns): the solution is recovered to
+  // Exact data, a full-rank design (3000 samples ≫ 29 unknowns): the solution is recovered to
   // the conditioning of the normal equations (measured 1e-12 relative; allow 1e-8).
   EXPECT_LE((fit.unknowns - x).norm(), 1e-8 * x.norm());
   EXPECT_LE(relative_error(fit.correction, make_samples(500, 4, f)), 1e-9);
@@ -123,7 +124,7 @@ TEST(RbfFit, RecoversAKnownSmoothCorrection) {
 
 TEST(RbfFit, ErrorShrinksWithMoreKernels) {
   // The kernel ‖σ − c‖ approximates like a piecewise-linear interpolant: more centres, smaller
-  // error. Cubic elastic truth, no damping: measured 10.7 % (20 centres) → 4.6 % (80 centres).
+  // error. Cubic elastic truth, no damping: measured 6.6 % with 80 centres.
   const Truth truth = [](const Vec3& s, const Vec3&) {
     const Vec3 e = s.array() - 1.0;
     return Vec3(5e4 * e.array().cube().matrix() + 2e4 * e.sum() * e.cwiseAbs2());
@@ -137,19 +138,20 @@ TEST(RbfFit, ErrorShrinksWithMoreKernels) {
   };
   const double coarse = error(20), fine = error(80);
   EXPECT_LT(fine, 0.6 * coarse);
-  EXPECT_LT(fine, 0.06);
+  EXPECT_LT(fine, 0.08); // measured 6.6 % with 80 scalar-weighted kernels
 }
 
 TEST(RbfFit, ElasticOnlyFitIgnoresRatesAndSortsSamples) {
-  // A linear correction is reproduced exactly by the polynomial tail (the kernels get ~0 weight).
+  // An isotropic linear correction (a Lamé change and a pressure) is reproduced exactly by the
+  // polynomial tail (the kernels get ~0 weight).
   Mat3 A;
   A << 3e4, 1e4, 1e4, 1e4, 3e4, 1e4, 1e4, 1e4, 3e4;
   const Truth truth = [&](const Vec3& s, const Vec3&) {
-    return Vec3(A * (s.array() - 1.0).matrix() + Vec3(10, 20, 30));
+    return Vec3(A * (s.array() - 1.0).matrix() + Vec3(10, 10, 10));
   };
   StressSamples train = make_samples(2000, 20, truth);
   // Unsorted copies of the same samples (stretches, rates and targets permuted alike) must give
-  // the same fit: the fit sorts each sample as RbfCorrection evaluates it.
+  // the same fit: the correction is equivariant, so the same equations appear, permuted.
   StressSamples shuffled = train;
   for (Eigen::Index j = 0; j < train.stretches.rows(); j += 2) {
     for (auto* m : { &shuffled.stretches, &shuffled.stretch_rates, &shuffled.targets })
@@ -158,7 +160,7 @@ TEST(RbfFit, ElasticOnlyFitIgnoresRatesAndSortsSamples) {
   RbfFitOptions options;
   options.fit_damping = false;
   const RbfDesign design(centres_for(train, 20), options);
-  EXPECT_EQ(design.num_unknowns(), 3 * 24);
+  EXPECT_EQ(design.num_unknowns(), 20 + 3);
   const RbfFitResult a = fit_rbf_correction(design, train),
                      b = fit_rbf_correction(design, shuffled);
   EXPECT_LE((a.unknowns - b.unknowns).norm(), 1e-9 * a.unknowns.norm());
@@ -197,6 +199,9 @@ TEST(RbfFit, RejectsBadInput) {
   nan.targets(4, 1) = std::nan("");
   EXPECT_THROW(fit_rbf_correction(design, nan), InputError);
   // λ = 0 and damping from zero stretch rates: the damping unknowns are undetermined.
+  RbfFitOptions exact;
+  exact.regularization = exact.damping_regularization = 0;
+  const RbfDesign unregularised(MatX::Identity(3, 3) + MatX::Ones(3, 3), exact);
   s.stretch_rates.setZero();
-  EXPECT_THROW(fit_rbf_correction(design, s), InputError);
+  EXPECT_THROW(fit_rbf_correction(unregularised, s), InputError);
 }

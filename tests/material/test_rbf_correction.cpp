@@ -26,15 +26,16 @@ RbfCorrection::Parameters test_parameters(double epsilon) {
   p.centres.resize(6, 3);
   p.centres << 1.0, 1.0, 1.0, 1.2, 1.0, 0.9, 1.1, 1.05, 0.8, 0.95, 0.9, 0.85, 1.3, 1.1, 1.0, 1.05,
       1.0, 0.7;
-  p.weights.resize(6, 3);
-  for (Eigen::Index i = 0; i < p.weights.size(); ++i)
-    p.weights.data()[i] = 1e3 * g(rng);
+  p.weights.resize(6);
+  for (auto& w : p.weights)
+    w = 1e3 * g(rng);
   p.damping_weights.resize(6);
   for (auto& v : p.damping_weights)
     v = 1e-2 * g(rng);
-  p.linear = 5e3 * Mat3::Random();
-  p.constant = Vec3(10, -20, 5);
-  p.damping_linear = Vec3(0.01, -0.02, 0.005);
+  p.own_slope = 5e3;
+  p.other_slope = -2e3;
+  p.constant = 10;
+  p.damping_slope = 0.01;
   p.damping_constant = 0.03;
   p.damping_tangent = rest_principal_tangent(CorotatedModel(Lame::from_young_poisson(5e4, 0.4)));
   p.epsilon = epsilon;
@@ -99,31 +100,54 @@ TEST(RbfCorrection, PermutationSymmetric) {
   perms << 1, 0, 2, 2, 0, 1, 2, 1, 0;
   for (int k = 0; k < 3; ++k) {
     // Input i of the permuted call is input p[i] of the sorted one: N(Pσ, Pḟ) = P N(σ, ḟ), and
-    // the gradients permute on both sides. Exact: the same arithmetic runs on the same numbers.
+    // the gradients permute on both sides. The elastic part is bit-identical (each direction
+    // sees the same view); D ḟ sums in another order, so allow round-off (1e-12 relative).
     Eigen::PermutationMatrix<3> P;
     P.indices() = perms.row(k).transpose();
     const Vec3 ps = P.transpose() * s, pr = P.transpose() * r;
-    EXPECT_EQ(n.correction(ps, pr), P.transpose() * ns);
+    EXPECT_LE((n.correction(ps, pr) - P.transpose() * ns).norm(), 1e-12 * ns.norm());
+    EXPECT_EQ(n.elastic_correction(ps), P.transpose() * n.elastic_correction(s));
     Mat3 pds, pdr;
     n.correction_gradient(ps, pr, pds, pdr);
-    EXPECT_EQ(pds, P.transpose() * ds * P);
-    EXPECT_EQ(pdr, P.transpose() * dr * P);
+    EXPECT_LE((pds - P.transpose() * ds * P).norm(), 1e-12 * ds.norm());
+    EXPECT_LE((pdr - P.transpose() * dr * P).norm(), 1e-12 * dr.norm());
   }
+}
+
+TEST(RbfCorrection, EqualStretchesGiveEqualStresses) {
+  // P = U diag(P̂ + N) Vᵀ is a function of F only if N_i = N_j whenever σ_i = σ_j (U, V are not
+  // unique there). Exact equality: both directions evaluate the same view of the stretches.
+  const RbfCorrection n(test_parameters(1e-3));
+  for (const Vec3& s : { Vec3(1.1, 1.1, 0.9), Vec3(0.8, 1.2, 1.2), Vec3(1.05, 0.7, 1.05), Vec3::Ones().eval() }) {
+    const Vec3 rates = Vec3(0.2, 0.2, 0.2); // equal rates too: the damping part is D ḟ, equivariant
+    const Vec3 out = n.correction(s, rates);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (s[i] == s[j]) EXPECT_EQ(out[i], out[j]) << "stretches " << s.transpose();
+  }
+  // And the outputs approach each other continuously as two stretches meet.
+  const Vec3 near(1.1 + 1e-7, 1.1, 0.9);
+  const Vec3 out = n.correction(near, Vec3::Zero());
+  EXPECT_LT(std::abs(out[0] - out[1]), 1e-7 * 1e5) << "Lipschitz with the slopes ~1e4–1e5 Pa";
 }
 
 TEST(RbfCorrection, SplitsIntoElasticAndDampingParts) {
   const RbfCorrection n(test_parameters(1e-3));
   const auto& p = n.parameters();
   const Vec3 s(1.15, 0.97, 0.88), r(0.3, -0.5, 0.1);
-  // N(σ, ḟ) − N(σ, 0) = Δα₁(σ) D ḟ, and Δα₁ is the documented RBF + linear tail.
+  // N(σ, ḟ) − N(σ, 0) = Δα₁(σ) D ḟ, and both parts are the documented RBF + linear tail.
   const double alpha = n.damping_correction(s);
-  double expected_alpha = p.damping_linear.dot(s - Vec3::Ones()) + p.damping_constant;
-  Vec3 expected_elastic = p.linear * (s - Vec3::Ones()) + p.constant;
-  for (int i = 0; i < 6; ++i) {
-    const double phi = rbf_kernel((s - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
-    expected_alpha += p.damping_weights[i] * phi;
-    expected_elastic += phi * p.weights.row(i).transpose();
+  double expected_alpha = p.damping_slope * (s.sum() - 3) + p.damping_constant;
+  Vec3 expected_elastic;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 y = stretch_view(s, k);
+    expected_elastic[k] = p.own_slope * (y[0] - 1) + p.other_slope * (y[1] + y[2] - 2) + p.constant;
+    for (int i = 0; i < 6; ++i)
+      expected_elastic[k] += p.weights[i] * rbf_kernel((y - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
   }
+  for (int i = 0; i < 6; ++i) // s is sorted descending already
+    expected_alpha += p.damping_weights[i] * rbf_kernel((s - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
+  EXPECT_EQ(stretch_view(Vec3(1.0, 2.0, 3.0), 0), Vec3(1.0, 3.0, 2.0));
   EXPECT_NEAR(alpha, expected_alpha, 1e-14);
   EXPECT_LE((n.elastic_correction(s) - expected_elastic).norm(), 1e-10);
   const Vec3 damping = n.correction(s, r) - n.correction(s, Vec3::Zero());
@@ -138,13 +162,25 @@ TEST(RbfCorrection, SplitsIntoElasticAndDampingParts) {
       1e-9 * lame.lambda);
 }
 
+TEST(RbfCorrection, LinearTailIsAnIsotropicLameChange) {
+  // a = 2Δμ + Δλ, b = Δλ reproduce 2Δμ(σ − 1) + Δλ tr(σ − 1) exactly: a wrong Young's modulus
+  // of a corotated nominal is representable without kernels.
+  RbfCorrection::Parameters p;
+  const double dmu = -3e3, dlambda = 7e3;
+  p.own_slope = 2 * dmu + dlambda;
+  p.other_slope = dlambda;
+  const RbfCorrection n(p);
+  const Vec3 s(1.2, 0.9, 0.75);
+  const Vec3 expected = 2 * dmu * (s - Vec3::Ones()) + dlambda * (s.sum() - 3) * Vec3::Ones();
+  EXPECT_LE((n.correction(s, Vec3::Zero()) - expected).norm(), 1e-9);
+}
+
 TEST(RbfCorrection, ZeroWithoutWeightsAndWithoutDampingPart) {
   RbfCorrection::Parameters p = test_parameters(1e-3);
   p.weights.setZero();
-  p.linear.setZero();
-  p.constant.setZero();
+  p.own_slope = p.other_slope = p.constant = 0;
   p.damping_weights.resize(0); // no damping RBF; the damping tail alone remains
-  p.damping_linear.setZero();
+  p.damping_slope = 0;
   p.damping_constant = 0;
   const RbfCorrection n(p);
   EXPECT_EQ(n.correction(Vec3(1.2, 1.0, 0.7), Vec3(1, 2, 3)), Vec3::Zero());
@@ -166,9 +202,10 @@ TEST(RbfCorrection, RejectsInconsistentParameters) {
       EXPECT_EQ(e.where(), "rbf_correction." + field) << e.what();
     }
   };
-  expect_error([](auto& p) { p.weights.conservativeResize(5, 3); }, "weights");
+  expect_error([](auto& p) { p.weights.conservativeResize(5); }, "weights");
   expect_error([](auto& p) { p.damping_weights.conservativeResize(4); }, "damping_weights");
   expect_error([](auto& p) { p.centres(2, 1) = std::nan(""); }, "centres");
+  expect_error([](auto& p) { p.own_slope = std::nan(""); }, "own_slope");
   expect_error([](auto& p) { p.epsilon = -1; }, "epsilon");
   expect_error([](auto& p) { p.damping_tangent(0, 0) = INFINITY; }, "damping_tangent");
 }

@@ -62,12 +62,11 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
       c.alpha = damping ? damping->coefficients(c.frame.stretches[0]) : material::RayleighCoefficients{};
       c.has_tangent = false;
       if (c.alpha.alpha1 != 0) {
-        // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 12×12.
-        c.tangent = material::first_piola_derivative(c.frame, c.stress.stress, c.stress.d_stretches,
-                                                     m_project_tangent);
+        // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 9×9
+        // or 12×12 (the eigen-form tangent is kept for the Jacobian).
+        c.tangent = material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
         c.has_tangent = true;
-        const Vec9 dP = c.tangent * Eigen::Map<const Vec9>(F_rate.data());
-        P += c.alpha.alpha1 * Eigen::Map<const Mat3>(dP.data());
+        P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
       }
       Eigen::Map<Eigen::Matrix<double, 3, 4>> force(m_force_buffer.data() + 12 * e);
       force.noalias() = -rest.volume * P * rest.gradients;
@@ -91,29 +90,24 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
   }
   const auto* correction = m_material.correction.get();
   const double density = m_material.density;
-  const int m = static_cast<int>(m_tets.rows());
-  if (m_matrix_buffer.size() != static_cast<size_t>(m) * 144)
-    m_matrix_buffer.assign(static_cast<size_t>(m) * 144, 0.0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
-    for (int e = r.begin(); e < r.end(); ++e) {
-      const TetRestData& rest = m_rest[e];
-      const ElementCache& c = m_cache[e];
-      Eigen::Map<Mat12> J(m_matrix_buffer.data() + 144 * e);
-      const Mat9 H = c.has_tangent ? c.tangent
-                                   : material::first_piola_derivative(c.frame, c.stress.stress,
-                                                                      c.stress.d_stretches, m_project_tangent);
-      // The projected tangent is symmetric; the exact one need not be (non-symmetric corrections).
-      J = element_matrix_from_tangent(H, rest, m_project_tangent);
-      J *= c_x + c_v * c.alpha.alpha1;
-      if (c.alpha.alpha0 != 0) J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
-      if (correction && c_v != 0) {
-        const Mat3 d_rates = m_project_tangent ? symmetric_psd(c.stress.d_stretch_rates) : c.stress.d_stretch_rates;
-        if (!d_rates.isZero(0))
-          J += c_v * element_matrix_from_tangent(material::first_piola_rate_derivative(c.frame, d_rates), rest);
-      }
+  ELASTOLEARN_CHECK(A.num_elements() == m_tets.rows(), "SystemMatrix was built for another mesh");
+  A.add_elements([&](int e, Mat12& J) {
+    const TetRestData& rest = m_rest[e];
+    const ElementCache& c = m_cache[e];
+    const Mat9 H = (c_x + c_v * c.alpha.alpha1) *
+                   material::first_piola_derivative(
+                       c.frame, c.has_tangent ? c.tangent
+                                              : material::principal_tangent(c.frame, c.stress.stress,
+                                                                            c.stress.d_stretches, m_project_tangent));
+    // The projected tangent is symmetric; the exact one need not be (non-symmetric corrections).
+    J = element_matrix_from_tangent(H, rest, m_project_tangent);
+    if (c.alpha.alpha0 != 0) J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
+    if (correction && c_v != 0) {
+      const Mat3 d_rates = m_project_tangent ? symmetric_psd(c.stress.d_stretch_rates) : c.stress.d_stretch_rates;
+      if (!d_rates.isZero(0))
+        J += c_v * element_matrix_from_tangent(material::first_piola_rate_derivative(c.frame, d_rates), rest);
     }
   });
-  A.add_element_blocks(m_matrix_buffer);
 }
 
 void ElasticForce::gather_forces(VecX& f) const {

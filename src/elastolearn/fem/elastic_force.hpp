@@ -29,7 +29,8 @@ struct MaterialModel {
 /// the element's largest stretch; the correction's rate dependence adds D_e = vol Bᵀ ∂P/∂Ḟ B
 /// (symmetrised, clamped PSD). The Jacobian drops ∂K/∂x·v (Rayleigh) and the variation of
 /// Ḟ̂ through U, V (correction): standard, and the residual is still exact.
-/// Element loops run in parallel (oneTBB) into per-element buffers gathered without locks.
+/// Element loops run in parallel (oneTBB): forces into per-element buffers gathered without
+/// locks, element matrices straight into the SystemMatrix (SystemMatrix::add_elements).
 class ElasticForce final : public ForceTerm {
 public:
   ElasticForce(const mesh::TetMesh& mesh, MaterialModel material);
@@ -56,7 +57,7 @@ private:
     material::PrincipalFrame frame;
     material::CorrectedStress stress;
     material::RayleighCoefficients alpha;
-    Mat9 tangent;              ///< dP/dF (projected unless disabled); valid if has_tangent
+    material::PrincipalTangent tangent; ///< dP/dF's eigen-form (projected unless disabled); valid if has_tangent
     bool has_tangent = false;
   };
   bool cache_matches(const ForceState& state) const;
@@ -68,7 +69,6 @@ private:
   std::vector<ElementCache> m_cache;    ///< m, from the last add_force
   VecX m_cached_x, m_cached_v;          ///< the state m_cache belongs to
   std::vector<double> m_force_buffer;   ///< m·12
-  std::vector<double> m_matrix_buffer;  ///< m·144 (allocated on first Jacobian request)
   std::vector<int> m_vertex_offsets;    ///< vertex → range in m_vertex_sources
   std::vector<int> m_vertex_sources;    ///< element·4 + local vertex
   bool m_project_tangent = true;

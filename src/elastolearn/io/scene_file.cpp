@@ -1,6 +1,6 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
-#include <elastolearn/io/scene_material.hpp>
 #include <elastolearn/mesh/primitives.hpp>
 #include <elastolearn/mesh/read_tet_mesh.hpp>
 #include <elastolearn/mesh/vertex_selection.hpp>
@@ -152,7 +152,7 @@ SceneFile parse_scene(const nlohmann::json& json, const std::string& file, const
   sim::Scene& s = out.scene;
   s.name = root.string("name", std::filesystem::path(file).stem().string());
   s.mesh = parse_mesh(root.object("mesh"), base_dir);
-  s.material = parse_material(root.object("material"));
+  s.material = scene_material_model(root, base_dir); // inline object or path of a material file
   s.mass = root.choice("mass", {"lumped", "consistent"}, "lumped") == "lumped" ? fem::MassType::Lumped
                                                                              : fem::MassType::Consistent;
   s.gravity = root.vec3("gravity", Vec3::Zero());

@@ -53,24 +53,11 @@ Mat3 first_piola(const PrincipalFrame& frame, const Vec3& principal_stress) {
     return frame.U * principal_stress.asDiagonal() * frame.V.transpose();
 }
 
-Mat9 first_piola_derivative(
+PrincipalTangent principal_tangent(
     const PrincipalFrame& frame, const Vec3& P, const Mat3& dP, bool project_psd) {
     const Vec3& s = frame.stretches;
-    const Mat3& U = frame.U;
-    const Mat3& V = frame.V;
-    // In the principal frame, K = d vec(Uᵀ P V) / d vec(Uᵀ F V) has the 3×3 block A = ∂P̂/∂σ on
-    // the diagonal entries and, per pair (i, j), the 2×2 block [a b; b a] on the entries (i,j),
-    // (j,i), whose eigenvectors (1, ±1)/√2 carry the twist and flip eigenvalues. With
-    // W = kron(V, U) (columns vec(u_k v_lᵀ)), dP/dF = W K Wᵀ is therefore the sum of
-    //   G A Gᵀ,  G's column k = vec(u_k v_kᵀ),
-    //   ½ twist · m₊ m₊ᵀ + ½ flip · m₋ m₋ᵀ per pair,  m± = vec(u_i v_jᵀ ± u_j v_iᵀ):
-    // H = Y Mᵀ with M = [G | m₊ | m₋] and Y = [G A | ½ twist m₊ | ½ flip m₋]; no 9×9×9×9 work.
-    const Mat3 A = project_psd ? project_psd_3x3(dP) : dP;
-    Mat9 M, Y;
-    for (int k = 0; k < 3; ++k)
-        for (int b = 0; b < 3; ++b)
-            M.col(k).segment<3>(3 * b) = V(b, k) * U.col(k);
-    Y.leftCols<3>().noalias() = M.leftCols<3>() * A;
+    PrincipalTangent t;
+    t.block = project_psd ? project_psd_3x3(dP) : dP;
     static constexpr int pairs[3][2] = { { 0, 1 }, { 0, 2 }, { 1, 2 } };
     for (int m = 0; m < 3; ++m) {
         const int i = pairs[m][0], j = pairs[m][1];
@@ -92,18 +79,42 @@ Mat9 first_piola_derivative(
             twist = std::max(twist, 0.0);
             flip = std::max(flip, 0.0);
         }
+        t.twist[m] = twist;
+        t.flip[m] = flip;
+    }
+    return t;
+}
+
+Mat9 first_piola_derivative(const PrincipalFrame& frame, const PrincipalTangent& t) {
+    const Mat3& U = frame.U;
+    const Mat3& V = frame.V;
+    // In the principal frame, K = d vec(Uᵀ P V) / d vec(Uᵀ F V) has the 3×3 block A = ∂P̂/∂σ on
+    // the diagonal entries and, per pair (i, j), the 2×2 block [a b; b a] on the entries (i,j),
+    // (j,i), whose eigenvectors (1, ±1)/√2 carry the twist and flip eigenvalues. With
+    // W = kron(V, U) (columns vec(u_k v_lᵀ)), dP/dF = W K Wᵀ is therefore the sum of
+    //   G A Gᵀ,  G's column k = vec(u_k v_kᵀ),
+    //   ½ twist · m₊ m₊ᵀ + ½ flip · m₋ m₋ᵀ per pair,  m± = vec(u_i v_jᵀ ± u_j v_iᵀ):
+    // H = Y Mᵀ with M = [G | m₊ | m₋] and Y = [G A | ½ twist m₊ | ½ flip m₋]; no 9×9×9×9 work.
+    Mat9 M, Y;
+    for (int k = 0; k < 3; ++k)
+        for (int b = 0; b < 3; ++b)
+            M.col(k).segment<3>(3 * b) = V(b, k) * U.col(k);
+    Y.leftCols<3>().noalias() = M.leftCols<3>() * t.block;
+    static constexpr int pairs[3][2] = { { 0, 1 }, { 0, 2 }, { 1, 2 } };
+    for (int m = 0; m < 3; ++m) {
+        const int i = pairs[m][0], j = pairs[m][1];
         for (int b = 0; b < 3; ++b) {
             const Vec3 p = V(b, j) * U.col(i); // vec(u_i v_jᵀ), rows 3b..3b+2
             const Vec3 q = V(b, i) * U.col(j); // vec(u_j v_iᵀ)
             M.col(3 + m).segment<3>(3 * b) = p + q;
             M.col(6 + m).segment<3>(3 * b) = p - q;
         }
-        Y.col(3 + m) = (0.5 * twist) * M.col(3 + m);
-        Y.col(6 + m) = (0.5 * flip) * M.col(6 + m);
+        Y.col(3 + m) = (0.5 * t.twist[m]) * M.col(3 + m);
+        Y.col(6 + m) = (0.5 * t.flip[m]) * M.col(6 + m);
     }
     Mat9 H;
-    if (project_psd) {
-        // A is symmetric, so H is: build its upper triangle and mirror it.
+    if (t.block == t.block.transpose()) {
+        // A symmetric block makes H symmetric: build its upper triangle and mirror it.
         [&]<int... C>(std::integer_sequence<int, C...>) {
             (upper_column_of_product<C>(Y, M, H), ...);
         }(std::make_integer_sequence<int, 9>());
@@ -117,6 +128,26 @@ Mat9 first_piola_derivative(
         }
     }
     return H;
+}
+
+Mat9 first_piola_derivative(
+    const PrincipalFrame& frame, const Vec3& P, const Mat3& dP, bool project_psd) {
+    return first_piola_derivative(frame, principal_tangent(frame, P, dP, project_psd));
+}
+
+Mat3 first_piola_differential(const PrincipalFrame& frame, const PrincipalTangent& t, const Mat3& dF) {
+    const Mat3 local = frame.U.transpose() * dF * frame.V;
+    Mat3 dP_local;
+    dP_local.diagonal() = t.block * local.diagonal();
+    static constexpr int pairs[3][2] = { { 0, 1 }, { 0, 2 }, { 1, 2 } };
+    for (int m = 0; m < 3; ++m) {
+        const int i = pairs[m][0], j = pairs[m][1];
+        const double twist_part = 0.5 * t.twist[m] * (local(i, j) + local(j, i));
+        const double flip_part = 0.5 * t.flip[m] * (local(i, j) - local(j, i));
+        dP_local(i, j) = twist_part + flip_part;
+        dP_local(j, i) = twist_part - flip_part;
+    }
+    return frame.U * dP_local * frame.V.transpose();
 }
 
 Mat9 first_piola_rate_derivative(const PrincipalFrame& frame, const Mat3& d_stretch_rates) {

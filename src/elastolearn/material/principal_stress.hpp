@@ -25,6 +25,24 @@ Vec3 stretch_rates(const PrincipalFrame& frame, const Mat3& F_rate);
 /// P = U diag(principal_stress) Vᵀ.
 Mat3 first_piola(const PrincipalFrame& frame, const Vec3& principal_stress);
 
+/// dP/dF of P = U P̂(σ(F)) Vᵀ in its eigen-form (see first_piola_derivative): the 3×3 block
+/// ∂P̂/∂σ and, per stretch pair (0,1), (0,2), (1,2), the twist and flip eigenvalues
+/// (P̂ᵢ − P̂ⱼ)/(σᵢ − σⱼ) and (P̂ᵢ + P̂ⱼ)/(σᵢ + σⱼ) (stable limits near equal or opposite
+/// stretches). With `project_psd` the block is made symmetric PSD and the eigenvalues ≥ 0.
+struct PrincipalTangent {
+  Mat3 block;
+  Vec3 twist;
+  Vec3 flip;
+};
+PrincipalTangent principal_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,
+                                   const Mat3& principal_stress_derivative, bool project_psd);
+/// The 9×9 dP/dF of an eigen-form tangent (symmetric if the tangent was projected).
+Mat9 first_piola_derivative(const PrincipalFrame& frame, const PrincipalTangent& tangent);
+/// dP = (dP/dF) : dF without forming the 9×9: dP = U dP̂ Vᵀ with, for dF̂ = Uᵀ dF V,
+/// dP̂ᵢᵢ = Σⱼ block(i,j) dF̂ⱼⱼ and per pair dP̂ᵢⱼ = ½(twist s + flip d), dP̂ⱼᵢ = ½(twist s − flip d),
+/// s = dF̂ᵢⱼ + dF̂ⱼᵢ, d = dF̂ᵢⱼ − dF̂ⱼᵢ. About a tenth of the work of forming dP/dF.
+Mat3 first_piola_differential(const PrincipalFrame& frame, const PrincipalTangent& tangent, const Mat3& dF);
+
 /// dP/dF (9×9) of P = U P̂(σ(F)) Vᵀ for an isotropic diagonal stress P̂(σ) with 3×3 derivative
 /// ∂P̂/∂σ. With `project_psd` the 3×3 block and the three 2×2 twist/flip blocks are made symmetric
 /// and their negative eigenvalues clamped to zero (Xu et al. 2015; Teran et al. 2005), so the

@@ -18,6 +18,33 @@ Vec3 KeyframeMotion::offset_at(double t) const {
   return (1 - s) * offsets[k - 1] + s * offsets[k];
 }
 
+Vec3 TrackedVertices::position_at(int j, double t) const {
+  const double s = (t - start_time) / dt;
+  const int last = static_cast<int>(positions.size()) - 1;
+  if (s <= 0) return positions.front().row(j).transpose();
+  if (s >= last) return positions.back().row(j).transpose();
+  const int k = std::min(static_cast<int>(s), last - 1);
+  const double w = s - k;
+  // Snap to a recorded frame when t is one (times are sums of steps and carry round-off).
+  if (w < 1e-9) return positions[k].row(j).transpose();
+  if (w > 1 - 1e-9) return positions[k + 1].row(j).transpose();
+  return ((1 - w) * positions[k].row(j) + w * positions[k + 1].row(j)).transpose();
+}
+
+void TrackedVertices::validate(int num_vertices) const {
+  if (vertices.empty()) throw InputError("tracked", "no tracked vertices");
+  for (int v : vertices)
+    if (v < 0 || v >= num_vertices)
+      throw InputError("tracked", "vertex index " + std::to_string(v) + " out of range [0, " +
+                                      std::to_string(num_vertices) + ")");
+  if (positions.empty()) throw InputError("tracked", "no recorded frames");
+  if (!(dt > 0 && std::isfinite(dt))) throw InputError("tracked.dt", "must be a positive number");
+  for (size_t k = 0; k < positions.size(); ++k)
+    if (positions[k].rows() != static_cast<Eigen::Index>(vertices.size()) || !positions[k].allFinite())
+      throw InputError("tracked", "frame " + std::to_string(k) + " must hold " + std::to_string(vertices.size()) +
+                                      " finite positions");
+}
+
 void KeyframeMotion::validate(int num_vertices) const {
   if (vertices.empty()) throw InputError("keyframes", "vertex group is empty");
   for (int v : vertices)

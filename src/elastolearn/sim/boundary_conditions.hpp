@@ -27,6 +27,21 @@ struct KeyframeMotion {
   void validate(int num_vertices) const;
 };
 
+/// Vertices that follow recorded positions: the constrained forward simulation of paper 000
+/// (Eqs. 6–8), where observed vertices are prescribed from their data and the rest is simulated.
+/// Frame k holds the positions at time start_time + k·dt; between frames they are interpolated
+/// linearly, outside the recording they are held.
+struct TrackedVertices {
+  std::vector<int> vertices;        ///< k vertex indices
+  std::vector<Positions> positions; ///< frames, each k×3 [m]
+  double dt = 0;                    ///< [s]
+  double start_time = 0;            ///< [s]
+  /// Position of tracked vertex j (row of `positions`) at time t.
+  Vec3 position_at(int j, double t) const;
+  /// Throws InputError (field "tracked") if inconsistent.
+  void validate(int num_vertices) const;
+};
+
 /// A force spread evenly over a vertex group, active while t < release_time.
 struct PointLoad {
   std::vector<int> vertices;

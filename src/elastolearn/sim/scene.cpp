@@ -9,6 +9,7 @@ namespace elastolearn::sim {
 std::vector<int> Scene::prescribed_vertices() const {
   std::vector<int> out = fixed_vertices;
   for (const auto& k : keyframes) out.insert(out.end(), k.vertices.begin(), k.vertices.end());
+  if (tracked) out.insert(out.end(), tracked->vertices.begin(), tracked->vertices.end());
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
@@ -26,6 +27,7 @@ void Scene::validate() const {
     if (v < 0 || v >= n)
       throw InputError("fixed", "vertex index " + std::to_string(v) + " out of range [0, " + std::to_string(n) + ")");
   for (const auto& k : keyframes) k.validate(n);
+  if (tracked) tracked->validate(n);
   auto check_loads = [&](const std::vector<PointLoad>& loads, const std::string& field) {
     for (const auto& l : loads) {
       if (l.vertices.empty()) throw InputError(field, "load has no vertices");

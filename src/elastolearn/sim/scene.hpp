@@ -8,6 +8,7 @@
 #include <elastolearn/sim/linear_solver.hpp>
 #include <elastolearn/sim/newton.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -22,13 +23,14 @@ struct Scene {
   std::vector<int> fixed_vertices;             ///< held at rest
   std::vector<KeyframeMotion> keyframes;       ///< prescribed motion
   std::vector<PointLoad> loads;                ///< during the motion
+  std::shared_ptr<const TrackedVertices> tracked; ///< optional: vertices following recorded data
   InitialCondition initial;
   double dt = 1e-3;                            ///< time step [s]
   int frames = 100;                            ///< number of steps (output has frames + 1 states)
   NewtonOptions newton;
   LinearSolverType linear_solver = LinearSolverType::Cholmod;
 
-  /// Vertices whose positions are prescribed (fixed ∪ keyframed), sorted, unique.
+  /// Vertices whose positions are prescribed (fixed ∪ keyframed ∪ tracked), sorted, unique.
   std::vector<int> prescribed_vertices() const;
   /// Throws InputError naming the offending field.
   void validate() const;

@@ -50,6 +50,9 @@ VecX Simulator::prescribed_positions(double t) const {
     const Vec3 offset = k.offset_at(t);
     for (int v : k.vertices) x.segment<3>(3 * v) += offset;
   }
+  if (const auto& tracked = m_scene.tracked)
+    for (size_t j = 0; j < tracked->vertices.size(); ++j)
+      x.segment<3>(3 * tracked->vertices[j]) = tracked->position_at(static_cast<int>(j), t);
   return x;
 }
 
@@ -189,7 +192,7 @@ NewtonReport Simulator::solve_static(int load_steps) {
 
 NewtonReport Simulator::apply_initial_condition() {
   const auto& ic = m_scene.initial;
-  m_x = flatten(m_scene.mesh.rest_positions());
+  m_x = prescribed_positions(0); // rest, with prescribed vertices where they are at t = 0
   m_v.setZero();
   m_time = 0;
   m_step = 0;

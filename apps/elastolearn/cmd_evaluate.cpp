@@ -1,0 +1,213 @@
+// elastolearn evaluate test_scene.json --material learned.json --truth test_traj.h5
+//                     [--json report.json] [-o learned_traj.h5]
+// Paper 000 Table 1's err_L: simulate the test scene with its own (nominal) material and with the
+// learned material, and compare both with the true trajectory over all vertices.
+#include "command.hpp"
+
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/scene_file.hpp>
+#include <elastolearn/io/trajectory_file.hpp>
+#include <elastolearn/learn/trajectory_error.hpp>
+#include <elastolearn/observe/observation.hpp>
+#include <elastolearn/sim/run_simulation.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+namespace {
+
+using namespace elastolearn;
+
+struct EvaluateOptions {
+  std::string scene;
+  std::string material;
+  std::string truth;
+  std::string json;
+  std::string output;
+  std::string solver;
+  bool quiet = false;
+};
+
+/// One simulated model and its error against the truth.
+struct ModelRun {
+  std::string label;
+  std::string description;
+  std::vector<VecX> frames; ///< flat 3n, frame 0 = initial state
+  sim::SimulationReport report;
+  learn::ErrorSummary error; ///< [m]
+  learn::ErrorSummary percent; ///< [% of the rest bounding-box diagonal]
+};
+
+/// The truth as flat frames, after checking that it belongs to `scene` (same vertex count and
+/// rest shape, scene.frames + 1 frames spaced scene.dt). Throws InputError naming the file.
+std::vector<VecX> read_truth(const std::string& path, const sim::Scene& scene) {
+  const io::TrajectoryData truth = io::read_trajectory_h5(path);
+  const int n = scene.mesh.num_vertices();
+  if (truth.rest_positions.rows() != n) {
+    throw InputError(path + ": /rest_positions",
+        "has " + std::to_string(truth.rest_positions.rows()) + " vertices but the scene's mesh has "
+            + std::to_string(n) + " (a trajectory of a different mesh?)");
+  }
+  const double tolerance = 1e-9 * scene.mesh.bounding_box_diagonal();
+  const double offset
+      = (truth.rest_positions - scene.mesh.rest_positions()).rowwise().norm().maxCoeff();
+  if (!(offset <= tolerance)) {
+    throw InputError(path + ": /rest_positions",
+        "differ from the scene's mesh by up to " + std::to_string(offset)
+            + " m (a trajectory of a different mesh?)");
+  }
+  const int expected = scene.frames + 1;
+  if (int(truth.positions.size()) != expected) {
+    throw InputError(path + ": /positions",
+        "has " + std::to_string(truth.positions.size()) + " frames but the scene simulates "
+            + std::to_string(expected) + " (" + std::to_string(scene.frames)
+            + " steps + the initial state)");
+  }
+  const double dt = observe::uniform_time_step(truth.time, path + ": /time");
+  if (std::abs(dt - scene.dt) > 1e-6 * scene.dt) {
+    throw InputError(path + ": /time",
+        "frames are " + std::to_string(dt) + " s apart but the scene's time step is "
+            + std::to_string(scene.dt) + " s");
+  }
+  std::vector<VecX> frames;
+  frames.reserve(truth.positions.size());
+  for (const Positions& p : truth.positions)
+    frames.emplace_back(flatten(p));
+  return frames;
+}
+
+/// Simulate `scene`, keeping every frame in memory and, if `output` is given, writing them.
+void simulate(const sim::Scene& scene, bool quiet, const std::string& output, ModelRun& run) {
+  std::optional<io::TrajectoryWriter> writer;
+  if (!output.empty())
+    writer.emplace(output, scene.mesh.rest_positions(), scene.mesh.tets(), Edges(),
+        scene.mesh.surface_faces());
+  auto sink = [&](int, double time, const VecX& x, const VecX& v) {
+    run.frames.push_back(x);
+    if (writer)
+      writer->append(time, unflatten(x), unflatten(v));
+  };
+  run.report = sim::run_simulation(
+      scene, sink, quiet ? ProgressCallback {} : terminal_progress(run.label));
+  if (writer && writer->frames() > 0) {
+    const std::map<std::string, std::string> metadata = { { "scene", scene.name },
+      { "material", run.description }, { "dt", std::to_string(scene.dt) },
+      { "status", run.report.completed ? "completed" : "stopped: " + run.report.message } };
+    writer->finish(metadata);
+  }
+}
+
+nlohmann::json run_to_json(const ModelRun& run) {
+  const auto& e = run.error;
+  const auto& p = run.percent;
+  return { { "material", run.description }, { "err_L_percent", p.max }, { "mean_percent", p.mean },
+    { "rms_percent", p.rms }, { "max_error", e.max }, { "mean_error", e.mean },
+    { "rms_error", e.rms }, { "worst_frame", e.worst_frame }, { "worst_vertex", e.worst_vertex },
+    { "frames_compared", run.frames.size() }, { "completed", run.report.completed },
+    { "message", run.report.message }, { "seconds", run.report.seconds } };
+}
+
+/// nominal / learned, or null (JSON) / "exact" (text) when the learned error is zero.
+std::optional<double> ratio(double nominal, double learned) {
+  if (!(learned > 0))
+    return std::nullopt;
+  return nominal / learned;
+}
+
+void run_evaluate(const EvaluateOptions& opts) {
+  io::SceneFile file = io::read_scene_file(opts.scene);
+  if (!opts.solver.empty())
+    file.scene.linear_solver = sim::linear_solver_type_from_string(opts.solver);
+  const sim::Scene& nominal_scene = file.scene;
+  sim::Scene learned_scene = file.scene;
+  learned_scene.material = io::material_model(io::read_material_file(opts.material), opts.material);
+  const std::vector<VecX> truth = read_truth(opts.truth, nominal_scene);
+  const double size = nominal_scene.mesh.bounding_box_diagonal();
+
+  std::printf("scene %s: %d vertices, %d tets, %d frames of dt = %g s, size (rest bounding-box "
+              "diagonal) %g m\n",
+      nominal_scene.name.c_str(), nominal_scene.mesh.num_vertices(), nominal_scene.mesh.num_tets(),
+      nominal_scene.frames, nominal_scene.dt, size);
+  ModelRun nominal { "nominal",
+    io::describe_material_model(nominal_scene.material) + " (the scene's)", {}, {}, {}, {} };
+  ModelRun learned { "learned",
+    io::describe_material_model(learned_scene.material) + " (" + opts.material + ")", {}, {}, {},
+    {} };
+  std::printf("truth:   %s (%zu frames)\nnominal: %s\nlearned: %s\n", opts.truth.c_str(),
+      truth.size(), nominal.description.c_str(), learned.description.c_str());
+  std::fflush(stdout);
+
+  simulate(nominal_scene, opts.quiet, "", nominal);
+  simulate(learned_scene, opts.quiet, opts.output, learned);
+  for (ModelRun* run : { &nominal, &learned }) {
+    run->error = learn::position_error(run->frames, truth);
+    run->percent = learn::as_percent_of(run->error, size);
+  }
+
+  std::printf("\n%-9s %12s %12s %12s %12s %11s\n", "model", "err_L [%]", "mean [%]", "rms [%]",
+      "max [m]", "worst frame");
+  for (const ModelRun* run : { &nominal, &learned }) {
+    std::printf("%-9s %12.4g %12.4g %12.4g %12.4g %11d%s\n", run->label.c_str(), run->percent.max,
+        run->percent.mean, run->percent.rms, run->error.max, run->error.worst_frame,
+        run->report.completed ? "" : "  (stopped early)");
+  }
+  const auto max_ratio = ratio(nominal.error.max, learned.error.max);
+  const auto mean_ratio = ratio(nominal.error.mean, learned.error.mean);
+  if (max_ratio && mean_ratio)
+    std::printf(
+        "improvement: err_L %.3gx lower, mean error %.3gx lower\n", *max_ratio, *mean_ratio);
+  else
+    std::printf("improvement: the learned material reproduces the truth exactly\n");
+  if (!opts.output.empty() && !learned.frames.empty())
+    std::printf("learned trajectory: %s\n", opts.output.c_str());
+
+  if (!opts.json.empty()) {
+    const nlohmann::json report = { { "format", "elastolearn-evaluation/1" },
+      { "scene", opts.scene }, { "material", opts.material }, { "truth", opts.truth },
+      { "vertices", nominal_scene.mesh.num_vertices() }, { "tets", nominal_scene.mesh.num_tets() },
+      { "frames", truth.size() }, { "dt", nominal_scene.dt }, { "size", size },
+      { "nominal", run_to_json(nominal) }, { "learned", run_to_json(learned) },
+      { "improvement",
+          { { "err_L", max_ratio ? nlohmann::json(*max_ratio) : nlohmann::json(nullptr) },
+              { "mean", mean_ratio ? nlohmann::json(*mean_ratio) : nlohmann::json(nullptr) } } } };
+    io::write_json_file(opts.json, report);
+    std::printf("report: %s\n", opts.json.c_str());
+  }
+  for (const ModelRun* run : { &nominal, &learned }) {
+    if (!run->report.completed) {
+      std::fprintf(stderr,
+          "elastolearn: error: the %s simulation %s (errors above cover frames 0..%zu)\n",
+          run->label.c_str(), run->report.message.c_str(), run->frames.size() - 1);
+      throw CLI::RuntimeError(1);
+    }
+  }
+}
+
+void add_evaluate_command(CLI::App& root) {
+  auto opts = std::make_shared<EvaluateOptions>();
+  auto* cmd = root.add_subcommand("evaluate",
+      "Compare the nominal and a learned material with a true trajectory (err_L, paper 000 Table "
+      "1)");
+  cmd->add_option(
+         "scene", opts->scene, "test scene (elastolearn-scene/1 JSON); its material is the nominal")
+      ->required();
+  cmd->add_option(
+         "--material", opts->material, "learned material file (elastolearn-material/1 JSON)")
+      ->required();
+  cmd->add_option(
+         "--truth", opts->truth, "true trajectory of the test scene (HDF5, e.g. from simulate)")
+      ->required();
+  cmd->add_option("--json", opts->json, "also write the numbers to this JSON file");
+  cmd->add_option("-o,--output", opts->output, "write the learned material's trajectory (HDF5)");
+  cmd->add_option(
+      "--solver", opts->solver, "linear solver: cholmod | cg | eigen-ldlt (overrides the scene)");
+  cmd->add_flag("-q,--quiet", opts->quiet, "no progress line");
+  cmd->callback([opts] { run_evaluate(*opts); });
+}
+
+} // namespace
+
+ELASTOLEARN_COMMAND(45, add_evaluate_command)

@@ -1,0 +1,166 @@
+// elastolearn learn scene.json --observations obs.h5 -o learned.json [--report DIR] [--resume] ...
+// Learn a correction of the scene's (nominal) material from observed vertex trajectories
+// (paper 000 §3–§6; docs/learning.md). Checkpoints after every iteration; --resume continues.
+#include "command.hpp"
+
+#include <elastolearn/core/atomic_file.hpp>
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/core/interrupt.hpp>
+#include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/io/learning_checkpoint.hpp>
+#include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/observation_file.hpp>
+#include <elastolearn/io/scene_file.hpp>
+#include <elastolearn/learn/learning_loop.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+namespace {
+
+struct LearnOptions {
+  std::string scene, observations, output, report, checkpoint;
+  bool resume = false;
+  bool quiet = false;
+  std::string reconstruction = "normal_equations";
+  bool no_damping = false;
+  elastolearn::learn::LearningOptions learning;
+};
+
+void write_report(const std::filesystem::path& dir, const elastolearn::learn::LearningState& state,
+                  const nlohmann::json& summary) {
+  using namespace elastolearn;
+  std::filesystem::create_directories(dir);
+  std::ostringstream csv;
+  csv << "iteration,forward_rms_m,forward_max_m,forward_mean_m,control_force_rms_N,space_time_initial,"
+         "space_time_objective,space_time_iterations,modes,centres,correction_misfit_N,correction_target_N,"
+         "seconds_forward,seconds_pod,seconds_constrained,seconds_space_time,seconds_reconstruction\n";
+  for (const auto& r : state.history)
+    csv << r.iteration << ',' << r.forward_error.rms << ',' << r.forward_error.max << ',' << r.forward_error.mean << ','
+        << r.control_force_rms << ',' << r.space_time_initial << ',' << r.space_time_objective << ','
+        << r.space_time_iterations << ',' << r.modes << ',' << r.centres << ',' << r.correction_misfit << ','
+        << r.correction_target << ',' << r.seconds_forward << ',' << r.seconds_pod << ',' << r.seconds_constrained
+        << ',' << r.seconds_space_time << ',' << r.seconds_reconstruction << '\n';
+  write_text_file_atomic(dir / "convergence.csv", csv.str());
+  io::write_json_file(dir / "report.json", summary);
+}
+
+void run_learn(const LearnOptions& o) {
+  using namespace elastolearn;
+  const auto scene_file = io::read_scene_file(o.scene);
+  const sim::Scene& scene = scene_file.scene;
+  if (scene.material.correction)
+    throw InputError(o.scene, "material: the scene's material already carries a correction; learn from a nominal one");
+  observe::Observation observed = io::read_observation_h5(o.observations);
+  observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, o.observations);
+
+  learn::LearningOptions options = o.learning;
+  options.reconstruction.method = learn::reconstruction_method_from_name(o.reconstruction, "--reconstruction");
+  options.rbf.fit_damping = !o.no_damping;
+  options.validate();
+
+  const std::filesystem::path checkpoint = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
+  const io::LearningInputs inputs{o.scene, o.observations, io::learning_options_to_json(options)};
+  learn::LearningState state;
+  if (o.resume) {
+    if (!std::filesystem::exists(checkpoint))
+      throw InputError(checkpoint.string(), "no checkpoint to resume from (run without --resume first)");
+    state = io::read_learning_checkpoint(checkpoint, inputs);
+    std::printf("resuming from %s at iteration %d\n", checkpoint.string().c_str(), state.next_iteration);
+  }
+  std::printf("learning %s: %d vertices, %d tets, %d frames of dt = %g s, %d observed vertices, nominal %s\n",
+              scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(), scene.frames, scene.dt,
+              observed.num_observed(), scene.material.elastic->name().c_str());
+  const double diagonal = scene.mesh.bounding_box_diagonal();
+  std::printf("%4s %12s %12s %14s %6s %6s %9s\n", "iter", "err rms [%]", "err max [%]", "control [N]", "modes",
+              "kernels", "time [s]");
+
+  learn::LearningCallbacks callbacks;
+  if (!o.quiet) callbacks.progress = terminal_progress("learn");
+  callbacks.interrupted = [] { return interrupt_requested(); };
+  callbacks.iteration = [&](const learn::IterationRecord& r) {
+    if (!r.forward_completed) {
+      std::printf("%4d  forward simulation diverged: stopping (the best correction so far is kept)\n", r.iteration);
+      return;
+    }
+    std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, space-time %.1f [%d it], "
+                "reconstruction %.1f)\n",
+                r.iteration, 100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal,
+                r.control_force_rms, r.modes, r.centres, r.seconds_total(), r.seconds_forward, r.seconds_constrained,
+                r.seconds_space_time, r.space_time_iterations, r.seconds_reconstruction);
+    std::fflush(stdout);
+  };
+  callbacks.checkpoint = [&](const learn::LearningState& s) { io::write_learning_checkpoint(checkpoint, inputs, s); };
+
+  const bool finished = learn::run_learning(scene, observed, options, state, callbacks);
+  if (!finished) {
+    std::fprintf(stderr, "elastolearn: interrupted; resume with the same command and --resume (checkpoint %s)\n",
+                 checkpoint.string().c_str());
+    throw CLI::RuntimeError(130);
+  }
+
+  double total_seconds = 0;
+  nlohmann::json history = nlohmann::json::array();
+  for (const auto& r : state.history) {
+    total_seconds += r.seconds_total();
+    history.push_back(io::iteration_record_to_json(r));
+  }
+  const nlohmann::json root = io::read_json_file(o.scene);
+  io::MaterialFile learned = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
+  learned.correction = state.best;
+  learned.training = {{"scene", o.scene},
+                      {"observations", o.observations},
+                      {"observed_vertices", observed.num_observed()},
+                      {"best_iteration", state.best_iteration},
+                      {"best_rms_error_m", state.best_error},
+                      {"options", inputs.options},
+                      {"seconds", total_seconds},
+                      {"history", history}};
+  io::write_material_file(o.output, learned);
+  if (!o.report.empty()) write_report(o.report, state, learned.training);
+
+  const auto& first = state.history.front().forward_error;
+  std::printf("best: iteration %d, observation error rms %.4f %% (nominal %.4f %%), max %.4f %% (nominal %.4f %%); "
+              "%.1f s in total\n",
+              state.best_iteration, 100 * state.best_error / diagonal, 100 * first.rms / diagonal,
+              100 * state.history[static_cast<size_t>(std::max(0, state.best_iteration))].forward_error.max / diagonal,
+              100 * first.max / diagonal, total_seconds);
+  std::printf("learned material: %s (%s)\n", o.output.c_str(),
+              state.best ? io::describe_correction(*state.best).c_str() : "no correction beat the nominal model");
+  if (!o.report.empty()) std::printf("report: %s/convergence.csv, report.json\n", o.report.c_str());
+}
+
+void add_learn_command(CLI::App& root) {
+  auto o = std::make_shared<LearnOptions>();
+  auto* cmd = root.add_subcommand("learn", "Learn a material correction from observed vertex trajectories");
+  cmd->add_option("scene", o->scene, "scene with the nominal material (elastolearn-scene/1 JSON)")->required();
+  cmd->add_option("--observations", o->observations, "observation HDF5 (from observe, or your capture)")->required();
+  cmd->add_option("-o,--output", o->output, "learned material JSON to write")->required();
+  cmd->add_option("--report", o->report, "folder for convergence.csv and report.json");
+  cmd->add_option("--checkpoint", o->checkpoint, "checkpoint file (default: OUTPUT.checkpoint.json)");
+  cmd->add_flag("--resume", o->resume, "continue from the checkpoint");
+  auto& l = o->learning;
+  cmd->add_option("--max-iterations", l.max_iterations, "corrections computed at most")->capture_default_str();
+  cmd->add_option("--patience", l.patience, "stop after this many iterations without improvement")->capture_default_str();
+  cmd->add_option("--modes", l.pod.max_modes, "POD modes r of the space-time optimisation")->capture_default_str();
+  cmd->add_option("--pod-stride", l.pod.frame_stride, "use every k-th frame for POD")->capture_default_str();
+  cmd->add_option("--kernels", l.centres, "RBF kernels (k-means centres)")->capture_default_str();
+  cmd->add_option("--position-weight", l.space_time.position_weight, "λ of the position term (Eq. 4)")
+      ->capture_default_str();
+  cmd->add_option("--space-time-iterations", l.space_time.max_iterations, "Gauss-Newton iterations per space-time solve")
+      ->capture_default_str();
+  cmd->add_option("--regularization", l.rbf.regularization, "Tikhonov weight of the RBF fit")->capture_default_str();
+  cmd->add_option("--reconstruction", o->reconstruction, "normal_equations | lsqr (min-norm stresses, paper Fig. 4)")
+      ->capture_default_str();
+  cmd->add_option("--frame-stride", l.reconstruction.frame_stride, "use every k-th frame in the reconstruction")
+      ->capture_default_str();
+  cmd->add_flag("--no-damping", o->no_damping, "do not learn the damping correction");
+  cmd->add_option("--seed", l.seed, "k-means seed")->capture_default_str();
+  cmd->add_flag("-q,--quiet", o->quiet, "no progress line");
+  cmd->callback([o] { run_learn(*o); });
+}
+
+} // namespace
+
+ELASTOLEARN_COMMAND(35, add_learn_command)

@@ -1,0 +1,149 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/io/learning_checkpoint.hpp>
+#include <elastolearn/io/material_file.hpp>
+
+namespace elastolearn::io {
+
+namespace {
+
+constexpr const char* k_format = "elastolearn-learning-checkpoint";
+
+nlohmann::json correction_json(const std::shared_ptr<const material::RbfCorrection>& c) {
+  return c ? correction_to_json(*c) : nlohmann::json(nullptr);
+}
+
+std::shared_ptr<const material::RbfCorrection> read_correction(const JsonObject& object, const std::string& key) {
+  if (object.json().at(key).is_null()) return nullptr;
+  auto c = correction_from_json(object.object(key));
+  auto rbf = std::dynamic_pointer_cast<const material::RbfCorrection>(c);
+  if (!rbf) object.fail(key, "must be an RBF correction");
+  return rbf;
+}
+
+nlohmann::json error_json(const learn::ErrorSummary& e) {
+  return {{"max", e.max}, {"mean", e.mean}, {"rms", e.rms}, {"worst_frame", e.worst_frame},
+          {"worst_vertex", e.worst_vertex}, {"samples", e.samples}};
+}
+
+learn::ErrorSummary read_error(const JsonObject& o) {
+  learn::ErrorSummary e;
+  e.max = o.number("max");
+  e.mean = o.number("mean");
+  e.rms = o.number("rms");
+  e.worst_frame = o.integer("worst_frame");
+  e.worst_vertex = o.integer("worst_vertex");
+  e.samples = static_cast<long>(o.number("samples"));
+  return e;
+}
+
+learn::IterationRecord read_record(const JsonObject& o) {
+  learn::IterationRecord r;
+  r.iteration = o.integer("iteration");
+  r.forward_error = read_error(o.object("forward_error"));
+  r.forward_completed = o.boolean("forward_completed", true);
+  r.control_force_rms = o.number("control_force_rms");
+  r.space_time_initial = o.number("space_time_initial");
+  r.space_time_objective = o.number("space_time_objective");
+  r.space_time_iterations = o.integer("space_time_iterations");
+  r.modes = o.integer("modes");
+  r.centres = o.integer("centres");
+  r.correction_misfit = o.number("correction_misfit");
+  r.correction_target = o.number("correction_target");
+  const JsonObject s = o.object("seconds");
+  r.seconds_forward = s.number("forward");
+  r.seconds_pod = s.number("pod");
+  r.seconds_constrained = s.number("constrained");
+  r.seconds_space_time = s.number("space_time");
+  r.seconds_reconstruction = s.number("reconstruction");
+  return r;
+}
+
+} // namespace
+
+nlohmann::json iteration_record_to_json(const learn::IterationRecord& r) {
+  return {{"iteration", r.iteration},
+          {"forward_error", error_json(r.forward_error)},
+          {"forward_completed", r.forward_completed},
+          {"control_force_rms", r.control_force_rms},
+          {"space_time_initial", r.space_time_initial},
+          {"space_time_objective", r.space_time_objective},
+          {"space_time_iterations", r.space_time_iterations},
+          {"modes", r.modes},
+          {"centres", r.centres},
+          {"correction_misfit", r.correction_misfit},
+          {"correction_target", r.correction_target},
+          {"seconds",
+           {{"forward", r.seconds_forward},
+            {"pod", r.seconds_pod},
+            {"constrained", r.seconds_constrained},
+            {"space_time", r.seconds_space_time},
+            {"reconstruction", r.seconds_reconstruction},
+            {"total", r.seconds_total()}}}};
+}
+
+nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
+  return {{"max_iterations", o.max_iterations},
+          {"patience", o.patience},
+          {"pod", {{"max_modes", o.pod.max_modes}, {"energy_fraction", o.pod.energy_fraction},
+                   {"first_frame", o.pod.first_frame}, {"frame_count", o.pod.frame_count},
+                   {"frame_stride", o.pod.frame_stride}, {"mass_orthonormal", o.pod.mass_orthonormal}}},
+          {"space_time", {{"position_weight", o.space_time.position_weight},
+                          {"max_iterations", o.space_time.max_iterations},
+                          {"tolerance", o.space_time.tolerance}}},
+          {"centres", o.centres},
+          {"rbf", {{"epsilon", o.rbf.epsilon}, {"elastic_polynomial", o.rbf.elastic_polynomial},
+                   {"fit_damping", o.rbf.fit_damping}, {"damping_polynomial", o.rbf.damping_polynomial},
+                   {"regularization", o.rbf.regularization}}},
+          {"reconstruction", {{"method", learn::reconstruction_method_name(o.reconstruction.method)},
+                              {"frame_stride", o.reconstruction.frame_stride}}},
+          {"stretch_samples", {{"frame_stride", o.stretch_samples.frame_stride},
+                               {"max_samples", o.stretch_samples.max_samples}}},
+          {"seed", o.seed}};
+}
+
+void write_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs,
+                               const learn::LearningState& state) {
+  nlohmann::json history = nlohmann::json::array();
+  for (const auto& r : state.history) history.push_back(iteration_record_to_json(r));
+  const nlohmann::json j = {
+      {"format", std::string(k_format) + "/1"},
+      {"inputs", {{"scene", inputs.scene}, {"observations", inputs.observations}, {"options", inputs.options}}},
+      {"state",
+       {{"next_iteration", state.next_iteration},
+        {"correction", correction_json(state.correction)},
+        {"best", correction_json(state.best)},
+        {"best_error", state.best_error},
+        {"best_iteration", state.best_iteration},
+        {"iterations_without_improvement", state.iterations_without_improvement},
+        {"finished", state.finished},
+        {"history", history}}}};
+  write_json_file(path, j);
+}
+
+learn::LearningState read_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs) {
+  const nlohmann::json j = read_json_file(path);
+  const JsonObject root(j, path.string());
+  check_format(root, k_format, 1);
+  const JsonObject in = root.object("inputs");
+  if (in.string("scene") != inputs.scene)
+    in.fail("scene", "the checkpoint belongs to scene '" + in.string("scene") + "', not '" + inputs.scene + "'");
+  if (in.string("observations") != inputs.observations)
+    in.fail("observations", "the checkpoint belongs to observations '" + in.string("observations") + "', not '" +
+                                inputs.observations + "'");
+  if (in.json().at("options") != inputs.options)
+    in.fail("options", "the checkpoint was made with other learning options: resume with the same options");
+  const JsonObject s = root.object("state");
+  learn::LearningState state;
+  state.next_iteration = s.integer("next_iteration");
+  state.correction = read_correction(s, "correction");
+  state.best = read_correction(s, "best");
+  state.best_error = s.number("best_error");
+  state.best_iteration = s.integer("best_iteration");
+  state.iterations_without_improvement = s.integer("iterations_without_improvement");
+  state.finished = s.boolean("finished", false);
+  for (const auto& r : s.objects("history")) state.history.push_back(read_record(r));
+  return state;
+}
+
+} // namespace elastolearn::io

@@ -1,0 +1,294 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/scene_material.hpp>
+#include <elastolearn/material/nn_correction.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
+
+#include <cmath>
+#include <optional>
+
+namespace elastolearn::io {
+
+using Json = nlohmann::json;
+
+namespace {
+
+constexpr const char* k_format_kind = "elastolearn-material";
+constexpr int k_format_version = 1;
+
+// ---- writing ---------------------------------------------------------------------------------
+
+/// A matrix as an array of rows (row i = [M(i,0), M(i,1), ...]).
+template <typename Derived> Json rows_to_json(const Eigen::MatrixBase<Derived>& m) {
+  Json out = Json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    Json row = Json::array();
+    for (Eigen::Index j = 0; j < m.cols(); ++j)
+      row.push_back(double(m(i, j)));
+    out.push_back(std::move(row));
+  }
+  return out;
+}
+
+template <typename Derived> Json vector_to_json(const Eigen::MatrixBase<Derived>& v) {
+  Json out = Json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    out.push_back(double(v[i]));
+  return out;
+}
+
+Json rbf_to_json(const material::RbfCorrection& c) {
+  const auto& p = c.parameters();
+  // JSON has no infinity: "no floor" (−∞) is written as null.
+  const Json floor = std::isfinite(p.damping_floor) ? Json(p.damping_floor) : Json(nullptr);
+  return Json { { "type", "rbf" }, { "epsilon", p.epsilon }, { "centres", rows_to_json(p.centres) },
+    { "weights", vector_to_json(p.weights) }, { "own_slope", p.own_slope },
+    { "other_slope", p.other_slope }, { "constant", p.constant },
+    { "damping_weights", vector_to_json(p.damping_weights) }, { "damping_slope", p.damping_slope },
+    { "damping_constant", p.damping_constant },
+    { "damping_tangent", rows_to_json(p.damping_tangent) }, { "damping_floor", floor } };
+}
+
+Json nn_to_json(const material::NnCorrection& c) {
+  const auto& p = c.parameters();
+  Json layers = Json::array();
+  for (const auto& layer : p.layers)
+    layers.push_back(
+        Json { { "weight", rows_to_json(layer.weight) }, { "bias", vector_to_json(layer.bias) } });
+  return Json { { "type", "nn" }, { "input_mean", vector_to_json(p.input_mean) },
+    { "input_scale", vector_to_json(p.input_scale) },
+    { "output_mean", vector_to_json(p.output_mean) },
+    { "output_scale", vector_to_json(p.output_scale) }, { "layers", std::move(layers) } };
+}
+
+// ---- reading ---------------------------------------------------------------------------------
+
+/// Array of finite numbers of length `size` (any length if size < 0).
+VecX read_vector(const JsonObject& o, const std::string& key, Eigen::Index size = -1) {
+  const std::vector<double> v = o.numbers(key);
+  if (size >= 0 && Eigen::Index(v.size()) != size) {
+    o.fail(key, "expected " + std::to_string(size) + " numbers, got " + std::to_string(v.size()));
+  }
+  return Eigen::Map<const VecX>(v.data(), Eigen::Index(v.size()));
+}
+
+/// Array of rows, each an array of finite numbers; `rows`/`cols` < 0 accept any count (but all
+/// rows must have the same length). An empty array is a 0 × max(cols, 0) matrix.
+MatX read_rows(const JsonObject& o, const std::string& key, Eigen::Index rows, Eigen::Index cols) {
+  if (!o.has(key))
+    o.fail(key, "missing required field");
+  const Json& v = o.json().at(key);
+  if (!v.is_array())
+    o.fail(key, "expected an array of rows, got " + describe_json(v));
+  if (rows >= 0 && Eigen::Index(v.size()) != rows) {
+    o.fail(key, "expected " + std::to_string(rows) + " rows, got " + std::to_string(v.size()));
+  }
+  const Eigen::Index n = Eigen::Index(v.size());
+  Eigen::Index width = cols;
+  if (width < 0)
+    width = n > 0 && v[0].is_array() ? Eigen::Index(v[0].size()) : 0;
+  MatX m(n, width);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const std::string row_key = key + "[" + std::to_string(i) + "]";
+    const Json& row = v[std::size_t(i)];
+    if (!row.is_array() || Eigen::Index(row.size()) != width) {
+      o.fail(row_key,
+          "expected an array of " + std::to_string(width) + " numbers, got " + describe_json(row));
+    }
+    for (Eigen::Index j = 0; j < width; ++j) {
+      const Json& e = row[std::size_t(j)];
+      if (!e.is_number() || !std::isfinite(e.get<double>())) {
+        o.fail(row_key + "[" + std::to_string(j) + "]",
+            "expected a finite number, got " + describe_json(e));
+      }
+      m(i, j) = e.get<double>();
+    }
+  }
+  return m;
+}
+
+/// Run a correction constructor; its InputError("rbf_correction.weights", ...) is re-thrown
+/// naming the file and the JSON field ("learned.json: correction.weights").
+template <typename Make> auto construct(const JsonObject& o, Make&& make) {
+  try {
+    return make();
+  } catch (const InputError& e) {
+    const std::string& where = e.where();
+    const std::size_t dot = where.find('.');
+    const std::string field = dot == std::string::npos ? std::string() : where.substr(dot + 1);
+    const std::string what = e.what();
+    o.fail(field, where.empty() ? what : what.substr(std::min(what.size(), where.size() + 2)));
+  }
+}
+
+std::shared_ptr<const material::Correction> rbf_from_json(const JsonObject& o) {
+  o.reject_unknown_keys({ "type", "epsilon", "centres", "weights", "own_slope", "other_slope",
+      "constant", "damping_weights", "damping_slope", "damping_constant", "damping_tangent",
+      "damping_floor" });
+  material::RbfCorrection::Parameters p;
+  p.epsilon = o.number("epsilon");
+  p.centres = read_rows(o, "centres", -1, 3);
+  p.weights = read_vector(o, "weights", p.centres.rows());
+  p.own_slope = o.number("own_slope", 0.0);
+  p.other_slope = o.number("other_slope", 0.0);
+  p.constant = o.number("constant", 0.0);
+  if (o.has("damping_weights")) {
+    p.damping_weights = read_vector(o, "damping_weights");
+    if (p.damping_weights.size() != 0 && p.damping_weights.size() != p.centres.rows()) {
+      o.fail("damping_weights",
+          "expected none or one per centre (" + std::to_string(p.centres.rows()) + "), got "
+              + std::to_string(p.damping_weights.size()));
+    }
+  }
+  p.damping_slope = o.number("damping_slope", 0.0);
+  p.damping_constant = o.number("damping_constant", 0.0);
+  const bool damped
+      = p.damping_weights.size() > 0 || p.damping_slope != 0 || p.damping_constant != 0;
+  if (o.has("damping_tangent"))
+    p.damping_tangent = read_rows(o, "damping_tangent", 3, 3);
+  else if (damped)
+    o.fail("damping_tangent", "missing required field (the damping correction needs it)");
+  if (o.has("damping_floor") && !o.json().at("damping_floor").is_null())
+    p.damping_floor = o.number("damping_floor");
+  return construct(
+      o, [&] { return std::make_shared<const material::RbfCorrection>(std::move(p)); });
+}
+
+std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
+  o.reject_unknown_keys(
+      { "type", "input_mean", "input_scale", "output_mean", "output_scale", "layers" });
+  material::NnCorrection::Parameters p;
+  p.input_mean = read_vector(o, "input_mean", 6);
+  p.input_scale = read_vector(o, "input_scale", 6);
+  p.output_mean = read_vector(o, "output_mean", 3);
+  p.output_scale = read_vector(o, "output_scale", 3);
+  const auto layers = o.objects("layers");
+  if (layers.empty())
+    o.fail("layers", "expected at least one layer");
+  Eigen::Index inputs = 6;
+  for (const JsonObject& l : layers) {
+    l.reject_unknown_keys({ "weight", "bias" });
+    material::NnCorrection::Layer layer;
+    layer.weight = read_rows(l, "weight", -1, inputs);
+    layer.bias = read_vector(l, "bias", layer.weight.rows());
+    inputs = layer.weight.rows();
+    p.layers.push_back(std::move(layer));
+  }
+  return construct(o, [&] { return std::make_shared<const material::NnCorrection>(std::move(p)); });
+}
+
+} // namespace
+
+Json correction_to_json(const material::Correction& correction) {
+  if (const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&correction))
+    return rbf_to_json(*rbf);
+  if (const auto* nn = dynamic_cast<const material::NnCorrection*>(&correction))
+    return nn_to_json(*nn);
+  throw InputError("material file",
+      "a correction of kind \"" + correction.name()
+          + "\" cannot be saved (only \"rbf\" and \"nn\" can)");
+}
+
+std::shared_ptr<const material::Correction> correction_from_json(const JsonObject& object) {
+  const std::string type = object.choice("type", { "rbf", "nn" });
+  return type == "rbf" ? rbf_from_json(object) : nn_from_json(object);
+}
+
+std::string describe_correction(const material::Correction& correction) {
+  if (const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&correction)) {
+    std::string s = "rbf, " + std::to_string(rbf->num_centres()) + " centres";
+    if (rbf->parameters().damping_weights.size() > 0)
+      s += ", with damping correction";
+    return s;
+  }
+  if (const auto* nn = dynamic_cast<const material::NnCorrection*>(&correction)) {
+    std::string s = "nn, 6";
+    for (const auto& layer : nn->parameters().layers) {
+      s += '-';
+      s += std::to_string(layer.weight.rows());
+    }
+    return s;
+  }
+  return correction.name();
+}
+
+std::string describe_material_model(const fem::MaterialModel& model) {
+  std::string s = model.elastic ? model.elastic->name() : std::string("(no elastic model)");
+  if (model.correction)
+    s += " + correction (" + describe_correction(*model.correction) + ")";
+  return s;
+}
+
+MaterialFile parse_material_file(const Json& json, const std::string& file) {
+  const JsonObject root(json, file);
+  check_format(root, k_format_kind, k_format_version);
+  root.reject_unknown_keys({ "format", "material", "correction", "training" });
+  MaterialFile out;
+  out.material = root.object("material").json();
+  (void)parse_material(root.object("material")); // validate now, naming this file
+  if (root.has("correction") && !root.json().at("correction").is_null())
+    out.correction = correction_from_json(root.object("correction"));
+  if (root.has("training"))
+    out.training = root.object("training").json();
+  return out;
+}
+
+MaterialFile read_material_file(const std::filesystem::path& path) {
+  return parse_material_file(read_json_file(path), path.string());
+}
+
+Json material_file_to_json(const MaterialFile& file) {
+  Json out = { { "format", std::string(k_format_kind) + "/" + std::to_string(k_format_version) },
+    { "material", file.material } };
+  out["correction"] = file.correction ? correction_to_json(*file.correction) : Json(nullptr);
+  out["training"] = file.training;
+  return out;
+}
+
+void write_material_file(const std::filesystem::path& path, const MaterialFile& file) {
+  const Json json = material_file_to_json(file);
+  // What we write must read back: validate the whole document under the target's name.
+  (void)parse_material_file(json, path.string());
+  write_json_file(path, json);
+}
+
+fem::MaterialModel material_model(const MaterialFile& file, const std::string& source) {
+  fem::MaterialModel model = parse_material(JsonObject(file.material, source, "material"));
+  model.correction = file.correction;
+  return model;
+}
+
+namespace {
+
+/// The material file a scene's "material" string refers to (resolved against base_dir), or
+/// nothing for an inline material object.
+std::optional<std::filesystem::path> referenced_material(
+    const JsonObject& scene, const std::filesystem::path& base_dir) {
+  if (!scene.has("material") || !scene.json().at("material").is_string())
+    return std::nullopt;
+  std::filesystem::path p = scene.string("material");
+  if (p.is_relative())
+    p = base_dir / p;
+  if (!std::filesystem::is_regular_file(p))
+    scene.fail("material", "material file " + p.string() + " does not exist");
+  return p;
+}
+
+} // namespace
+
+MaterialFile scene_material(const JsonObject& scene, const std::filesystem::path& base_dir) {
+  if (const auto path = referenced_material(scene, base_dir))
+    return read_material_file(*path);
+  MaterialFile out;
+  out.material = scene.object("material").json();
+  return out;
+}
+
+fem::MaterialModel scene_material_model(
+    const JsonObject& scene, const std::filesystem::path& base_dir) {
+  if (const auto path = referenced_material(scene, base_dir))
+    return material_model(read_material_file(*path), path->string());
+  return parse_material(scene.object("material"));
+}
+
+} // namespace elastolearn::io

@@ -1,0 +1,198 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/sim/run_simulation.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace elastolearn::learn {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+/// The scene with the observed (not already prescribed) vertices following their data.
+sim::Scene constrained_scene(const sim::Scene& scene, const observe::Observation& observed) {
+  sim::Scene out = scene;
+  const auto prescribed = scene.prescribed_vertices();
+  auto tracked = std::make_shared<sim::TrackedVertices>();
+  std::vector<int> rows;
+  for (int j = 0; j < observed.num_observed(); ++j)
+    if (!std::binary_search(prescribed.begin(), prescribed.end(), observed.vertex_ids[j])) {
+      tracked->vertices.push_back(observed.vertex_ids[j]);
+      rows.push_back(j);
+    }
+  if (tracked->vertices.empty()) return out;
+  tracked->dt = observed.dt;
+  tracked->start_time = observed.start_time;
+  tracked->positions.reserve(observed.positions.size());
+  for (const auto& frame : observed.positions) {
+    Positions p(static_cast<Eigen::Index>(rows.size()), 3);
+    for (size_t i = 0; i < rows.size(); ++i) p.row(static_cast<Eigen::Index>(i)) = frame.row(rows[i]);
+    tracked->positions.push_back(std::move(p));
+  }
+  out.tracked = std::move(tracked);
+  return out;
+}
+
+std::vector<int> free_vertices(const sim::Scene& scene) {
+  const auto prescribed = scene.prescribed_vertices();
+  std::vector<int> out;
+  for (int v = 0; v < scene.mesh.num_vertices(); ++v)
+    if (!std::binary_search(prescribed.begin(), prescribed.end(), v)) out.push_back(v);
+  return out;
+}
+
+std::vector<Positions> as_positions(const std::vector<VecX>& frames) {
+  std::vector<Positions> out;
+  out.reserve(frames.size());
+  for (const auto& x : frames) out.emplace_back(unflatten(x));
+  return out;
+}
+
+template <typename T> std::vector<T> without_first(const std::vector<T>& v) { return {v.begin() + 1, v.end()}; }
+
+} // namespace
+
+void LearningOptions::validate() const {
+  if (max_iterations < 0) throw InputError("learn.max_iterations", "must be ≥ 0");
+  if (patience < 1) throw InputError("learn.patience", "must be ≥ 1");
+  if (centres < 1) throw InputError("learn.centres", "must be ≥ 1");
+  pod.validate();
+  space_time.validate();
+  rbf.validate();
+  reconstruction.validate();
+  stretch_samples.validate();
+}
+
+sim::Scene with_correction(const sim::Scene& scene, std::shared_ptr<const material::Correction> correction) {
+  sim::Scene out = scene;
+  out.material.correction = std::move(correction);
+  return out;
+}
+
+ForwardRun simulate_positions(const sim::Scene& scene, const ProgressCallback& progress) {
+  ForwardRun run;
+  run.positions.reserve(static_cast<size_t>(scene.frames) + 1);
+  const auto report = sim::run_simulation(
+      scene,
+      [&](int frame, double, const VecX& x, const VecX& v) {
+        if (frame == 0) run.initial_velocity = v;
+        run.positions.push_back(x);
+      },
+      progress);
+  run.completed = report.completed;
+  run.message = report.message;
+  if (!run.completed) run.positions.clear();
+  return run;
+}
+
+bool run_learning(const sim::Scene& scene, const observe::Observation& observed, const LearningOptions& options,
+                  LearningState& state, const LearningCallbacks& callbacks) {
+  options.validate();
+  scene.validate();
+  if (scene.material.correction) throw InputError("material", "the nominal scene must not carry a correction already");
+  observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, "observations");
+  auto interrupted = [&] { return callbacks.interrupted && callbacks.interrupted(); };
+
+  RbfFitOptions rbf = options.rbf;
+  rbf.damping_tangent = material::rest_principal_tangent(*scene.material.elastic);
+  // α₁ + Δα₁ ≥ 0: the learned damping may cancel the nominal one, never turn negative.
+  rbf.damping_floor = 0.0;
+  const ReconstructionMesh reconstruction_mesh(scene.mesh);
+  const std::vector<int> basis_vertices = free_vertices(scene);
+  const sim::Scene tracked_scene = constrained_scene(scene, observed);
+  TrajectoryPhysics nominal_physics(scene);
+
+  while (!state.finished) {
+    if (interrupted()) return false;
+    IterationRecord record;
+    record.iteration = state.next_iteration;
+    LearningState next = state; // committed only once the iteration is complete
+    const sim::Scene current = with_correction(scene, state.correction);
+
+    // 1. Forward simulation with C_k: the convergence signal.
+    auto t0 = Clock::now();
+    const ForwardRun forward = simulate_positions(current, callbacks.progress);
+    record.seconds_forward = seconds_since(t0);
+    record.forward_completed = forward.completed;
+    if (!forward.completed && record.iteration == 0)
+      throw InputError("scene", "the nominal model's forward simulation failed: " + forward.message);
+    const double error = forward.completed ? observation_error(forward.positions, observed).rms
+                                           : std::numeric_limits<double>::infinity();
+    if (forward.completed) record.forward_error = observation_error(forward.positions, observed);
+    if (forward.completed && (next.best_error < 0 || error < next.best_error)) {
+      next.best = state.correction;
+      next.best_error = error;
+      next.best_iteration = record.iteration;
+      next.iterations_without_improvement = 0;
+    } else {
+      ++next.iterations_without_improvement;
+    }
+    if (!forward.completed || next.iterations_without_improvement >= options.patience ||
+        record.iteration >= options.max_iterations) {
+      next.finished = true;
+    }
+    if (!next.finished) {
+      if (interrupted()) return false;
+      // 2. POD basis of the forward simulation.
+      t0 = Clock::now();
+      const PodBasis basis = pod_basis(as_positions(forward.positions), scene.mesh.rest_positions(), basis_vertices,
+                                       options.pod);
+      record.modes = basis.num_modes();
+      record.seconds_pod = seconds_since(t0);
+
+      // 3. Constrained forward simulation: the starting trajectory (falls back to the forward one).
+      t0 = Clock::now();
+      ForwardRun constrained = simulate_positions(with_correction(tracked_scene, state.correction), callbacks.progress);
+      const std::vector<VecX>& origin = constrained.completed ? constrained.positions : forward.positions;
+      record.seconds_constrained = seconds_since(t0);
+      if (interrupted()) return false;
+
+      // 4. Sparse reduced space-time optimisation.
+      t0 = Clock::now();
+      TrajectoryPhysics physics(current);
+      const SpaceTimeResult optimized = optimize_space_time(physics, basis.modes, origin, forward.initial_velocity,
+                                                            observed, options.space_time, callbacks.progress);
+      record.space_time_initial = optimized.initial_objective;
+      record.space_time_objective = optimized.objective;
+      record.space_time_iterations = optimized.iterations;
+      record.control_force_rms = optimized.physics_rms;
+      record.seconds_space_time = seconds_since(t0);
+      if (interrupted()) return false;
+
+      // 5–6. Control forces → the total force the correction must produce (nominal residual),
+      // centres by k-means, stress reconstruction.
+      t0 = Clock::now();
+      const auto targets = trajectory_residuals(nominal_physics, optimized.positions, forward.initial_velocity);
+      const auto velocities = finite_difference_velocities(optimized.positions, forward.initial_velocity, scene.dt);
+      const MatX stretches =
+          stretch_views(collect_stretches(reconstruction_mesh, optimized.positions, options.stretch_samples));
+      KMeansOptions kmeans_options;
+      kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(stretches.rows()));
+      kmeans_options.seed = options.seed + static_cast<std::uint64_t>(record.iteration);
+      const KMeansResult clusters = kmeans(stretches, kmeans_options);
+      const RbfDesign design(clusters.centres, rbf);
+      const StressReconstructionResult reconstructed = reconstruct_rbf_correction(
+          reconstruction_mesh, physics.dofs(), design, without_first(optimized.positions), without_first(velocities),
+          without_first(targets), options.reconstruction);
+      record.centres = design.num_centres();
+      record.correction_misfit = reconstructed.misfit.rms_residual;
+      record.correction_target = reconstructed.misfit.rms_target;
+      record.seconds_reconstruction = seconds_since(t0);
+      next.correction = std::make_shared<material::RbfCorrection>(reconstructed.correction);
+    }
+    next.next_iteration = record.iteration + 1;
+    next.history.push_back(record);
+    if (interrupted()) return false;
+    state = std::move(next);
+    if (callbacks.iteration) callbacks.iteration(record);
+    if (callbacks.checkpoint) callbacks.checkpoint(state);
+  }
+  return true;
+}
+
+} // namespace elastolearn::learn

@@ -1,0 +1,108 @@
+#pragma once
+/// \file The learning loop of paper 000 (§3, Fig. 2; DESIGN.md "The learning loop"): from
+/// observed vertex trajectories, learn an RBF correction N(F̂, Ḟ̂) of a nominal material so that
+/// forward simulation reproduces the observations. Each iteration k:
+///   1. forward-simulate with the current correction C_k; its error against the observations is
+///      the convergence signal (the best C_k so far is kept);
+///   2. POD basis Φ of that simulation (§5.1);
+///   3. constrained forward simulation: observed vertices follow their data (Eqs. 6–8);
+///   4. sparse reduced space-time optimisation from it (Eqs. 2–4, space_time.hpp);
+///   5. control forces (Eq. 5) and stress reconstruction (Eqs. 10–13): the new correction's
+///      nodal forces must equal the nominal model's residual along the optimised trajectory;
+///   6. RBF centres re-clustered (k-means) over the trajectory's stretches each iteration.
+/// The loop stops when the forward error has not improved for `patience` iterations, or after
+/// `max_iterations` corrections. Every stage is deterministic, and an iteration depends only on
+/// the current correction, so a run resumed from a checkpoint reaches the same result.
+#include <elastolearn/core/progress.hpp>
+#include <elastolearn/learn/kmeans.hpp>
+#include <elastolearn/learn/pod_basis.hpp>
+#include <elastolearn/learn/rbf_fit.hpp>
+#include <elastolearn/learn/space_time.hpp>
+#include <elastolearn/learn/stress_reconstruction.hpp>
+#include <elastolearn/learn/trajectory_error.hpp>
+#include <elastolearn/observe/observation.hpp>
+#include <elastolearn/sim/scene.hpp>
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace elastolearn::learn {
+
+struct LearningOptions {
+  int max_iterations = 8; ///< corrections computed at most
+  int patience = 2;       ///< stop after this many iterations without a better forward error
+  PodOptions pod;         ///< reduced basis (max_modes, frame window and stride)
+  SpaceTimeOptions space_time;
+  int centres = 40;       ///< RBF kernels m (k-means clusters)
+  RbfFitOptions rbf;      ///< ε, polynomial tails, damping part, regularisation
+  StressReconstructionOptions reconstruction;
+  StretchSampleOptions stretch_samples; ///< samples for k-means
+  std::uint64_t seed = 1; ///< k-means seeding
+  /// Throws InputError("learn.<field>", ...) for an out-of-range field.
+  void validate() const;
+};
+
+/// What one iteration measured. Times in seconds.
+struct IterationRecord {
+  int iteration = 0;                ///< k (0: the nominal model)
+  ErrorSummary forward_error;       ///< of C_k's forward simulation at the observed vertices [m]
+  bool forward_completed = true;    ///< false if C_k's forward simulation diverged
+  double control_force_rms = 0;     ///< √(mean r²) of the optimised trajectory [N]
+  double space_time_initial = 0;    ///< E at the constrained simulation
+  double space_time_objective = 0;  ///< E after optimisation
+  int space_time_iterations = 0;
+  int modes = 0;
+  int centres = 0;
+  double correction_misfit = 0;     ///< RMS force misfit of C_{k+1} against its targets [N]
+  double correction_target = 0;     ///< RMS of those targets [N]
+  double seconds_forward = 0, seconds_pod = 0, seconds_constrained = 0, seconds_space_time = 0,
+         seconds_reconstruction = 0;
+  double seconds_total() const {
+    return seconds_forward + seconds_pod + seconds_constrained + seconds_space_time + seconds_reconstruction;
+  }
+};
+
+/// Everything needed to continue a run: the checkpoint.
+struct LearningState {
+  int next_iteration = 0;                                     ///< k of the next forward simulation
+  std::shared_ptr<const material::RbfCorrection> correction;  ///< C_k (null = nominal)
+  std::shared_ptr<const material::RbfCorrection> best;        ///< best so far (null = nominal)
+  double best_error = -1;                                     ///< its RMS forward error [m] (−1: none yet)
+  int best_iteration = -1;
+  int iterations_without_improvement = 0;
+  bool finished = false;
+  std::vector<IterationRecord> history;
+};
+
+struct LearningCallbacks {
+  ProgressCallback progress;                                ///< within long stages
+  std::function<void(const IterationRecord&)> iteration;    ///< after each iteration (log a line)
+  std::function<void(const LearningState&)> checkpoint;     ///< after each iteration (save)
+  std::function<bool()> interrupted;                        ///< polled between stages
+};
+
+/// Run (or continue, from `state`) the loop for `scene` (the nominal model: its material must
+/// not carry a correction) against `observed` (T + 1 frames = scene.frames + 1, same dt).
+/// On return `state.best` is the learned correction (null if nothing beat the nominal model).
+/// Returns false if interrupted (state is then the last checkpoint's). Throws InputError for
+/// invalid inputs.
+bool run_learning(const sim::Scene& scene, const observe::Observation& observed, const LearningOptions& options,
+                  LearningState& state, const LearningCallbacks& callbacks = {});
+
+/// The scene with `correction` attached to its material.
+sim::Scene with_correction(const sim::Scene& scene, std::shared_ptr<const material::Correction> correction);
+
+/// All states of a forward simulation (flat 3n), and its initial velocity. Empty positions if it
+/// diverged before the end (message then says where).
+struct ForwardRun {
+  std::vector<VecX> positions;
+  VecX initial_velocity;
+  bool completed = false;
+  std::string message;
+};
+ForwardRun simulate_positions(const sim::Scene& scene, const ProgressCallback& progress = {});
+
+} // namespace elastolearn::learn

@@ -1,0 +1,276 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/fem/tet_element.hpp>
+#include <elastolearn/learn/nn_distillation.hpp>
+#include <elastolearn/material/principal_stress.hpp>
+#include <elastolearn/sim/run_simulation.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+namespace elastolearn::learn {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& field, const std::string& what) {
+  throw InputError("distillation." + field, what);
+}
+
+template <typename T> std::string str(T v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+/// Sample j in stable descending stretch order, rates and target permuted alike (as
+/// NnCorrection and RbfCorrection evaluate).
+void sorted_sample(const StressSamples& samples, Eigen::Index j, Vec3& s, Vec3& f, Vec3& y) {
+  const Vec3 s0 = samples.stretches.row(j).transpose();
+  std::array<int, 3> p { 0, 1, 2 };
+  std::stable_sort(p.begin(), p.end(), [&](int a, int b) { return s0[a] > s0[b]; });
+  for (int i = 0; i < 3; ++i) {
+    s[i] = s0[p[i]];
+    f[i] = samples.stretch_rates(j, p[i]);
+    y[i] = samples.targets(j, p[i]);
+  }
+}
+
+/// Row-wise mean and standard deviation of the columns `cols` of `m`; a (numerically) constant
+/// row gets scale 1 so that standardisation stays finite.
+void row_statistics(const MatX& m, const std::vector<int>& cols, VecX& mean, VecX& scale) {
+  const Eigen::Index rows = m.rows();
+  mean = VecX::Zero(rows);
+  for (int c : cols)
+    mean += m.col(c);
+  mean /= double(cols.size());
+  VecX var = VecX::Zero(rows);
+  for (int c : cols)
+    var += (m.col(c) - mean).cwiseAbs2();
+  var /= double(cols.size());
+  scale = var.cwiseSqrt();
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    if (!(scale[r] > 1e-12 * std::max(1.0, std::abs(mean[r]))))
+      scale[r] = 1;
+  }
+}
+
+/// RMS of ‖N(σ_j, ḟ_j) − y_j‖ over the columns `cols` of X (6 × n) and Y (3 × n).
+double rms_error(const material::Correction& n, const MatX& x, const MatX& y,
+    const std::vector<int>& cols) {
+  double sum = 0;
+  for (int c : cols) {
+    const Vec3 out = n.correction(x.col(c).head<3>(), x.col(c).tail<3>());
+    sum += (out - y.col(c)).squaredNorm();
+  }
+  return std::sqrt(sum / double(cols.size()));
+}
+
+} // namespace
+
+void DistillationSampleOptions::validate() const {
+  if (recorded_samples < 1)
+    fail("recorded_samples", "must be ≥ 1, got " + str(recorded_samples));
+  if (frame_stride < 1)
+    fail("frame_stride", "must be ≥ 1, got " + str(frame_stride));
+  if (jitter_copies < 0)
+    fail("jitter_copies", "must be ≥ 0, got " + str(jitter_copies));
+  if (!std::isfinite(stretch_jitter) || stretch_jitter < 0)
+    fail("stretch_jitter", "must be finite and ≥ 0, got " + str(stretch_jitter));
+  if (!std::isfinite(rate_jitter) || rate_jitter < 0)
+    fail("rate_jitter", "must be finite and ≥ 0, got " + str(rate_jitter));
+}
+
+void NnDistillationOptions::validate() const {
+  training.validate();
+  if (!(validation_fraction > 0 && validation_fraction < 1))
+    fail("validation_fraction", "must be in (0, 1), got " + str(validation_fraction));
+}
+
+StressSamples distillation_samples(std::span<const sim::Scene> scenes,
+    const material::Correction& teacher, const DistillationSampleOptions& o,
+    DistillationSampleReport* report_out) {
+  o.validate();
+  if (scenes.empty())
+    fail("scenes", "no scene to simulate");
+  DistillationSampleReport report;
+  const Eigen::Index k = o.recorded_samples;
+  Rows3 stretches(k, 3), rates(k, 3);
+  std::mt19937_64 rng(o.seed);
+  long seen = 0;
+  const std::shared_ptr<const material::Correction> shared_teacher = teacher.clone();
+
+  for (const sim::Scene& original : scenes) {
+    sim::Scene scene = original;
+    scene.material.correction = shared_teacher;
+    const std::vector<fem::TetRestData> rest = fem::precompute_rest_data(scene.mesh);
+    const Tets& tets = scene.mesh.tets();
+    // Reservoir sampling (Algorithm R) over all element states: state i replaces slot j < k with
+    // j uniform in [0, i]. Stretches and rates are computed only for the states kept.
+    const sim::FrameSink sink = [&](int frame, double, const VecX& x, const VecX& v) {
+      if (frame % o.frame_stride != 0)
+        return;
+      for (Eigen::Index e = 0; e < tets.rows(); ++e, ++seen) {
+        Eigen::Index slot = seen;
+        if (seen >= k) {
+          slot = static_cast<Eigen::Index>(uniform01(rng) * double(seen + 1));
+          if (slot >= k)
+            continue;
+        }
+        const Eigen::Vector4i tet = tets.row(e).transpose();
+        const auto& r = rest[static_cast<std::size_t>(e)];
+        const Mat3 F = fem::deformation_gradient(fem::gather_tet(x, tet), r);
+        const Mat3 F_rate = fem::deformation_gradient(fem::gather_tet(v, tet), r);
+        const material::PrincipalFrame pf = material::principal_frame(F);
+        stretches.row(slot) = pf.stretches.transpose();
+        rates.row(slot) = material::stretch_rates(pf, F_rate).transpose();
+      }
+    };
+    const sim::SimulationReport run = sim::run_simulation(scene, sink);
+    if (run.completed)
+      ++report.scenes_completed;
+    else
+      report.messages.push_back(scene.name + ": " + run.message);
+  }
+  report.states_seen = seen;
+  const Eigen::Index recorded = std::min<Eigen::Index>(k, seen);
+  if (recorded == 0)
+    fail("scenes", "the simulations recorded no element state");
+  report.recorded = static_cast<int>(recorded);
+
+  // Jittered copies around the recorded states.
+  const Eigen::Index total = recorded * (1 + o.jitter_copies);
+  StressSamples out;
+  out.stretches.resize(total, 3);
+  out.stretch_rates.resize(total, 3);
+  out.targets.resize(total, 3);
+  out.stretches.topRows(recorded) = stretches.topRows(recorded);
+  out.stretch_rates.topRows(recorded) = rates.topRows(recorded);
+  const double rate_rms = std::sqrt(rates.topRows(recorded).squaredNorm() / double(3 * recorded));
+  const double rate_sigma = o.rate_jitter * rate_rms;
+  for (Eigen::Index j = recorded; j < total; ++j) {
+    const Eigen::Index src = j % recorded;
+    for (int i = 0; i < 3; ++i) {
+      out.stretches(j, i) = stretches(src, i) + o.stretch_jitter * standard_normal(rng);
+      out.stretch_rates(j, i) = rates(src, i) + rate_sigma * standard_normal(rng);
+    }
+  }
+  report.jittered = static_cast<int>(total - recorded);
+  // Stored in descending stretch order (a jitter may swap two stretches), then the teacher.
+  for (Eigen::Index j = 0; j < total; ++j) {
+    Vec3 s, f, unused;
+    out.targets.row(j).setZero();
+    sorted_sample(out, j, s, f, unused);
+    out.stretches.row(j) = s.transpose();
+    out.stretch_rates.row(j) = f.transpose();
+    out.targets.row(j) = teacher.correction(s, f).transpose();
+  }
+  if (!out.targets.allFinite())
+    fail("teacher", "the teacher correction returned a non-finite value");
+  if (report_out)
+    *report_out = std::move(report);
+  return out;
+}
+
+StressSamples distillation_samples(const sim::Scene& scene, std::span<const double> motion_scales,
+    const material::Correction& teacher, const DistillationSampleOptions& options,
+    DistillationSampleReport* report) {
+  const double one = 1.0;
+  const std::vector<sim::Scene> scenes
+      = scaled_motions(scene, motion_scales.empty() ? std::span<const double>(&one, 1) : motion_scales);
+  return distillation_samples(std::span<const sim::Scene>(scenes), teacher, options, report);
+}
+
+std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const double> scales) {
+  std::vector<sim::Scene> out;
+  for (double a : scales) {
+    if (!std::isfinite(a))
+      fail("motion_scales", "contains a non-finite factor " + str(a));
+    sim::Scene s = scene;
+    s.name = scene.name + "_x" + str(a);
+    s.initial.velocity *= a;
+    s.initial.angular_velocity *= a;
+    for (auto& l : s.initial.static_loads)
+      l.total_force *= a;
+    for (auto& l : s.loads)
+      l.total_force *= a;
+    for (auto& m : s.keyframes) {
+      m.amplitude *= a;
+      for (Vec3& offset : m.offsets)
+        offset *= a;
+    }
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+NnDistillationResult distill_nn_correction(
+    const StressSamples& samples, const NnDistillationOptions& o) {
+  o.validate();
+  const Eigen::Index n = samples.stretches.rows();
+  if (samples.stretch_rates.rows() != n || samples.targets.rows() != n) {
+    fail("samples",
+        str(n) + " stretch samples but " + str(samples.stretch_rates.rows())
+            + " stretch rates and " + str(samples.targets.rows()) + " targets");
+  }
+  if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite()
+      || !samples.targets.allFinite()) {
+    fail("samples", "contain a non-finite value");
+  }
+  // Columns are samples, in the sorted order the network sees.
+  MatX x(6, n), y(3, n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    Vec3 s, f, t;
+    sorted_sample(samples, j, s, f, t);
+    x.col(j) << s, f;
+    y.col(j) = t;
+  }
+  std::vector<int> order(static_cast<std::size_t>(n));
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(o.training.seed + 0x5bd1e995ULL);
+  shuffle_in_place(order, rng);
+  const auto n_valid = static_cast<std::size_t>(std::llround(o.validation_fraction * double(n)));
+  if (n_valid < 2 || order.size() - n_valid < 2) {
+    fail("samples",
+        str(n) + " samples leave fewer than 2 in the training or validation split "
+            + "(validation_fraction " + str(o.validation_fraction) + ")");
+  }
+  std::vector<int> valid(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n_valid));
+  std::vector<int> train(order.begin() + static_cast<std::ptrdiff_t>(n_valid), order.end());
+  // Training in sample order keeps the split independent of the shuffle inside train_mlp.
+  std::sort(valid.begin(), valid.end());
+  std::sort(train.begin(), train.end());
+
+  VecX in_mean, in_scale, out_mean, out_scale;
+  row_statistics(x, train, in_mean, in_scale);
+  row_statistics(y, train, out_mean, out_scale);
+  const auto standardised = [&](const MatX& m, const VecX& mean, const VecX& scale,
+                                const std::vector<int>& cols) {
+    MatX r(m.rows(), static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t c = 0; c < cols.size(); ++c)
+      r.col(static_cast<Eigen::Index>(c)) = (m.col(cols[c]) - mean).cwiseQuotient(scale);
+    return r;
+  };
+  const MlpTrainingResult trained = train_mlp(standardised(x, in_mean, in_scale, train),
+      standardised(y, out_mean, out_scale, train), standardised(x, in_mean, in_scale, valid),
+      standardised(y, out_mean, out_scale, valid), o.training);
+
+  material::NnCorrection::Parameters p;
+  p.input_mean = in_mean;
+  p.input_scale = in_scale;
+  p.output_mean = out_mean;
+  p.output_scale = out_scale;
+  p.layers = fold_batch_norm(trained.network);
+  NnDistillationResult result { material::NnCorrection(std::move(p)), trained.report };
+  result.training_samples = static_cast<int>(train.size());
+  result.validation_samples = static_cast<int>(valid.size());
+  result.training_rms = rms_error(result.correction, x, y, train);
+  result.validation_rms = rms_error(result.correction, x, y, valid);
+  result.target_rms = std::sqrt(y.squaredNorm() / double(n));
+  return result;
+}
+
+} // namespace elastolearn::learn

@@ -1,0 +1,97 @@
+#pragma once
+/// \file Distillation of a learned correction (the RBF of the learning loop) into the network
+/// correction of paper 000 §6.2: "We use the learned RBF parametric model and run many
+/// simulations while recording principal stretches and stretch rates of elements", then train
+/// the 6 → 6 → 6 → 3 network (learn/mlp_training.hpp) on the teacher's outputs at those states.
+/// Rationale and measured numbers: docs/learning.md ("Neural-network correction").
+#include <elastolearn/learn/mlp_training.hpp>
+#include <elastolearn/learn/rbf_fit.hpp>
+#include <elastolearn/material/nn_correction.hpp>
+#include <elastolearn/sim/scene.hpp>
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace elastolearn::learn {
+
+struct DistillationSampleOptions {
+  /// Element states (one element at one frame) kept over all scenes: a uniform random subsample
+  /// (reservoir sampling, so memory stays O(recorded_samples)). ≥ 1.
+  int recorded_samples = 25000;
+  int frame_stride = 1; ///< record every frame_stride-th frame (frame 0 = initial state); ≥ 1
+  /// Jittered copies per recorded state, to cover its neighbourhood (total samples
+  /// = recorded · (1 + jitter_copies)). ≥ 0.
+  int jitter_copies = 1;
+  double stretch_jitter = 0.02; ///< standard deviation of the Gaussian stretch jitter [-]
+  /// Standard deviation of the rate jitter, relative to the RMS recorded stretch rate [-].
+  double rate_jitter = 0.25;
+  std::uint64_t seed = 1; ///< subsampling and jitter (same seed, same samples)
+  /// Throws InputError("distillation.<field>", ...) for an out-of-range field.
+  void validate() const;
+};
+
+struct DistillationSampleReport {
+  long states_seen = 0; ///< element states over all recorded frames of all scenes
+  int recorded = 0; ///< kept after subsampling
+  int jittered = 0; ///< jittered samples added
+  int scenes_completed = 0; ///< simulations that ran all their frames
+  std::vector<std::string> messages; ///< why a simulation stopped early (its frames are kept)
+};
+
+/// Simulate every scene with `teacher` as its correction (replacing any correction the scene
+/// has), record each element's principal stretches and stretch rates (sorted descending, rates
+/// permuted alike) at every frame_stride-th frame, keep a uniform random subsample of
+/// `recorded_samples` states over all scenes, add `jitter_copies` Gaussian-jittered copies of each,
+/// and evaluate the teacher on all of them: targets = N_teacher(σ, ḟ) [Pa], which for the RBF
+/// of the learning loop is the elastic RBF plus the Δα₁ damping stress (paper §6.2).
+/// A simulation that diverges contributes the frames before it (reported). Deterministic.
+/// Throws InputError for bad options, no scenes, or no recorded state at all.
+StressSamples distillation_samples(std::span<const sim::Scene> scenes,
+    const material::Correction& teacher, const DistillationSampleOptions& options,
+    DistillationSampleReport* report = nullptr);
+
+/// Convenience: distillation_samples over scaled_motions(scene, motion_scales), i.e. the scene's
+/// motion at several amplitudes (e.g. {0.5, 1, 1.5}); an empty list means {1}.
+StressSamples distillation_samples(const sim::Scene& scene, std::span<const double> motion_scales,
+    const material::Correction& teacher, const DistillationSampleOptions& options,
+    DistillationSampleReport* report = nullptr);
+
+/// Copies of `scene` whose motion is scaled by each factor: initial velocity and angular
+/// velocity, static (initial) loads, point loads and keyframe amplitudes/offsets are multiplied
+/// by the factor (gravity and the mesh are kept), and the copy's name gets a "_x<factor>" suffix.
+/// Training on several amplitudes covers more of the stretch space than the one observed motion.
+/// Throws InputError("distillation.motion_scales", ...) for a non-finite factor.
+std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const double> scales);
+
+struct NnDistillationOptions {
+  MlpTrainingOptions training; ///< architecture, Adam, early stopping, seed
+  double validation_fraction = 0.2; ///< held-out share of the samples, in (0, 1)
+  /// Throws InputError("distillation.<field>" or "mlp_training.<field>", ...).
+  void validate() const;
+};
+
+struct NnDistillationResult {
+  material::NnCorrection correction; ///< the folded network with its standardisation
+  MlpTrainingReport training; ///< losses in standardised units, history, epochs, time
+  int training_samples = 0;
+  int validation_samples = 0;
+  double training_rms = 0; ///< √(mean ‖N_nn − N_teacher‖²) over the training split [Pa]
+  double validation_rms = 0; ///< idem over the validation split [Pa]
+  double target_rms = 0; ///< √(mean ‖N_teacher‖²) over all samples [Pa]
+  double relative_training_rms() const { return training_rms / target_rms; }
+  double relative_validation_rms() const { return validation_rms / target_rms; }
+};
+
+/// Train the network correction on `samples` (targets = the teacher's outputs): sort each sample
+/// descending (as NnCorrection evaluates), split off a random validation set, standardise inputs
+/// and outputs with the training split's mean and standard deviation (a constant column gets
+/// scale 1), train (train_mlp), fold batch norm, and measure the RMS errors of the resulting
+/// NnCorrection in Pa. Deterministic for a given seed.
+/// Throws InputError for bad options or samples (empty, mismatched, non-finite, fewer than
+/// 2 samples in a split).
+NnDistillationResult distill_nn_correction(
+    const StressSamples& samples, const NnDistillationOptions& options);
+
+} // namespace elastolearn::learn

@@ -1,0 +1,391 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/core/interrupt.hpp>
+#include <elastolearn/learn/parameter_fit.hpp>
+#include <elastolearn/material/rayleigh_damping.hpp>
+#include <elastolearn/material/spline_edited.hpp>
+#include <elastolearn/sim/run_simulation.hpp>
+
+#include <oneapi/tbb/parallel_for.h>
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace elastolearn::learn {
+
+namespace {
+
+constexpr double kPoissonMax = 0.49; ///< upper end of the fitted ν range (0, 0.49)
+constexpr std::array<const char*, 4> kParameterNames = { "young", "poisson", "alpha0", "alpha1" };
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// The change of variables u ↔ p that keeps every trial physically valid.
+struct ParameterTransform {
+  double floor0 = 0, floor1 = 0;
+
+  double to_u(FitParameter which, const NominalParameters& p) const {
+    switch (which) {
+    case FitParameter::Young: return std::log(p.young);
+    case FitParameter::Poisson: {
+      const double s = p.poisson / kPoissonMax;
+      return std::log(s / (1 - s));
+    }
+    case FitParameter::Alpha0: return std::log(p.alpha0 + floor0);
+    case FitParameter::Alpha1: return std::log(p.alpha1 + floor1);
+    }
+    return 0;
+  }
+  void set(FitParameter which, double u, NominalParameters& p) const {
+    switch (which) {
+    case FitParameter::Young: p.young = std::exp(u); break;
+    case FitParameter::Poisson: p.poisson = kPoissonMax / (1 + std::exp(-u)); break;
+    case FitParameter::Alpha0: p.alpha0 = std::max(0.0, std::exp(u) - floor0); break;
+    case FitParameter::Alpha1: p.alpha1 = std::max(0.0, std::exp(u) - floor1); break;
+    }
+  }
+};
+
+/// One forward simulation compared with the observation.
+struct Evaluation {
+  bool completed = false;
+  std::string message;  ///< the simulation's reason when not completed
+  VecX residual;        ///< x_sim − x_obs at the observed vertices, frame-major, (frames+1)·k·3
+  double cost = std::numeric_limits<double>::infinity(); ///< ‖residual‖²
+  double max_error = 0; ///< max over (frame, vertex) of the error norm [m]
+
+  double rms(int samples) const { return std::sqrt(cost / samples); }
+};
+
+Evaluation evaluate(const sim::Scene& base, material::ElasticModelType type,
+    const NominalParameters& parameters, const observe::Observation& obs, int frames) {
+  sim::Scene scene = scene_with_parameters(base, type, parameters);
+  scene.frames = frames;
+  const int k = obs.num_observed();
+  Evaluation e;
+  e.residual.setZero(static_cast<Eigen::Index>(frames + 1) * k * 3);
+  double max_sq = 0;
+  const auto sink = [&](int frame, double, const VecX& x, const VecX&) {
+    const Positions& observed = obs.positions[static_cast<size_t>(frame)];
+    for (int j = 0; j < k; ++j) {
+      const Vec3 d = x.segment<3>(3 * obs.vertex_ids[static_cast<size_t>(j)])
+          - observed.row(j).transpose();
+      e.residual.segment<3>((static_cast<Eigen::Index>(frame) * k + j) * 3) = d;
+      max_sq = std::max(max_sq, d.squaredNorm());
+    }
+  };
+  const sim::SimulationReport report = sim::run_simulation(scene, sink);
+  e.completed = report.completed && e.residual.allFinite();
+  if (!e.completed) {
+    e.message = report.message.empty() ? "non-finite positions" : report.message;
+    return e;
+  }
+  e.cost = e.residual.squaredNorm();
+  e.max_error = std::sqrt(max_sq);
+  return e;
+}
+
+std::string describe(const NominalParameters& p) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "E %.5g Pa, nu %.4f, alpha0 %.4g 1/s, alpha1 %.4g s", p.young,
+      p.poisson, p.alpha0, p.alpha1);
+  return buf;
+}
+
+std::string describe(const ParameterFitIteration& it) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+      "iteration %d: rms %.4g m, max %.4g m | %s | lambda %.2g, %d rejected | %.1f s",
+      it.iteration, it.rms_error, it.max_error, describe(it.parameters).c_str(), it.lambda,
+      it.rejected_steps, it.seconds);
+  return buf;
+}
+
+void check_start(const NominalParameters& p, const std::vector<FitParameter>& fitted) {
+  if (!(p.young > 0 && std::isfinite(p.young)))
+    throw InputError("young", "start value must be positive and finite, got " + std::to_string(p.young));
+  if (!(p.poisson > -1 && p.poisson < 0.5))
+    throw InputError("poisson", "start value must be in (-1, 0.5), got " + std::to_string(p.poisson));
+  if (!(p.alpha0 >= 0 && std::isfinite(p.alpha0)))
+    throw InputError("alpha0", "start value must be >= 0 and finite, got " + std::to_string(p.alpha0));
+  if (!(p.alpha1 >= 0 && std::isfinite(p.alpha1)))
+    throw InputError("alpha1", "start value must be >= 0 and finite, got " + std::to_string(p.alpha1));
+  const bool fits_poisson
+      = std::find(fitted.begin(), fitted.end(), FitParameter::Poisson) != fitted.end();
+  if (fits_poisson && !(p.poisson > 0 && p.poisson < kPoissonMax))
+    throw InputError("poisson",
+        "start value " + std::to_string(p.poisson)
+            + " is outside the fitted range (0, 0.49): start inside it or do not fit poisson");
+}
+
+} // namespace
+
+std::string to_string(FitParameter parameter) {
+  return kParameterNames[static_cast<size_t>(parameter)];
+}
+
+FitParameter fit_parameter_from_string(std::string_view name, const std::string& where) {
+  for (size_t i = 0; i < kParameterNames.size(); ++i)
+    if (name == kParameterNames[i]) return static_cast<FitParameter>(i);
+  throw InputError(where,
+      "unknown parameter '" + std::string(name) + "' (valid: young, poisson, alpha0, alpha1)");
+}
+
+std::vector<FitParameter> fit_parameters_from_string(std::string_view list, const std::string& where) {
+  std::vector<FitParameter> result;
+  size_t begin = 0;
+  while (begin <= list.size()) {
+    size_t end = list.find(',', begin);
+    if (end == std::string_view::npos) end = list.size();
+    std::string_view token = list.substr(begin, end - begin);
+    while (!token.empty() && token.front() == ' ') token.remove_prefix(1);
+    while (!token.empty() && token.back() == ' ') token.remove_suffix(1);
+    if (token.empty()) throw InputError(where, "empty parameter name in '" + std::string(list) + "'");
+    const FitParameter p = fit_parameter_from_string(token, where);
+    if (std::find(result.begin(), result.end(), p) != result.end())
+      throw InputError(where, "parameter '" + std::string(token) + "' is listed twice");
+    result.push_back(p);
+    begin = end + 1;
+  }
+  return result;
+}
+
+std::string to_string(FitStop stop) {
+  switch (stop) {
+  case FitStop::Converged: return "converged";
+  case FitStop::MaxIterations: return "max_iterations";
+  case FitStop::NoImprovingStep: return "no_improving_step";
+  case FitStop::StartDiverged: return "start_diverged";
+  case FitStop::Interrupted: return "interrupted";
+  }
+  return "unknown";
+}
+
+sim::Scene scene_with_parameters(
+    const sim::Scene& scene, material::ElasticModelType type, const NominalParameters& parameters) {
+  const material::Lame lame = material::Lame::from_young_poisson(parameters.young, parameters.poisson);
+  sim::Scene result = scene;
+  if (type == material::ElasticModelType::SplineEdited) {
+    const auto* edited = dynamic_cast<const material::SplineEditedModel*>(scene.material.elastic.get());
+    if (!edited)
+      throw InputError("material.model",
+          "spline_edited parameters need a scene whose material is spline-edited (it holds the spline)");
+    result.material.elastic = std::make_shared<material::SplineEditedModel>(
+        edited->base_type(), lame, edited->region(), edited->spline());
+  } else {
+    result.material.elastic = material::make_elastic_model(type, lame);
+  }
+  result.material.damping
+      = std::make_shared<material::RayleighDamping>(parameters.alpha0, parameters.alpha1);
+  return result;
+}
+
+void ParameterFitOptions::validate() const {
+  if (parameters.empty()) throw InputError("fit.parameters", "choose at least one parameter to fit");
+  for (size_t i = 0; i < parameters.size(); ++i)
+    for (size_t j = i + 1; j < parameters.size(); ++j)
+      if (parameters[i] == parameters[j])
+        throw InputError("fit.parameters", "'" + to_string(parameters[i]) + "' is listed twice");
+  if (max_iterations < 1)
+    throw InputError("fit.max_iterations", "must be >= 1, got " + std::to_string(max_iterations));
+  if (frames == 0 || frames < -1)
+    throw InputError("fit.frames", "must be >= 1 (or -1 for all), got " + std::to_string(frames));
+  if (!(tolerance >= 0 && tolerance < 1))
+    throw InputError("fit.tolerance", "must be in [0, 1), got " + std::to_string(tolerance));
+  if (!(initial_lambda > 0 && std::isfinite(initial_lambda)))
+    throw InputError("fit.initial_lambda", "must be positive, got " + std::to_string(initial_lambda));
+  if (max_rejections < 1)
+    throw InputError("fit.max_rejections", "must be >= 1, got " + std::to_string(max_rejections));
+  if (!(finite_difference_step > 0 && finite_difference_step < 1))
+    throw InputError("fit.finite_difference_step",
+        "must be in (0, 1), got " + std::to_string(finite_difference_step));
+  if (!(max_step > 0 && std::isfinite(max_step)))
+    throw InputError("fit.max_step", "must be positive, got " + std::to_string(max_step));
+  if (!std::isfinite(error_tolerance))
+    throw InputError("fit.error_tolerance", "must be finite, got " + std::to_string(error_tolerance));
+  if (!std::isfinite(alpha0_floor) || !std::isfinite(alpha1_floor))
+    throw InputError("fit.alpha_floor", "damping floors must be finite");
+}
+
+ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticModelType type,
+    const NominalParameters& start, const observe::Observation& obs,
+    const ParameterFitOptions& options, const ProgressCallback& progress) {
+  const auto t0 = Clock::now();
+  options.validate();
+  check_start(start, options.parameters);
+  obs.validate(scene.mesh.num_vertices(), -1, scene.dt, "observation");
+  if (obs.num_frames() < 2)
+    throw InputError("observation: /observed/positions", "needs at least 2 frames to fit a motion");
+  const int frames = options.frames < 0 ? obs.num_frames() - 1 : options.frames;
+  if (frames > obs.num_frames() - 1)
+    throw InputError("fit.frames",
+        std::to_string(frames) + " steps requested but the observation has only "
+            + std::to_string(obs.num_frames() - 1) + " (frames 0.." + std::to_string(obs.num_frames() - 1) + ")");
+
+  const double duration = frames * scene.dt;
+  const ParameterTransform transform{
+    options.alpha0_floor > 0 ? options.alpha0_floor : 1e-2 / duration,
+    options.alpha1_floor > 0 ? options.alpha1_floor : 1e-2 * scene.dt };
+  const auto& fitted = options.parameters;
+  const int p = static_cast<int>(fitted.size());
+  const int samples = (frames + 1) * obs.num_observed();
+  const double error_floor = options.error_tolerance > 0
+      ? options.error_tolerance
+      : 1e-10 * scene.mesh.bounding_box_diagonal();
+  const bool parallel = options.parallel && 3 * scene.mesh.num_vertices() <= kParallelFitMaxDofs;
+
+  ParameterFitReport report;
+  report.initial = report.fitted = start;
+  report.frames = frames;
+
+  auto record = [&](int iteration, const Evaluation& e, double lambda, int rejected) {
+    ParameterFitIteration it;
+    it.iteration = iteration;
+    it.parameters = report.fitted;
+    it.rms_error = e.rms(samples);
+    it.max_error = e.max_error;
+    it.lambda = lambda;
+    it.rejected_steps = rejected;
+    it.seconds = seconds_since(t0);
+    report.history.push_back(it);
+    if (progress) progress(iteration, options.max_iterations, describe(it));
+  };
+  auto finish = [&](const Evaluation& e, FitStop stop, std::string message) {
+    report.final_rms = e.rms(samples);
+    report.final_max = e.max_error;
+    report.stop = stop;
+    report.message = std::move(message);
+    report.seconds = seconds_since(t0);
+    return report;
+  };
+
+  Evaluation current = evaluate(scene, type, start, obs, frames);
+  ++report.simulations;
+  if (!current.completed) {
+    report.diverged = 1;
+    report.seconds = seconds_since(t0);
+    report.stop = interrupt_requested() ? FitStop::Interrupted : FitStop::StartDiverged;
+    report.message = "the simulation with the start parameters failed: " + current.message;
+    return report;
+  }
+  report.initial_rms = current.rms(samples);
+  report.initial_max = current.max_error;
+  double lambda = options.initial_lambda;
+  record(0, current, lambda, 0);
+
+  const double h = options.finite_difference_step;
+  for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
+    if (current.rms(samples) <= error_floor)
+      return finish(current, FitStop::Converged, "the observation is matched to round-off");
+    report.iterations = iteration;
+    // Transformed coordinates of the current parameters (re-derived each time, so a damping
+    // clamped at 0 sits at log(floor) where its forward difference is informative).
+    VecX u(p);
+    for (int i = 0; i < p; ++i) u[i] = transform.to_u(fitted[i], report.fitted);
+
+    // Forward-difference Jacobian: one simulation per parameter (backwards if forwards diverges).
+    MatX J = MatX::Zero(current.residual.size(), p);
+    std::vector<int> runs(static_cast<size_t>(p), 0), failures(static_cast<size_t>(p), 0);
+    const auto column = [&](int i) {
+      for (const double step : { h, -h }) {
+        NominalParameters trial = report.fitted;
+        transform.set(fitted[i], u[i] + step, trial);
+        const Evaluation e = evaluate(scene, type, trial, obs, frames);
+        ++runs[static_cast<size_t>(i)];
+        if (e.completed) {
+          J.col(i) = (e.residual - current.residual) / step;
+          return;
+        }
+        ++failures[static_cast<size_t>(i)];
+        if (interrupt_requested()) return;
+      }
+    };
+    if (parallel) {
+      tbb::parallel_for(0, p, column);
+    } else {
+      for (int i = 0; i < p; ++i) column(i);
+    }
+    for (int i = 0; i < p; ++i) {
+      report.simulations += runs[static_cast<size_t>(i)];
+      report.diverged += failures[static_cast<size_t>(i)];
+    }
+    if (interrupt_requested())
+      return finish(current, FitStop::Interrupted, "interrupted; the best parameters so far are kept");
+
+    const MatX JtJ = J.transpose() * J;
+    const VecX gradient = J.transpose() * current.residual;
+    // Columns whose simulations all diverged (or that do not influence the motion) stay fixed.
+    const double diag_max = JtJ.diagonal().maxCoeff();
+    if (!(diag_max > 0))
+      return finish(current, FitStop::NoImprovingStep,
+          "no fitted parameter changes the observed motion (or every perturbed simulation diverged)");
+    std::vector<bool> active(static_cast<size_t>(p));
+    for (int i = 0; i < p; ++i) active[static_cast<size_t>(i)] = JtJ(i, i) > 1e-14 * diag_max;
+
+    int rejected = 0;
+    std::string last_failure;
+    bool accepted = false;
+    double improvement = 0;
+    while (!accepted) {
+      MatX A = JtJ;
+      for (int i = 0; i < p; ++i) {
+        if (active[static_cast<size_t>(i)]) {
+          A(i, i) *= 1 + lambda;
+        } else {
+          A.row(i).setZero();
+          A.col(i).setZero();
+          A(i, i) = 1;
+        }
+      }
+      VecX rhs = -gradient;
+      for (int i = 0; i < p; ++i)
+        if (!active[static_cast<size_t>(i)]) rhs[i] = 0;
+      VecX delta = A.ldlt().solve(rhs);
+      const double largest = delta.cwiseAbs().maxCoeff();
+      if (largest > options.max_step) delta *= options.max_step / largest;
+
+      NominalParameters trial = report.fitted;
+      for (int i = 0; i < p; ++i) transform.set(fitted[i], u[i] + delta[i], trial);
+      Evaluation e = evaluate(scene, type, trial, obs, frames);
+      ++report.simulations;
+      if (interrupt_requested())
+        return finish(current, FitStop::Interrupted, "interrupted; the best parameters so far are kept");
+      if (e.completed && e.cost < current.cost) {
+        improvement = (current.cost - e.cost) / current.cost;
+        current = std::move(e);
+        report.fitted = trial;
+        lambda = std::max(lambda / 3, 1e-12);
+        accepted = true;
+      } else {
+        if (!e.completed) ++report.diverged;
+        last_failure = e.completed ? "" : e.message;
+        lambda *= e.completed ? 4 : 10; // a diverged trial was a long step: shrink harder
+        if (++rejected >= options.max_rejections) {
+          record(iteration, current, lambda, rejected);
+          return finish(current, FitStop::NoImprovingStep,
+              std::to_string(rejected) + " trial steps in a row did not lower the error"
+                  + (last_failure.empty() ? std::string() : " (last: " + last_failure + ")"));
+        }
+      }
+    }
+    record(iteration, current, lambda, rejected);
+    if (improvement < options.tolerance) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "relative improvement %.2g below the tolerance %.2g",
+          improvement, options.tolerance);
+      return finish(current, FitStop::Converged, buf);
+    }
+  }
+  return finish(current, FitStop::MaxIterations,
+      "reached " + std::to_string(options.max_iterations) + " iterations");
+}
+
+} // namespace elastolearn::learn

@@ -1,0 +1,224 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/learn/space_time.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+namespace elastolearn::learn {
+
+void SpaceTimeOptions::validate() const {
+  if (!(position_weight > 0 && std::isfinite(position_weight)))
+    throw InputError("space_time.position_weight", "must be a positive number, got " + std::to_string(position_weight));
+  if (max_iterations < 0) throw InputError("space_time.max_iterations", "must be ≥ 0");
+  if (!(tolerance >= 0)) throw InputError("space_time.tolerance", "must be ≥ 0");
+}
+
+/// Everything that does not change between Gauss–Newton iterations, and the work buffers.
+struct SpaceTimeProblem::Impl {
+  TrajectoryPhysics& physics;
+  const observe::Observation& observed;
+  VecX v0;
+  int steps = 0;                 ///< T
+  int modes = 0;                 ///< r
+  double h = 0;
+  double scale = 0;              ///< s = h²/m̄
+  double lambda = 0;
+  std::vector<int> free;         ///< free dofs
+  MatX free_basis;               ///< Φ restricted to the free dofs
+  MatX inertia;                  ///< Φᵀ M Φ / h² (r × r)
+  std::vector<int> observed_dofs; ///< observed free dofs
+  std::vector<int> observed_row; ///< their index in the flattened k×3 data frames
+  MatX observed_basis;           ///< S Φ
+  fem::SystemMatrix stiffness, damping;
+  MatX stiffness_basis, damping_basis;
+  VecX residual, residual_free;
+
+  Impl(TrajectoryPhysics& p, const observe::Observation& o) : physics(p), observed(o) {}
+
+  /// S x_i − s_i.
+  VecX position_error(const VecX& x, int frame) const {
+    VecX e(static_cast<Eigen::Index>(observed_dofs.size()));
+    const double* d = observed.positions[frame].data();
+    for (size_t i = 0; i < observed_dofs.size(); ++i) e[static_cast<Eigen::Index>(i)] = x[observed_dofs[i]] - d[observed_row[i]];
+    return e;
+  }
+  /// r_i into residual / residual_free; x_{−1} = x_0 − h v_0.
+  void residual_at(const std::vector<VecX>& x, int i, const VecX& before) {
+    physics.residual(i == 1 ? before : x[i - 2], x[i - 1], x[i], i * h, residual);
+    physics.dofs().restrict_into(residual, residual_free);
+  }
+};
+
+SpaceTimeProblem::SpaceTimeProblem(TrajectoryPhysics& physics, ConstRef<MatX> basis, int steps, const VecX& v0,
+                                   const observe::Observation& observed, double position_weight)
+    : m_impl(std::make_unique<Impl>(physics, observed)) {
+  Impl& s = *m_impl;
+  const int n3 = physics.dofs().num_dofs();
+  s.v0 = v0;
+  s.steps = steps;
+  s.modes = static_cast<int>(basis.cols());
+  s.h = physics.dt();
+  s.lambda = position_weight;
+  if (steps < 1) throw InputError("space_time", "the trajectory needs at least two states");
+  if (basis.rows() != n3 || s.modes < 1)
+    throw InputError("space_time", "basis must have " + std::to_string(n3) + " rows and at least one column");
+  if (v0.size() != n3) throw InputError("space_time", "initial velocity of wrong size");
+  if (observed.num_frames() != steps + 1)
+    throw InputError("observations", "have " + std::to_string(observed.num_frames()) + " frames, the trajectory " +
+                                         std::to_string(steps + 1));
+  s.free = physics.dofs().free_dofs();
+  s.free_basis.resize(static_cast<Eigen::Index>(s.free.size()), s.modes);
+  for (size_t i = 0; i < s.free.size(); ++i) s.free_basis.row(static_cast<Eigen::Index>(i)) = basis.row(s.free[i]);
+  const VecX free_masses = physics.dofs().restrict(physics.dof_masses());
+  s.scale = s.h * s.h / free_masses.mean();
+  s.inertia = s.free_basis.transpose() * free_masses.asDiagonal() * s.free_basis / (s.h * s.h);
+  for (int j = 0; j < observed.num_observed(); ++j) {
+    const int v = observed.vertex_ids[j];
+    if (v < 0 || 3 * v + 2 >= n3) throw InputError("observations", "vertex id " + std::to_string(v) + " out of range");
+    if (physics.dofs().is_prescribed_vertex(v)) continue;
+    for (int c = 0; c < 3; ++c) {
+      s.observed_dofs.push_back(3 * v + c);
+      s.observed_row.push_back(3 * j + c);
+    }
+  }
+  s.observed_basis.resize(static_cast<Eigen::Index>(s.observed_dofs.size()), s.modes);
+  for (size_t i = 0; i < s.observed_dofs.size(); ++i)
+    s.observed_basis.row(static_cast<Eigen::Index>(i)) = basis.row(s.observed_dofs[i]);
+  s.stiffness = physics.make_matrix();
+  s.damping = physics.make_matrix();
+}
+
+SpaceTimeProblem::~SpaceTimeProblem() = default;
+int SpaceTimeProblem::modes() const { return m_impl->modes; }
+int SpaceTimeProblem::steps() const { return m_impl->steps; }
+
+SpaceTimeProblem::Value SpaceTimeProblem::evaluate(const std::vector<VecX>& x) {
+  Impl& s = *m_impl;
+  ELASTOLEARN_CHECK(static_cast<int>(x.size()) == s.steps + 1, "trajectory length");
+  Value value;
+  const VecX before = s.physics.state_before_start(x[0], s.v0);
+  for (int i = 1; i <= s.steps; ++i) {
+    s.residual_at(x, i, before);
+    value.residual_squares += s.residual_free.squaredNorm();
+    value.physics += 0.5 * (s.scale * (s.free_basis.transpose() * s.residual_free)).squaredNorm();
+  }
+  for (int i = 0; i <= s.steps; ++i) value.position_squares += s.position_error(x[i], i).squaredNorm();
+  value.position = 0.5 * s.lambda * s.lambda * value.position_squares;
+  return value;
+}
+
+void SpaceTimeProblem::assemble(const std::vector<VecX>& x, BlockBandedMatrix& normal, VecX& gradient) {
+  Impl& s = *m_impl;
+  const int T = s.steps, r = s.modes;
+  ELASTOLEARN_CHECK(normal.blocks() == T + 1 && normal.block_size() == r, "normal matrix shape");
+  normal.set_zero();
+  gradient.setZero(static_cast<Eigen::Index>(T + 1) * r);
+  const VecX before = s.physics.state_before_start(x[0], s.v0);
+  MatX blocks[3];
+  for (int i = 1; i <= T; ++i) {
+    s.residual_at(x, i, before);
+    s.physics.jacobians(s.stiffness, s.damping);
+    s.stiffness_basis.noalias() = s.stiffness.matrix() * s.free_basis;
+    s.damping_basis.noalias() = s.damping.matrix() * s.free_basis;
+    // ∂(s Φᵀ r_i)/∂z for z_i, z_{i−1}, z_{i−2}: s Φᵀ (M/h² + K + D/h) Φ, s Φᵀ (−2M/h² − D/h) Φ, s Φᵀ M Φ/h².
+    blocks[0].noalias() = s.scale * (s.inertia + s.free_basis.transpose() * s.stiffness_basis);
+    blocks[1].noalias() = s.scale * (-2 * s.inertia - s.free_basis.transpose() * s.damping_basis / s.h);
+    blocks[2].noalias() = s.scale * s.inertia;
+    int count = 3;
+    if (i == 1) { // x_{−1} = x_0 − h v_0 moves with z_0
+      blocks[1] += blocks[2];
+      count = 2;
+    }
+    const VecX c = s.scale * (s.free_basis.transpose() * s.residual_free);
+    for (int a = 0; a < count; ++a) {
+      gradient.segment(static_cast<Eigen::Index>(i - a) * r, r).noalias() += blocks[a].transpose() * c;
+      for (int b = a; b < count; ++b) // block (i − a, i − b), row block ≥ column block
+        normal.block(i - a, i - b).noalias() += blocks[a].transpose() * blocks[b];
+    }
+  }
+  const double lambda2 = s.lambda * s.lambda;
+  const MatX position_normal = lambda2 * s.observed_basis.transpose() * s.observed_basis;
+  for (int i = 0; i <= T; ++i) {
+    normal.block(i, i) += position_normal;
+    gradient.segment(static_cast<Eigen::Index>(i) * r, r).noalias() +=
+        lambda2 * s.observed_basis.transpose() * s.position_error(x[i], i);
+  }
+}
+
+SpaceTimeResult optimize_space_time(TrajectoryPhysics& physics, ConstRef<MatX> basis, const std::vector<VecX>& origin,
+                                    const VecX& v0, const observe::Observation& observed,
+                                    const SpaceTimeOptions& options, const ProgressCallback& progress) {
+  options.validate();
+  const auto start_time = std::chrono::steady_clock::now();
+  const int T = static_cast<int>(origin.size()) - 1;
+  for (const auto& state : origin)
+    if (state.size() != basis.rows()) throw InputError("space_time", "origin state of wrong size");
+  SpaceTimeProblem problem(physics, basis, T, v0, observed, options.position_weight);
+  const int r = problem.modes();
+
+  SpaceTimeResult result;
+  result.positions = origin;
+  auto& x = result.positions;
+  SpaceTimeProblem::Value current = problem.evaluate(x);
+  result.initial_objective = current.total();
+
+  BlockBandedMatrix normal(T + 1, r);
+  BandedBlockCholesky cholesky;
+  VecX gradient;
+  std::vector<VecX> trial(x.size());
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    problem.assemble(x, normal, gradient);
+    // A tiny Levenberg shift keeps directions neither term sees from making JᵀJ singular.
+    double max_diagonal = 0;
+    for (int i = 0; i <= T; ++i) max_diagonal = std::max(max_diagonal, normal.block(i, i).diagonal().maxCoeff());
+    for (int i = 0; i <= T; ++i) normal.block(i, i).diagonal().array() += 1e-10 * max_diagonal;
+    cholesky.compute(normal);
+    VecX step = -gradient;
+    cholesky.solve_in_place(step);
+
+    // Backtracking line search on E.
+    bool accepted = false;
+    SpaceTimeProblem::Value candidate;
+    for (double alpha = 1; alpha > 1e-3; alpha *= 0.5) {
+      for (int i = 0; i <= T; ++i)
+        trial[i] = x[i] + alpha * (basis * step.segment(static_cast<Eigen::Index>(i) * r, r));
+      candidate = problem.evaluate(trial);
+      if (candidate.total() < current.total()) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    const double decrease = current.total() - candidate.total();
+    x.swap(trial);
+    current = candidate;
+    result.iterations = iteration + 1;
+    if (progress)
+      progress(iteration + 1, options.max_iterations,
+               "space-time E " + std::to_string(current.total()) + " (physics " + std::to_string(current.physics) +
+                   ", positions " + std::to_string(current.position) + ")");
+    if (decrease < options.tolerance * (current.total() + decrease)) break;
+  }
+  result.objective = current.total();
+  const double free_count = static_cast<double>(physics.dofs().num_free());
+  result.physics_rms = std::sqrt(current.residual_squares / (T * free_count));
+  const double observed_points = current.position_squares > 0 || observed.num_observed() > 0
+                                     ? static_cast<double>(observed.num_observed()) : 1.0;
+  result.position_rms = std::sqrt(current.position_squares / ((T + 1) * observed_points));
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  return result;
+}
+
+std::vector<VecX> trajectory_residuals(TrajectoryPhysics& physics, const std::vector<VecX>& positions, const VecX& v0) {
+  std::vector<VecX> out(positions.size());
+  if (positions.empty()) return out;
+  out[0] = VecX::Zero(positions[0].size());
+  const VecX before = physics.state_before_start(positions[0], v0);
+  for (size_t i = 1; i < positions.size(); ++i)
+    physics.residual(i == 1 ? before : positions[i - 2], positions[i - 1], positions[i],
+                     static_cast<double>(i) * physics.dt(), out[i]);
+  return out;
+}
+
+} // namespace elastolearn::learn

@@ -1,0 +1,332 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/learn/stress_reconstruction.hpp>
+#include <elastolearn/learn/stress_reconstruction_lsqr.hpp>
+
+#include <Eigen/Cholesky>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace elastolearn::learn {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& field, const std::string& what) {
+  throw InputError("stress_reconstruction." + field, what);
+}
+
+template <typename T> std::string str(T v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Element states of elements [begin, end) (serial; no allocation).
+void element_states_range(const ReconstructionMesh& mesh, const VecX& x, const VecX& v, int begin,
+    int end, std::vector<ElementState>& states) {
+  for (int e = begin; e < end; ++e) {
+    const fem::TetRestData& rest = mesh.rest[e];
+    const Eigen::Vector4i tet = mesh.tets.row(e).transpose();
+    ElementState& s = states[e];
+    s.frame = material::principal_frame(fem::deformation_gradient(fem::gather_tet(x, tet), rest));
+    s.stretch_rates = material::stretch_rates(
+        s.frame, fem::deformation_gradient(fem::gather_tet(v, tet), rest));
+  }
+}
+
+/// Free index of each element's 12 local dofs (−1 for prescribed).
+std::vector<std::array<int, 12>> element_free_rows(
+    const ReconstructionMesh& mesh, const fem::DofMap& dofs) {
+  std::vector<std::array<int, 12>> rows(mesh.num_tets());
+  for (int e = 0; e < mesh.num_tets(); ++e)
+    for (int a = 0; a < 4; ++a)
+      for (int c = 0; c < 3; ++c)
+        rows[e][3 * a + c] = dofs.free_index(3 * mesh.tets(e, a) + c);
+  return rows;
+}
+
+/// Per-thread work space of the normal-equation assembly.
+struct AssemblyScratch {
+  std::vector<ElementState> states;
+  MatX jt; ///< Jᵀ of one frame: unknowns × free dofs
+  RbfDesign::OutputMatrix outputs;             ///< A_e: 3 × unknowns
+  Eigen::Matrix<double, 12, Eigen::Dynamic> element_rows; ///< G_e A_e
+  VecX target;
+};
+
+/// Per-block sums (a block is a fixed range of frames, so the result is thread-count independent).
+struct BlockSums {
+  MatX normal; ///< lower triangle of Σ JᵀJ
+  VecX rhs; ///< Σ Jᵀ g
+};
+
+constexpr int k_frame_blocks = 16;
+
+} // namespace
+
+ReconstructionMesh::ReconstructionMesh(const mesh::TetMesh& mesh)
+    : rest(fem::precompute_rest_data(mesh))
+    , tets(mesh.tets())
+    , num_vertices(mesh.num_vertices()) { }
+
+ReconstructionMesh::ReconstructionMesh(
+    std::vector<fem::TetRestData> rest_data, Tets tet_indices, int n)
+    : rest(std::move(rest_data))
+    , tets(std::move(tet_indices))
+    , num_vertices(n) {
+  if (rest.size() != static_cast<size_t>(tets.rows()))
+    fail("mesh", str(rest.size()) + " rest data for " + str(tets.rows()) + " tets");
+  if (tets.size() > 0 && (tets.minCoeff() < 0 || tets.maxCoeff() >= n))
+    fail("mesh", "a tet index is outside [0, " + str(n) + ")");
+}
+
+void compute_element_states(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,
+    std::vector<ElementState>& states) {
+  states.resize(mesh.num_tets());
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, mesh.num_tets(), 256), [&](const tbb::blocked_range<int>& r) {
+        element_states_range(mesh, x, v, r.begin(), r.end(), states);
+      });
+}
+
+Eigen::Matrix<double, 12, 3> element_force_operator(
+    const fem::TetRestData& rest, const material::PrincipalFrame& frame) {
+  // f_a = −vol U diag(p̂) Vᵀ g_a = Σ_k p̂_k (−vol (v_k · g_a) u_k).
+  const Eigen::Matrix<double, 3, 4> vg = frame.V.transpose() * rest.gradients; // (v_k · g_a)
+  Eigen::Matrix<double, 12, 3> G;
+  for (int a = 0; a < 4; ++a)
+    for (int k = 0; k < 3; ++k)
+      G.block<3, 1>(3 * a, k) = (-rest.volume * vg(k, a)) * frame.U.col(k);
+  return G;
+}
+
+VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
+    const VecX& x, const VecX& v) {
+  const int m = mesh.num_tets();
+  std::vector<ElementState> states;
+  compute_element_states(mesh, x, v, states);
+  std::vector<Vec12> element_forces(m);
+  tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
+    for (int e = r.begin(); e < r.end(); ++e) {
+      const ElementState& s = states[e];
+      element_forces[e].noalias() = element_force_operator(mesh.rest[e], s.frame)
+          * correction.correction(s.frame.stretches, s.stretch_rates);
+    }
+  });
+  VecX f = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));
+  for (int e = 0; e < m; ++e)
+    for (int a = 0; a < 4; ++a)
+      f.segment<3>(3 * mesh.tets(e, a)) += element_forces[e].segment<3>(3 * a);
+  return f;
+}
+
+void StretchSampleOptions::validate() const {
+  if (frame_stride < 1)
+    throw InputError("stretch_samples.frame_stride", "must be ≥ 1, got " + str(frame_stride));
+  if (max_samples < 0)
+    throw InputError("stretch_samples.max_samples", "must be ≥ 0, got " + str(max_samples));
+}
+
+MatX collect_stretches(const ReconstructionMesh& mesh, const std::vector<VecX>& positions,
+    const StretchSampleOptions& options) {
+  options.validate();
+  detail::check_frames(mesh, nullptr, positions, nullptr, nullptr);
+  const std::vector<int> frames
+      = detail::selected_frames(int(positions.size()), options.frame_stride);
+  const Eigen::Index m = mesh.num_tets();
+  const Eigen::Index total = Eigen::Index(frames.size()) * m;
+  const Eigen::Index step = options.max_samples > 0
+      ? std::max<Eigen::Index>(1, (total + options.max_samples - 1) / options.max_samples)
+      : 1;
+  const Eigen::Index rows = (total + step - 1) / step;
+  MatX out(rows, 3);
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, rows, 1024),
+      [&](const tbb::blocked_range<Eigen::Index>& r) {
+        for (Eigen::Index i = r.begin(); i < r.end(); ++i) {
+          const Eigen::Index sample = i * step;
+          const int e = int(sample % m);
+          const VecX& x = positions[frames[sample / m]];
+          const Mat3 F = fem::deformation_gradient(
+              fem::gather_tet(x, mesh.tets.row(e).transpose()), mesh.rest[e]);
+          out.row(i) = material::principal_frame(F).stretches.transpose();
+        }
+      });
+  return out;
+}
+
+std::string reconstruction_method_name(ReconstructionMethod method) {
+  return method == ReconstructionMethod::lsqr ? "lsqr" : "normal_equations";
+}
+
+ReconstructionMethod reconstruction_method_from_name(
+    const std::string& name, const std::string& where) {
+  if (name == "normal_equations")
+    return ReconstructionMethod::normal_equations;
+  if (name == "lsqr")
+    return ReconstructionMethod::lsqr;
+  throw InputError(where, "unknown method '" + name + "' (expected normal_equations or lsqr)");
+}
+
+void StressReconstructionOptions::validate() const {
+  if (frame_stride < 1)
+    fail("frame_stride", "must be ≥ 1, got " + str(frame_stride));
+  if (!std::isfinite(lsqr_tolerance) || lsqr_tolerance <= 0)
+    fail("lsqr_tolerance", "must be finite and > 0, got " + str(lsqr_tolerance));
+  if (lsqr_max_iterations < 0)
+    fail("lsqr_max_iterations", "must be ≥ 0, got " + str(lsqr_max_iterations));
+}
+
+namespace detail {
+
+void check_frames(const ReconstructionMesh& mesh, const fem::DofMap* dofs,
+    const std::vector<VecX>& positions, const std::vector<VecX>* velocities,
+    const std::vector<VecX>* target_forces) {
+  const Eigen::Index n3 = 3 * Eigen::Index(mesh.num_vertices);
+  if (positions.empty())
+    fail("positions", "no frames");
+  if (dofs != nullptr && dofs->num_dofs() != n3)
+    fail("dofs", "the DofMap has " + str(dofs->num_dofs()) + " dofs, the mesh " + str(n3));
+  const std::array<std::pair<const char*, const std::vector<VecX>*>, 3> lists {
+    { { "positions", &positions }, { "velocities", velocities },
+        { "target_forces", target_forces } }
+  };
+  for (const auto& [name, list] : lists) {
+    if (list == nullptr)
+      continue;
+    if (list->size() != positions.size())
+      fail(name, str(list->size()) + " frames but " + str(positions.size()) + " positions");
+    for (size_t t = 0; t < list->size(); ++t) {
+      const VecX& f = (*list)[t];
+      if (f.size() != n3)
+        fail(std::string(name) + "[" + str(t) + "]",
+            "length " + str(f.size()) + ", expected 3n = " + str(n3));
+      if (!f.allFinite())
+        fail(std::string(name) + "[" + str(t) + "]", "contains a non-finite value");
+    }
+  }
+}
+
+std::vector<int> selected_frames(int count, int stride) {
+  std::vector<int> frames;
+  for (int t = 0; t < count; t += stride)
+    frames.push_back(t);
+  return frames;
+}
+
+} // namespace detail
+
+ForceMisfit correction_force_misfit(const ReconstructionMesh& mesh, const fem::DofMap& dofs,
+    const material::Correction& correction, const std::vector<VecX>& positions,
+    const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces, int frame_stride) {
+  if (frame_stride < 1)
+    fail("frame_stride", "must be ≥ 1, got " + str(frame_stride));
+  detail::check_frames(mesh, &dofs, positions, &velocities, &target_forces);
+  if (dofs.num_free() == 0)
+    fail("dofs", "no free degree of freedom");
+  const std::vector<int> frames = detail::selected_frames(int(positions.size()), frame_stride);
+  double residual = 0, target = 0;
+  VecX g, f;
+  for (int t : frames) {
+    dofs.restrict_into(target_forces[t], g);
+    dofs.restrict_into(correction_force(mesh, correction, positions[t], velocities[t]), f);
+    residual += (f - g).squaredNorm();
+    target += g.squaredNorm();
+  }
+  const double count = double(frames.size()) * (dofs.num_free() / 3.0);
+  return { std::sqrt(residual / count), std::sqrt(target / count), int(frames.size()) };
+}
+
+StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& mesh,
+    const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
+    const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
+    const StressReconstructionOptions& options) {
+  options.validate();
+  if (options.method == ReconstructionMethod::lsqr)
+    return reconstruct_rbf_correction_via_lsqr(
+        mesh, dofs, design, positions, velocities, target_forces, options);
+  detail::check_frames(mesh, &dofs, positions, &velocities, &target_forces);
+  const int rows = dofs.num_free();
+  if (rows == 0)
+    fail("dofs", "no free degree of freedom");
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<int> frames
+      = detail::selected_frames(int(positions.size()), options.frame_stride);
+  const std::vector<std::array<int, 12>> free_rows = element_free_rows(mesh, dofs);
+  const int m = mesh.num_tets();
+  const int u = design.num_unknowns();
+
+  // Frames in k_frame_blocks contiguous blocks; each block's sums are formed serially in frame
+  // order on one thread, and the blocks are added in block order.
+  const int blocks = std::min<int>(k_frame_blocks, int(frames.size()));
+  std::vector<BlockSums> sums(blocks);
+  tbb::enumerable_thread_specific<AssemblyScratch> scratch([&] {
+    AssemblyScratch s;
+    s.states.resize(m);
+    s.jt.resize(u, rows);
+    s.outputs.resize(3, u);
+    s.element_rows.resize(12, u);
+    return s;
+  });
+  tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
+    AssemblyScratch& s = scratch.local();
+    for (int b = r.begin(); b < r.end(); ++b) {
+      BlockSums& sum = sums[b];
+      sum.normal = MatX::Zero(u, u);
+      sum.rhs = VecX::Zero(u);
+      const size_t first = frames.size() * b / blocks, last = frames.size() * (b + 1) / blocks;
+      for (size_t i = first; i < last; ++i) {
+        const int t = frames[i];
+        element_states_range(mesh, positions[t], velocities[t], 0, m, s.states);
+        // Element e adds G_e A_e (12 × u) to the rows of its free dofs: its nodal forces are
+        // G_e N = G_e A_e x (A_e = design.output_matrix at the element's state).
+        s.jt.setZero();
+        for (int e = 0; e < m; ++e) {
+          const ElementState& st = s.states[e];
+          const Eigen::Matrix<double, 12, 3> G = element_force_operator(mesh.rest[e], st.frame);
+          design.output_matrix(st.frame.stretches, st.stretch_rates, s.outputs);
+          s.element_rows.noalias() = G * s.outputs;
+          for (int l = 0; l < 12; ++l) {
+            const int row = free_rows[e][l];
+            if (row >= 0) s.jt.col(row) += s.element_rows.row(l).transpose();
+          }
+        }
+        dofs.restrict_into(target_forces[t], s.target);
+        sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.jt);
+        sum.rhs.noalias() += s.jt * s.target;
+      }
+    }
+  });
+  MatX normal = MatX::Zero(u, u);
+  VecX rhs = VecX::Zero(u);
+  for (const BlockSums& sum : sums) {
+    normal += sum.normal;
+    rhs += sum.rhs;
+  }
+  normal.triangularView<Eigen::StrictlyUpper>() = normal.transpose();
+  const double assembly_seconds = seconds_since(start);
+
+  const auto solve_start = std::chrono::steady_clock::now();
+  VecX x = solve_regularised_normal_equations(std::move(normal), rhs, design.regularization_weights(), long(frames.size()));
+  material::RbfCorrection correction = design.correction(x);
+  const double solve_seconds = seconds_since(solve_start);
+
+  const auto misfit_start = std::chrono::steady_clock::now();
+  const ForceMisfit misfit = correction_force_misfit(
+      mesh, dofs, correction, positions, velocities, target_forces, options.frame_stride);
+  StressReconstructionResult result { std::move(correction), std::move(x), misfit, rows };
+  result.assembly_seconds = assembly_seconds;
+  result.solve_seconds = solve_seconds;
+  result.misfit_seconds = seconds_since(misfit_start);
+  return result;
+}
+
+} // namespace elastolearn::learn

@@ -1,0 +1,327 @@
+// Learned-material files: bit-exact round trips of RBF and NN corrections (parameters and the
+// evaluated correction), the nominal material and provenance kept, scenes that reference a
+// material file, and one InputError naming the file and field per kind of bad file.
+#include "io_test_util.hpp"
+
+#include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/scene_file.hpp>
+#include <elastolearn/material/analytic_correction.hpp>
+#include <elastolearn/material/nn_correction.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <limits>
+#include <random>
+
+using namespace elastolearn;
+using namespace elastolearn::io;
+using test::expect_input_error;
+using test::ScratchDir;
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace {
+
+/// Values that use every mantissa bit and span many magnitudes, so that any rounding in the
+/// text representation would show as a mismatch in an exact comparison.
+double awkward(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_int_distribution<int> e(-30, 30);
+  return u(rng) * std::pow(10.0, e(rng)) / 3.0;
+}
+
+template <typename M> void fill(M& m, std::mt19937& rng) {
+  for (Eigen::Index i = 0; i < m.size(); ++i)
+    m.data()[i] = awkward(rng);
+}
+
+material::RbfCorrection::Parameters rbf_parameters(int centres, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> stretch(0.7, 1.3);
+  material::RbfCorrection::Parameters p;
+  p.centres.resize(centres, 3);
+  for (Eigen::Index i = 0; i < p.centres.size(); ++i)
+    p.centres.data()[i] = stretch(rng) + 1e-15 / 7;
+  p.weights.resize(centres);
+  fill(p.weights, rng);
+  p.own_slope = awkward(rng);
+  p.other_slope = awkward(rng);
+  p.constant = awkward(rng);
+  p.damping_weights.resize(centres);
+  fill(p.damping_weights, rng);
+  p.damping_slope = awkward(rng);
+  p.damping_constant = awkward(rng);
+  fill(p.damping_tangent, rng);
+  p.damping_floor = -0.002 / 3;
+  p.epsilon = 1e-3 / 3;
+  return p;
+}
+
+material::NnCorrection::Parameters nn_parameters(unsigned seed) {
+  std::mt19937 rng(seed);
+  material::NnCorrection::Parameters p;
+  fill(p.input_mean, rng);
+  p.input_scale = p.input_scale.array() + 1.0 / 3.0;
+  fill(p.output_mean, rng);
+  p.output_scale << 1e5 / 3, 2e5 / 7, 3e5 / 11;
+  std::normal_distribution<double> g(0.0, 0.5);
+  const int widths[] = { 6, 6, 6, 3 };
+  for (int k = 0; k + 1 < 4; ++k) {
+    material::NnCorrection::Layer l;
+    l.weight.resize(widths[k + 1], widths[k]);
+    l.bias.resize(widths[k + 1]);
+    for (Eigen::Index i = 0; i < l.weight.size(); ++i)
+      l.weight.data()[i] = g(rng);
+    for (Eigen::Index i = 0; i < l.bias.size(); ++i)
+      l.bias[i] = g(rng);
+    p.layers.push_back(std::move(l));
+  }
+  return p;
+}
+
+const Json k_nominal = Json::parse(R"({"model": "corotated", "young": 35000, "poisson": 0.43,
+  "density": 1000, "damping": {"alpha0": 0.1, "alpha1": 0.002}})");
+
+/// The correction and its gradient agree bit for bit at a spread of states.
+void expect_same_function(const material::Correction& a, const material::Correction& b) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> s(0.6, 1.4), r(-2.0, 2.0);
+  for (int i = 0; i < 50; ++i) {
+    const Vec3 st(s(rng), s(rng), s(rng)), rate(r(rng), r(rng), r(rng));
+    EXPECT_EQ(a.correction(st, rate), b.correction(st, rate));
+    Mat3 ds_a, df_a, ds_b, df_b;
+    a.correction_gradient(st, rate, ds_a, df_a);
+    b.correction_gradient(st, rate, ds_b, df_b);
+    EXPECT_EQ(ds_a, ds_b);
+    EXPECT_EQ(df_a, df_b);
+  }
+}
+
+/// A valid file with an RBF correction as JSON, for tests that break one field.
+Json valid_rbf_file() {
+  MaterialFile f;
+  f.material = k_nominal;
+  f.correction = std::make_shared<material::RbfCorrection>(rbf_parameters(4, 1));
+  return material_file_to_json(f);
+}
+
+/// Parse `json` as "bad.json" and expect an InputError containing every one of `parts`.
+void expect_bad(const Json& json, const std::vector<std::string>& parts) {
+  expect_input_error([&] { parse_material_file(json, "bad.json"); }, parts);
+}
+
+} // namespace
+
+TEST(MaterialFile, RbfRoundTripIsBitExact) {
+  ScratchDir dir;
+  MaterialFile f;
+  f.material = k_nominal;
+  const auto original = std::make_shared<material::RbfCorrection>(rbf_parameters(17, 5));
+  f.correction = original;
+  f.training = { { "iterations", 7 }, { "forward_error", 0.0123 } };
+  write_material_file(dir / "learned.json", f);
+  EXPECT_EQ(dir.files(), std::vector<std::string> { "learned.json" }); // no temporary left
+  const MaterialFile g = read_material_file(dir / "learned.json");
+  EXPECT_EQ(g.material, f.material);
+  EXPECT_EQ(g.training, f.training);
+  const auto* back = dynamic_cast<const material::RbfCorrection*>(g.correction.get());
+  ASSERT_NE(back, nullptr);
+  const auto& p = original->parameters();
+  const auto& q = back->parameters();
+  EXPECT_EQ(p.centres, q.centres);
+  EXPECT_EQ(p.weights, q.weights);
+  EXPECT_EQ(p.own_slope, q.own_slope);
+  EXPECT_EQ(p.other_slope, q.other_slope);
+  EXPECT_EQ(p.constant, q.constant);
+  EXPECT_EQ(p.damping_weights, q.damping_weights);
+  EXPECT_EQ(p.damping_slope, q.damping_slope);
+  EXPECT_EQ(p.damping_floor, q.damping_floor);
+  EXPECT_EQ(p.damping_constant, q.damping_constant);
+  EXPECT_EQ(p.damping_tangent, q.damping_tangent);
+  EXPECT_EQ(p.epsilon, q.epsilon);
+  expect_same_function(*original, *back);
+}
+
+TEST(MaterialFile, RbfWithoutDampingFloorRoundTrips) {
+  // The default floor is −∞ ("no floor"), which JSON cannot hold: it travels as null.
+  auto p = rbf_parameters(3, 8);
+  p.damping_floor = -std::numeric_limits<double>::infinity();
+  MaterialFile f;
+  f.material = k_nominal;
+  f.correction = std::make_shared<material::RbfCorrection>(p);
+  const Json j = material_file_to_json(f);
+  EXPECT_TRUE(j["correction"]["damping_floor"].is_null());
+  const MaterialFile g = parse_material_file(Json::parse(j.dump()), "f.json");
+  const auto& q = dynamic_cast<const material::RbfCorrection&>(*g.correction).parameters();
+  EXPECT_EQ(q.damping_floor, -std::numeric_limits<double>::infinity());
+  expect_same_function(*f.correction, *g.correction);
+}
+
+TEST(MaterialFile, NnRoundTripIsBitExact) {
+  ScratchDir dir;
+  MaterialFile f;
+  f.material = k_nominal;
+  const auto original = std::make_shared<material::NnCorrection>(nn_parameters(9));
+  f.correction = original;
+  write_material_file(dir / "nn.json", f);
+  const MaterialFile g = read_material_file(dir / "nn.json");
+  const auto* back = dynamic_cast<const material::NnCorrection*>(g.correction.get());
+  ASSERT_NE(back, nullptr);
+  const auto& p = original->parameters();
+  const auto& q = back->parameters();
+  EXPECT_EQ(p.input_mean, q.input_mean);
+  EXPECT_EQ(p.input_scale, q.input_scale);
+  EXPECT_EQ(p.output_mean, q.output_mean);
+  EXPECT_EQ(p.output_scale, q.output_scale);
+  ASSERT_EQ(p.layers.size(), q.layers.size());
+  for (std::size_t k = 0; k < p.layers.size(); ++k) {
+    EXPECT_EQ(p.layers[k].weight, q.layers[k].weight) << "layer " << k;
+    EXPECT_EQ(p.layers[k].bias, q.layers[k].bias) << "layer " << k;
+  }
+  expect_same_function(*original, *back);
+  EXPECT_EQ(describe_correction(*back), "nn, 6-6-6-3");
+}
+
+TEST(MaterialFile, NominalOnlyFileGivesTheSceneMaterialModel) {
+  ScratchDir dir;
+  MaterialFile f;
+  f.material = k_nominal;
+  write_material_file(dir / "nominal.json", f);
+  const MaterialFile g = read_material_file(dir / "nominal.json");
+  EXPECT_EQ(g.correction, nullptr);
+  const fem::MaterialModel m = material_model(g, "nominal.json");
+  EXPECT_EQ(m.elastic->name(), "corotated");
+  EXPECT_EQ(m.correction, nullptr);
+  ASSERT_NE(m.damping, nullptr);
+  EXPECT_EQ(m.density, 1000.0);
+  // With a correction, the model carries that very object.
+  f.correction = std::make_shared<material::RbfCorrection>(rbf_parameters(3, 2));
+  EXPECT_EQ(material_model(f, "x.json").correction, f.correction);
+}
+
+TEST(MaterialFile, UnsavableCorrectionKindIsRefusedAndNothingIsWritten) {
+  ScratchDir dir;
+  MaterialFile f;
+  f.material = k_nominal;
+  f.correction = std::make_shared<material::AnalyticCorrection>(
+      material::AnalyticCorrection::Parameters { 1, 2, 3 });
+  expect_input_error([&] { write_material_file(dir / "a.json", f); }, { "analytic" });
+  f.correction = nullptr;
+  f.material["young"] = -1;
+  expect_input_error(
+      [&] { write_material_file(dir / "b.json", f); }, { "b.json", "material.young" });
+  EXPECT_TRUE(dir.files().empty());
+}
+
+TEST(MaterialFile, BadFilesNameTheFileAndField) {
+  Json j = valid_rbf_file();
+  EXPECT_NO_THROW(parse_material_file(j, "ok.json"));
+
+  j["format"] = "elastolearn-scene/1";
+  expect_bad(j, { "bad.json: format", "elastolearn-material/1" });
+
+  j = valid_rbf_file();
+  j["correction"].erase("weights");
+  expect_bad(j, { "bad.json: correction.weights", "missing" });
+
+  j = valid_rbf_file();
+  j["correction"]["weights"].erase(1); // 3 weights for 4 centres
+  expect_bad(j, { "bad.json: correction.weights", "expected 4 numbers" });
+
+  j = valid_rbf_file();
+  j["correction"]["centres"][2] = Json::array({ 1.0, 1.0 });
+  expect_bad(j, { "bad.json: correction.centres[2]", "3 numbers" });
+
+  j = valid_rbf_file();
+  j["correction"]["damping_weights"] = Json::array();
+  j["correction"].erase("damping_tangent");
+  expect_bad(j, { "bad.json: correction.damping_tangent", "missing" });
+
+  j = valid_rbf_file();
+  j["correction"]["damping_weights"].erase(0);
+  expect_bad(j, { "bad.json: correction.damping_weights" });
+
+  // JSON has no NaN: nlohmann writes a NaN as null, and a hand-edited "NaN" is invalid JSON.
+  j = valid_rbf_file();
+  j["correction"]["weights"][2] = std::nan("");
+  expect_bad(j, { "bad.json: correction.weights[2]", "finite" });
+  j = valid_rbf_file();
+  j["correction"]["weights"][2] = nullptr;
+  expect_bad(j, { "bad.json: correction.weights[2]", "null" });
+
+  j = valid_rbf_file();
+  j["correction"]["damping_floor"] = "low";
+  expect_bad(j, { "bad.json: correction.damping_floor", "number" });
+
+  j = valid_rbf_file();
+  j["correction"]["epsilon"] = -1.0;
+  expect_bad(j, { "bad.json: correction.epsilon" }); // the RbfCorrection's own check, renamed
+
+  j = valid_rbf_file();
+  j["correction"]["type"] = "spline";
+  expect_bad(j, { "bad.json: correction.type", "\"rbf\"" });
+
+  j = valid_rbf_file();
+  j["correction"]["wieghts"] = j["correction"]["weights"];
+  expect_bad(j, { "bad.json: correction.wieghts", "weights" });
+
+  j = valid_rbf_file();
+  j["material"]["poisson"] = 0.7;
+  expect_bad(j, { "bad.json: material.poisson" });
+
+  MaterialFile nn;
+  nn.material = k_nominal;
+  nn.correction = std::make_shared<material::NnCorrection>(nn_parameters(1));
+  j = material_file_to_json(nn);
+  j["correction"]["layers"][1]["weight"].erase(0); // 5 × 6 then a 6-input layer
+  j["correction"]["layers"][1]["bias"].erase(0);
+  expect_bad(j, { "bad.json: correction.layers[2].weight" });
+  j = material_file_to_json(nn);
+  j["correction"]["input_scale"][3] = 0.0;
+  expect_bad(j, { "bad.json: correction.input_scale", "> 0" });
+}
+
+TEST(MaterialFile, BrokenJsonNamesTheLine) {
+  ScratchDir dir;
+  std::ofstream(dir / "nan.json")
+      << "{\"format\": \"elastolearn-material/1\",\n \"material\": {\"young\": NaN}}";
+  expect_input_error([&] { read_material_file(dir / "nan.json"); }, { "nan.json:2:" });
+  expect_input_error([&] { read_material_file(dir / "missing.json"); }, { "missing.json" });
+}
+
+TEST(MaterialFile, SceneMayReferenceAMaterialFile) {
+  ScratchDir dir;
+  fs::create_directories(dir / "materials");
+  MaterialFile f;
+  f.material = k_nominal;
+  f.correction = std::make_shared<material::RbfCorrection>(rbf_parameters(5, 4));
+  write_material_file(dir / "materials" / "learned.json", f);
+  const std::string scene = R"({"format": "elastolearn-scene/1",
+    "mesh": {"type": "box", "size": [0.1, 0.02, 0.02], "cells": [2, 1, 1]},
+    "material": "materials/learned.json", "time": {"dt": 0.01, "frames": 2}})";
+  std::ofstream(dir / "scene.json") << scene;
+  const SceneFile s = read_scene_file(dir / "scene.json");
+  ASSERT_NE(s.scene.material.correction, nullptr);
+  expect_same_function(*f.correction, *s.scene.material.correction);
+  EXPECT_EQ(s.scene.material.elastic->name(), "corotated");
+
+  // scene_material gives the nominal JSON too (what `learn` needs to save a result).
+  const Json scene_json = Json::parse(scene);
+  EXPECT_EQ(scene_material(JsonObject(scene_json, "scene.json"), dir.path()).material, k_nominal);
+
+  std::string missing = scene;
+  missing.replace(missing.find("materials/learned.json"), 22, "materials/nothere.json");
+  std::ofstream(dir / "missing.json") << missing;
+  expect_input_error(
+      [&] { read_scene_file(dir / "missing.json"); }, { "missing.json: material", "nothere.json" });
+
+  f.material["young"] = -5;
+  std::ofstream(dir / "materials" / "broken.json") << material_file_to_json(f).dump();
+  std::string broken = scene;
+  broken.replace(broken.find("materials/learned.json"), 22, "materials/broken.json");
+  std::ofstream(dir / "broken_scene.json") << broken;
+  expect_input_error(
+      [&] { read_scene_file(dir / "broken_scene.json"); }, { "broken.json: material.young" });
+}

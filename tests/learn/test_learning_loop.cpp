@@ -1,0 +1,110 @@
+// The learning loop end to end (paper 000 §3, issue 3 "Tests"): a small clamped bar whose truth
+// is neo-Hookean is learned from a corotated nominal with the wrong stiffness (the turtle case's
+// E ratio 2e4 : 3.5e4), observing every surface vertex of a droop under gravity, and evaluated on
+// a different, larger motion (an upward swing). Also: truth = nominal learns ≈ nothing.
+#include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/material/elastic_model_type.hpp>
+#include <elastolearn/material/rayleigh_damping.hpp>
+#include <elastolearn/mesh/primitives.hpp>
+#include <elastolearn/mesh/vertex_selection.hpp>
+#include <elastolearn/observe/visible_vertices.hpp>
+
+#include <gtest/gtest.h>
+
+namespace elastolearn::learn {
+namespace {
+
+fem::MaterialModel make_material(material::ElasticModelType type, double young) {
+  fem::MaterialModel m;
+  m.elastic = material::make_elastic_model(type, material::Lame::from_young_poisson(young, 0.43));
+  m.damping = std::make_shared<material::RayleighDamping>(0.0, 0.01);
+  m.density = 1000;
+  return m;
+}
+
+/// 0.4 × 0.1 × 0.1 m bar, 240 tets, clamped at x = 0, 100 frames of 4 ms.
+sim::Scene bar_scene(const fem::MaterialModel& material, bool swing) {
+  sim::Scene s;
+  s.mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), {10, 2, 2});
+  s.material = material;
+  s.gravity = Vec3(0, -9.81, 0);
+  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
+  s.dt = 4e-3;
+  s.frames = 100;
+  if (swing) {
+    s.initial.kind = sim::InitialCondition::Kind::Velocity;
+    s.initial.angular_velocity = Vec3(0, 0, 2.0);
+  }
+  return s;
+}
+
+observe::Observation observe_surface(const sim::Scene& truth) {
+  const auto run = simulate_positions(truth);
+  EXPECT_TRUE(run.completed);
+  std::vector<Positions> frames;
+  for (const auto& x : run.positions) frames.emplace_back(unflatten(x));
+  return observe::observe_vertices(frames, truth.dt, observe::select_visible_vertices(truth.mesh, 1.0, 1), 0.0, 1);
+}
+
+LearningOptions small_options() {
+  LearningOptions o;
+  o.max_iterations = 4;
+  o.centres = 20;
+  o.pod.max_modes = 12;
+  return o;
+}
+
+/// err_L (% of the rest bounding-box diagonal) of `scene`'s swing against the truth's.
+double swing_error(const sim::Scene& truth, const sim::Scene& model) {
+  const auto a = simulate_positions(truth), b = simulate_positions(model);
+  EXPECT_TRUE(a.completed && b.completed) << b.message;
+  return as_percent_of(position_error(b.positions, a.positions), truth.mesh.bounding_box_diagonal()).max;
+}
+
+TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
+  const auto truth = make_material(material::ElasticModelType::NeoHookean, 1e6);
+  const auto nominal = make_material(material::ElasticModelType::Corotated, 1.75e6);
+  const auto observed = observe_surface(bar_scene(truth, false));
+  LearningState state;
+  ASSERT_TRUE(run_learning(bar_scene(nominal, false), observed, small_options(), state));
+  ASSERT_TRUE(state.best);
+  ASSERT_FALSE(state.history.empty());
+  // The training fit improves by orders of magnitude (measured 4.3e-3 m → 3.5e-5 m RMS).
+  EXPECT_LT(state.best_error, 0.02 * state.history.front().forward_error.rms);
+
+  const double nominal_error = swing_error(bar_scene(truth, true), bar_scene(nominal, true));
+  const double learned_error = swing_error(bar_scene(truth, true), with_correction(bar_scene(nominal, true), state.best));
+  // Stored regression numbers (Release build, this configuration): nominal 4.304 %, learned
+  // 0.024 %. The issue asks for ≥ 5× below the nominal; we assert that and that we have not
+  // regressed by more than 4× from the stored learned figure (round-off in k-means/TBB sums
+  // can move it a little; a broken stage moves it by orders of magnitude).
+  EXPECT_NEAR(nominal_error, 4.304, 0.01);
+  EXPECT_LT(learned_error, nominal_error / 5);
+  EXPECT_LT(learned_error, 4 * 0.024);
+}
+
+TEST(LearningLoop, TruthEqualToNominalLearnsAlmostNothing) {
+  const auto material = make_material(material::ElasticModelType::Corotated, 1e6);
+  auto scene = bar_scene(material, false);
+  scene.frames = 60;
+  const auto observed = observe_surface(scene);
+  LearningOptions options = small_options();
+  options.max_iterations = 1;
+  LearningState state;
+  ASSERT_TRUE(run_learning(scene, observed, options, state));
+  ASSERT_EQ(state.history.size(), 2u);
+  const IterationRecord& first = state.history.front();
+  // The constrained simulation reproduces the data and the physics holds: the control forces
+  // are at the solver's residual level, ~1e-6 of the weight of a vertex (mg ≈ 0.05 N here).
+  EXPECT_LT(first.control_force_rms, 1e-5);
+  EXPECT_LT(first.correction_target, 1e-5);
+  ASSERT_TRUE(state.correction);
+  // The fitted correction is negligible against the nominal stress at 5 % strain (~5e4 Pa).
+  for (const Vec3& s : {Vec3(1.05, 1.0, 0.98), Vec3(0.97, 1.0, 1.0), Vec3(1, 1, 1)})
+    EXPECT_LT(state.correction->correction(s, Vec3::Zero()).norm(), 50.0) << s.transpose();
+  // Its forward simulation is as good as the nominal's (which is exact).
+  EXPECT_LT(state.history.back().forward_error.max, 1e-5);
+}
+
+} // namespace
+} // namespace elastolearn::learn

@@ -1,0 +1,277 @@
+// Network correction training and distillation (paper 000 §6.2): batch-norm folding is exact,
+// training reaches a small error on a known smooth correction, runs are deterministic, and the
+// simulation sampler records what the teacher sees.
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/learn/nn_distillation.hpp>
+#include <elastolearn/material/analytic_correction.hpp>
+#include <elastolearn/material/corotated.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
+#include <elastolearn/mesh/primitives.hpp>
+#include <elastolearn/mesh/vertex_selection.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <random>
+
+using namespace elastolearn;
+using namespace elastolearn::learn;
+
+namespace {
+
+/// A teacher like the learning loop's: the isotropic linear tail of nominal Lamé parameters off
+/// by Δμ = 3 kPa, Δλ = 4 kPa (a = 2Δμ + Δλ, b = Δλ), 4 centres around rest with elastic weights
+/// ~1e3 Pa, and a damping RBF Δα₁ ~ 1e-3 s on the corotated damping tangent (E = 50 kPa,
+/// ν = 0.4). Over the sampled box the linear, kernel and damping stresses are all ~1e3 Pa at
+/// stretch rates ~1/s.
+material::RbfCorrection smooth_teacher() {
+  material::RbfCorrection::Parameters p;
+  p.centres.resize(4, 3);
+  p.centres << 1.0, 1.0, 1.0, 1.15, 1.0, 0.9, 1.05, 0.95, 0.85, 0.95, 0.92, 0.9;
+  p.weights = Eigen::Vector4d(800, -500, 300, -400);
+  p.own_slope = 2 * 3e3 + 4e3;
+  p.other_slope = 4e3;
+  p.damping_weights = Eigen::Vector4d(4e-3, -2e-3, 3e-3, -1e-3);
+  p.damping_constant = 1e-3;
+  p.damping_tangent = material::rest_principal_tangent(
+      material::CorotatedModel(material::Lame::from_young_poisson(5e4, 0.4)));
+  p.epsilon = 0.05;
+  return material::RbfCorrection(std::move(p));
+}
+
+/// n samples with stretches uniform in [0.85, 1.15]³ and rates N(0, 1/s²), targets from `teacher`.
+StressSamples random_samples(const material::Correction& teacher, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.85, 1.15);
+  std::normal_distribution<double> g(0.0, 1.0);
+  StressSamples s;
+  s.stretches.resize(n, 3);
+  s.stretch_rates.resize(n, 3);
+  s.targets.resize(n, 3);
+  for (int j = 0; j < n; ++j) {
+    const Vec3 sigma(u(rng), u(rng), u(rng)), rate(g(rng), g(rng), g(rng));
+    s.stretches.row(j) = sigma.transpose();
+    s.stretch_rates.row(j) = rate.transpose();
+    s.targets.row(j) = teacher.correction(sigma, rate).transpose();
+  }
+  return s;
+}
+
+/// NnCorrection with identity standardisation around the given layers.
+material::NnCorrection identity_wrapped(std::vector<material::NnCorrection::Layer> layers) {
+  material::NnCorrection::Parameters p;
+  p.layers = std::move(layers);
+  return material::NnCorrection(std::move(p));
+}
+
+/// Random inputs (6 × n) whose first three rows are sorted descending per column, so that
+/// NnCorrection's sorting is the identity on them.
+MatX sorted_inputs(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  MatX x(6, n);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < 6; ++i)
+      x(i, j) = g(rng);
+    std::sort(x.col(j).data(), x.col(j).data() + 3, std::greater<>());
+  }
+  return x;
+}
+
+double max_relative_difference(const material::NnCorrection& folded, const MatX& x, const MatX& reference) {
+  double worst = 0;
+  for (Eigen::Index j = 0; j < x.cols(); ++j) {
+    const Vec3 out = folded.correction(x.col(j).head<3>(), x.col(j).tail<3>());
+    worst = std::max(worst, (out - reference.col(j)).norm() / reference.col(j).norm());
+  }
+  return worst;
+}
+
+} // namespace
+
+TEST(BatchNormFolding, FoldedNetworkEqualsTheInferenceModeNetwork) {
+  // Random γ, β, biases and running statistics (variances 0.1–2.1), so every term of the fold
+  // W' = diag(s) W, b' = s ⊙ (b − μ) + β matters. Same arithmetic up to reassociation:
+  // agreement to round-off (1e-12 relative of outputs ~1).
+  BatchNormMlp net = make_batch_norm_mlp(6, { 6, 6 }, 3, true, 3);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (auto& l : net.layers) {
+    l.bias = l.bias.unaryExpr([&](double) { return u(rng); });
+    if (!l.has_batch_norm())
+      continue;
+    l.gamma = l.gamma.unaryExpr([&](double) { return 1.5 * u(rng); });
+    l.beta = l.beta.unaryExpr([&](double) { return u(rng); });
+    l.running_mean = l.running_mean.unaryExpr([&](double) { return u(rng); });
+    l.running_var = l.running_var.unaryExpr([&](double) { return 1.1 + u(rng); });
+  }
+  const MatX x = sorted_inputs(200, 4);
+  const MatX inference = evaluate(net, x, BatchNormMode::Inference);
+  const auto folded = identity_wrapped(fold_batch_norm(net));
+  EXPECT_LT(max_relative_difference(folded, x, inference), 1e-12);
+  // The fold really uses the running statistics: training mode (batch statistics) differs.
+  EXPECT_GT((evaluate(net, x, BatchNormMode::Training) - inference).norm(), 1e-3 * inference.norm());
+}
+
+TEST(BatchNormFolding, TrainingModeEqualsFoldedWhenRunningStatisticsAreTheBatchStatistics) {
+  // Set each layer's running mean/variance to the statistics its batch-norm sees on one batch
+  // (layer by layer, in training mode): then the training-mode outputs on that batch are what
+  // the folded network computes sample by sample. Round-off only: 1e-12.
+  BatchNormMlp net = make_batch_norm_mlp(6, { 6, 6 }, 3, true, 8);
+  const MatX x = sorted_inputs(64, 9);
+  MatX a = x;
+  for (std::size_t k = 0; k + 1 < net.layers.size(); ++k) {
+    auto& l = net.layers[k];
+    l.gamma.setConstant(0.7);
+    l.beta.setConstant(0.2);
+    MatX z = l.weight * a;
+    z.colwise() += l.bias;
+    l.running_mean = z.rowwise().mean();
+    l.running_var = (z.colwise() - l.running_mean).rowwise().squaredNorm() / double(z.cols());
+    BatchNormMlp prefix;
+    prefix.layers.assign(net.layers.begin(), net.layers.begin() + static_cast<long>(k) + 1);
+    prefix.layers.emplace_back(); // evaluate() needs a last (linear) layer: identity
+    prefix.layers.back().weight = MatX::Identity(l.weight.rows(), l.weight.rows());
+    prefix.layers.back().bias = VecX::Zero(l.weight.rows());
+    a = evaluate(prefix, x, BatchNormMode::Training);
+  }
+  const MatX training = evaluate(net, x, BatchNormMode::Training);
+  const auto folded = identity_wrapped(fold_batch_norm(net));
+  EXPECT_LT(max_relative_difference(folded, x, training), 1e-12);
+}
+
+TEST(NnDistillation, LearnsASmoothCorrection) {
+  // 12 000 samples of the RBF teacher. The 6 → 6 → 6 → 3 network of the paper reaches a
+  // validation RMS of 1.9–2.2 % of the target RMS over seeds 1–3 (docs/learning.md); the bound
+  // 5 % leaves room for platform round-off changing the optimisation path. A 1-epoch network
+  // is far above it, so the bound tests the training, not the architecture alone.
+  const auto teacher = smooth_teacher();
+  const StressSamples samples = random_samples(teacher, 12000, 21);
+  NnDistillationOptions o;
+  const NnDistillationResult r = distill_nn_correction(samples, o);
+  RecordProperty("relative_validation_rms", std::to_string(r.relative_validation_rms()));
+  std::cout << "epochs " << r.training.epochs << " (best " << r.training.best_epoch << "), "
+            << r.training.seconds << " s, relative RMS train " << r.relative_training_rms()
+            << " validation " << r.relative_validation_rms() << "\n";
+  EXPECT_EQ(r.training_samples + r.validation_samples, 12000);
+  EXPECT_LT(r.relative_validation_rms(), 0.05);
+  EXPECT_LT(r.relative_training_rms(), 0.05);
+
+  NnDistillationOptions short_run = o;
+  short_run.training.max_epochs = 1;
+  EXPECT_GT(distill_nn_correction(samples, short_run).relative_validation_rms(),
+      2 * r.relative_validation_rms());
+}
+
+TEST(NnDistillation, DeterministicForASeed) {
+  const auto teacher = smooth_teacher();
+  const StressSamples samples = random_samples(teacher, 2000, 5);
+  NnDistillationOptions o;
+  o.training.max_epochs = 15;
+  const auto a = distill_nn_correction(samples, o);
+  const auto b = distill_nn_correction(samples, o);
+  const auto& pa = a.correction.parameters();
+  const auto& pb = b.correction.parameters();
+  ASSERT_EQ(pa.layers.size(), pb.layers.size());
+  for (std::size_t k = 0; k < pa.layers.size(); ++k) {
+    EXPECT_EQ(pa.layers[k].weight, pb.layers[k].weight);
+    EXPECT_EQ(pa.layers[k].bias, pb.layers[k].bias);
+  }
+  EXPECT_EQ(a.validation_rms, b.validation_rms);
+  o.training.seed = 2;
+  const auto c = distill_nn_correction(samples, o);
+  EXPECT_NE(pa.layers[0].weight, c.correction.parameters().layers[0].weight);
+}
+
+TEST(NnDistillation, RejectsBadInput) {
+  NnDistillationOptions o;
+  StressSamples s = random_samples(smooth_teacher(), 100, 1);
+  s.targets(3, 1) = std::nan("");
+  EXPECT_THROW(distill_nn_correction(s, o), InputError);
+  s = random_samples(smooth_teacher(), 3, 1); // too few for two splits of ≥ 2
+  EXPECT_THROW(distill_nn_correction(s, o), InputError);
+  o.validation_fraction = 1.0;
+  EXPECT_THROW(o.validate(), InputError);
+  o = {};
+  o.training.hidden_widths = { 6, 33 };
+  EXPECT_THROW(o.validate(), InputError);
+}
+
+namespace {
+
+/// A clamped bar (8 × 2 × 2 cells, 192 tets) swinging from an initial velocity, corotated nominal.
+sim::Scene swinging_bar() {
+  sim::Scene s;
+  s.name = "bar";
+  s.mesh = mesh::make_box_bar({ 0.4, 0.1, 0.1 }, { 8, 2, 2 });
+  s.material.elastic = std::make_shared<material::CorotatedModel>(
+      material::Lame::from_young_poisson(5e4, 0.4));
+  s.material.density = 1000;
+  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
+  s.initial.kind = sim::InitialCondition::Kind::Velocity;
+  s.initial.velocity = Vec3(0, 0.5, 0);
+  s.dt = 5e-3;
+  s.frames = 30;
+  return s;
+}
+
+} // namespace
+
+TEST(DistillationSamples, RecordsTheTeachersStatesFromSimulations) {
+  const material::AnalyticCorrection teacher({ 2e5, 50, 10 });
+  const sim::Scene bar = swinging_bar();
+  const std::vector<double> factors { 1.0, 2.0 };
+  const auto scenes = scaled_motions(bar, factors);
+  ASSERT_EQ(scenes.size(), 2u);
+  EXPECT_EQ(scenes[1].initial.velocity, Vec3(0, 1.0, 0));
+  EXPECT_EQ(scenes[1].name, "bar_x2");
+
+  DistillationSampleOptions o;
+  o.recorded_samples = 3000;
+  o.frame_stride = 2;
+  o.jitter_copies = 2;
+  DistillationSampleReport report;
+  const StressSamples s = distillation_samples(std::span<const sim::Scene>(scenes), teacher, o, &report);
+  // 2 scenes × 16 recorded frames (0, 2, …, 30) × 192 tets = 6144 states seen.
+  EXPECT_EQ(report.states_seen, 2L * 16 * 192);
+  EXPECT_EQ(report.scenes_completed, 2);
+  EXPECT_EQ(report.recorded, 3000);
+  EXPECT_EQ(report.jittered, 6000);
+  ASSERT_EQ(s.stretches.rows(), 9000);
+  double max_deformation = 0, max_rate = 0;
+  for (Eigen::Index j = 0; j < s.stretches.rows(); ++j) {
+    const Vec3 sigma = s.stretches.row(j).transpose(), rate = s.stretch_rates.row(j).transpose();
+    ASSERT_GE(sigma[0], sigma[1]);
+    ASSERT_GE(sigma[1], sigma[2]);
+    ASSERT_EQ(s.targets.row(j).transpose(), teacher.correction(sigma, rate));
+    if (j < report.recorded) {
+      max_deformation = std::max(max_deformation, (sigma - Vec3::Ones()).cwiseAbs().maxCoeff());
+      max_rate = std::max(max_rate, rate.cwiseAbs().maxCoeff());
+    }
+  }
+  // The bar really moves: stretches of a few per cent and non-zero rates were recorded.
+  EXPECT_GT(max_deformation, 5e-3);
+  EXPECT_GT(max_rate, 1e-2);
+
+  // Same seed, same samples.
+  const StressSamples again = distillation_samples(bar, factors, teacher, o);
+  EXPECT_EQ(again.stretches, s.stretches);
+  EXPECT_EQ(again.targets, s.targets);
+}
+
+TEST(DistillationSamples, DistilledNetworkFollowsTheTeacherOnSimulatedStates) {
+  // End to end on simulated states: the network trained on the bar's states (plus jitter)
+  // reproduces the RBF teacher there (measured in docs/learning.md; bound 5 % as above).
+  const auto teacher = smooth_teacher();
+  const std::vector<double> factors { 0.5, 1.0, 2.0 };
+  DistillationSampleOptions so;
+  so.recorded_samples = 4000;
+  const StressSamples s = distillation_samples(swinging_bar(), factors, teacher, so);
+  const NnDistillationResult r = distill_nn_correction(s, {});
+  std::cout << "simulated: epochs " << r.training.epochs << " (best " << r.training.best_epoch << "), relative RMS train " << r.relative_training_rms() << " validation "
+            << r.relative_validation_rms() << ", " << r.training.seconds << " s\n";
+  EXPECT_LT(r.relative_validation_rms(), 0.05);
+}

@@ -1,0 +1,332 @@
+// Stress reconstruction (paper 000 §6.1, Eqs. 10–13): the nodal-force operator agrees with
+// fem::ElasticForce, a known RBF correction (elastic + damping) is recovered from the nodal forces
+// it produces, and the LSQR option returns the minimum-norm least-squares element stresses.
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/fem/elastic_force.hpp>
+#include <elastolearn/learn/kmeans.hpp>
+#include <elastolearn/learn/stress_reconstruction.hpp>
+#include <elastolearn/learn/stress_reconstruction_lsqr.hpp>
+#include <elastolearn/material/corotated.hpp>
+#include <elastolearn/mesh/primitives.hpp>
+
+#include <Eigen/QR>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <iostream>
+#include <random>
+
+using namespace elastolearn;
+using namespace elastolearn::learn;
+
+namespace {
+
+std::shared_ptr<const material::CorotatedModel> nominal() {
+  return std::make_shared<material::CorotatedModel>(material::Lame::from_young_poisson(5e4, 0.4));
+}
+
+/// Smoothly deformed, rotated and moving frames of `mesh`: x = R (X + A X + s(X)) + c with a
+/// random affine part (|A_ij| ≤ 0.12) and a sine bend along x, v = W X + cos bend (|W_ij| ≤ 1/s).
+/// Stretches stay within about [0.75, 1.3] (no inversion).
+struct Frames {
+  std::vector<VecX> positions, velocities;
+};
+Frames make_frames(const mesh::TetMesh& mesh, int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Positions& X = mesh.rest_positions();
+  const double length = mesh.bounding_box().sizes().maxCoeff();
+  Frames frames;
+  for (int t = 0; t < count; ++t) {
+    Mat3 A, W;
+    for (int k = 0; k < 9; ++k) {
+      A.data()[k] = 0.12 * u(rng);
+      W.data()[k] = u(rng);
+    }
+    const Eigen::Quaterniond q(1.0, 0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng));
+    const Mat3 R = q.normalized().toRotationMatrix();
+    const Vec3 bend(0.03 * u(rng), 0.05 * u(rng), 0.05 * u(rng)), phase(u(rng), u(rng), u(rng));
+    VecX x(3 * X.rows()), v(3 * X.rows());
+    for (Eigen::Index i = 0; i < X.rows(); ++i) {
+      const Vec3 p = X.row(i).transpose();
+      const double s = 3.0 * p[0] / length;
+      Vec3 d = A * p, w = W * p;
+      for (int c = 0; c < 3; ++c) {
+        d[c] += length * bend[c] * std::sin(s + phase[c]);
+        w[c] += 0.5 * std::cos(2 * s + phase[c]);
+      }
+      x.segment<3>(3 * i) = R * (p + d) + Vec3(0.1, -0.2, 0.05);
+      v.segment<3>(3 * i) = w;
+    }
+    frames.positions.push_back(std::move(x));
+    frames.velocities.push_back(std::move(v));
+  }
+  return frames;
+}
+
+/// Vertices on the face x = 0 (fixed in the tests, so some elements touch prescribed dofs).
+std::vector<int> left_face(const mesh::TetMesh& mesh) {
+  std::vector<int> ids;
+  for (int i = 0; i < mesh.num_vertices(); ++i)
+    if (mesh.rest_positions()(i, 0) == 0.0)
+      ids.push_back(i);
+  return ids;
+}
+
+/// Nodal forces of `correction` through an independent path: ElasticForce with the correction
+/// minus ElasticForce without (same nominal, no damping model).
+VecX elastic_force_difference(const mesh::TetMesh& mesh, const material::RbfCorrection& correction,
+    const VecX& x, const VecX& v) {
+  fem::ElasticForce with(mesh, { nominal(), correction.clone(), nullptr, 1000 });
+  fem::ElasticForce without(mesh, { nominal(), nullptr, nullptr, 1000 });
+  VecX f = VecX::Zero(x.size()), f0 = VecX::Zero(x.size());
+  with.add_force({ x, v }, f);
+  without.add_force({ x, v }, f0);
+  return f - f0;
+}
+
+RbfFitOptions design_options(double regularization) {
+  RbfFitOptions o;
+  o.damping_tangent = material::rest_principal_tangent(*nominal());
+  o.regularization = regularization;
+  o.damping_regularization = regularization;
+  return o;
+}
+
+/// Random unknowns of `design`: elastic weights ~ 2 kPa, tails ~ 1 kPa, damping weights ~ 10 ms.
+VecX random_unknowns(const RbfDesign& design, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  VecX x(design.num_unknowns());
+  const int qe = design.elastic_unknowns();
+  for (int i = 0; i < x.size(); ++i)
+    x[i] = (i < qe ? 2e3 : 1e-2) * u(rng);
+  return x;
+}
+
+struct KnownAnswer {
+  mesh::TetMesh mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 6, 2, 2 });
+  ReconstructionMesh geometry { mesh };
+  fem::DofMap dofs { mesh.num_vertices(), left_face(mesh) };
+  Frames frames = make_frames(mesh, 10, 7);
+  RbfDesign design;
+  VecX truth;
+  std::vector<VecX> targets;
+
+  explicit KnownAnswer(double regularization)
+      : design(centres(), design_options(regularization)) {
+    truth = random_unknowns(design, 11);
+    const material::RbfCorrection n = design.correction(truth);
+    for (size_t t = 0; t < frames.positions.size(); ++t)
+      targets.push_back(
+          elastic_force_difference(mesh, n, frames.positions[t], frames.velocities[t]));
+  }
+  MatX centres() const {
+    KMeansOptions k;
+    k.clusters = 4;
+    return kmeans(collect_stretches(geometry, frames.positions), k).centres;
+  }
+};
+
+} // namespace
+
+TEST(StressReconstruction, CorrectionForceMatchesElasticForceDifference) {
+  const KnownAnswer k(1e-12);
+  const material::RbfCorrection n = k.design.correction(k.truth);
+  for (size_t t = 0; t < 3; ++t) {
+    const VecX& x = k.frames.positions[t];
+    const VecX& v = k.frames.velocities[t];
+    const VecX f = correction_force(k.geometry, n, x, v);
+    // Same arithmetic up to the order of summation: agreement to ~1e-12 relative.
+    EXPECT_LE((f - k.targets[t]).lpNorm<Eigen::Infinity>(),
+        1e-10 * k.targets[t].lpNorm<Eigen::Infinity>());
+    EXPECT_GT(k.targets[t].norm(), 0.0);
+  }
+}
+
+TEST(StressReconstruction, CollectStretchesIsSortedAndCapped) {
+  const KnownAnswer k(1e-12);
+  const MatX all = collect_stretches(k.geometry, k.frames.positions);
+  const int m = k.mesh.num_tets();
+  ASSERT_EQ(all.rows(), 10 * m);
+  // Row (frame 3, element 5) is that element's principal stretches.
+  const Mat3 F = fem::deformation_gradient(
+      fem::gather_tet(k.frames.positions[3], k.mesh.tets().row(5).transpose()), k.geometry.rest[5]);
+  EXPECT_LE(
+      (all.row(3 * m + 5).transpose() - material::principal_frame(F).stretches).norm(), 1e-14);
+  for (Eigen::Index i = 0; i < all.rows(); ++i) {
+    EXPECT_GE(all(i, 0), all(i, 1));
+    EXPECT_GE(all(i, 1), all(i, 2));
+  }
+  StretchSampleOptions o;
+  o.frame_stride = 3; // frames 0, 3, 6, 9
+  o.max_samples = 100;
+  const MatX capped = collect_stretches(k.geometry, k.frames.positions, o);
+  EXPECT_LE(capped.rows(), 100);
+  EXPECT_GE(capped.rows(), 50); // every ⌈4m/100⌉-th sample
+  EXPECT_EQ(capped.row(1), all.row(6)); // step ⌈576/100⌉ = 6: sample 6 is frame 0, element 6
+}
+
+TEST(StressReconstruction, RecoversKnownRbfCorrectionFromNodalForces) {
+  const KnownAnswer k(1e-13);
+  const StressReconstructionResult r = reconstruct_rbf_correction(
+      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, k.targets);
+  EXPECT_EQ(r.misfit.frames, 10);
+  EXPECT_EQ(r.rows_per_frame, k.dofs.num_free());
+  // The truth lies in the design and the targets are exact, so the only errors are round-off
+  // amplified by the conditioning of the normal equations and the Tikhonov bias (λ = 1e-13).
+  // Measured: 2e-10 (elastic), 5e-11 (damping), force misfit 4e-12. 1e-6 leaves room for other
+  // summation orders; a wrong operator (sign, transposed frame, missing damping) gives O(1).
+  const int qe = k.design.elastic_unknowns();
+  const auto relative = [&](Eigen::Index start, Eigen::Index size) {
+    return (r.unknowns.segment(start, size) - k.truth.segment(start, size)).norm()
+        / k.truth.segment(start, size).norm();
+  };
+  EXPECT_LT(relative(0, qe), 1e-6) << "elastic weights";
+  EXPECT_LT(relative(qe, k.design.damping_unknowns()), 1e-6) << "damping weights";
+  EXPECT_LT(r.misfit.rms_residual, 1e-8 * r.misfit.rms_target);
+  EXPECT_GT(r.misfit.rms_target, 0.0);
+
+  // Every second frame still determines the 35 unknowns (5 frames × 162 free dofs).
+  StressReconstructionOptions o;
+  o.frame_stride = 2;
+  const StressReconstructionResult half = reconstruct_rbf_correction(
+      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, k.targets, o);
+  EXPECT_EQ(half.misfit.frames, 5);
+  EXPECT_LT((half.unknowns - k.truth).norm(), 1e-6 * k.truth.norm());
+}
+
+TEST(StressReconstruction, RejectsInconsistentFrames) {
+  const KnownAnswer k(1e-12);
+  std::vector<VecX> short_targets(k.targets.begin(), k.targets.end() - 1);
+  EXPECT_THROW(reconstruct_rbf_correction(k.geometry, k.dofs, k.design, k.frames.positions,
+                   k.frames.velocities, short_targets),
+      InputError);
+  std::vector<VecX> bad = k.targets;
+  bad[2][4] = std::nan("");
+  EXPECT_THROW(reconstruct_rbf_correction(
+                   k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, bad),
+      InputError);
+  const fem::DofMap wrong(k.mesh.num_vertices() - 1, {});
+  EXPECT_THROW(reconstruct_rbf_correction(
+                   k.geometry, wrong, k.design, k.frames.positions, k.frames.velocities, k.targets),
+      InputError);
+  // Static frames leave the damping weights undetermined: singular without regularisation.
+  const KnownAnswer unregularised(0.0);
+  std::vector<VecX> still(10, VecX::Zero(3 * k.mesh.num_vertices()));
+  EXPECT_THROW(reconstruct_rbf_correction(unregularised.geometry, unregularised.dofs,
+                   unregularised.design, k.frames.positions, still, k.targets),
+      InputError);
+}
+
+TEST(StressReconstructionLsqr, MinimumNormLeastSquaresStresses) {
+  // 12 tets (36 stresses) and 12 vertices, 2 fixed: 30 free dofs, so B has a null space.
+  const mesh::TetMesh mesh = mesh::make_box_bar(Vec3(0.2, 0.1, 0.1), { 2, 1, 1 });
+  const ReconstructionMesh geometry(mesh);
+  const fem::DofMap dofs(mesh.num_vertices(), { 0, 3 });
+  const Frames frames = make_frames(mesh, 1, 3);
+  std::vector<ElementState> states;
+  compute_element_states(geometry, frames.positions[0], frames.velocities[0], states);
+  const MatX B = MatX(assemble_stress_operator(geometry, dofs, states));
+  ASSERT_EQ(B.rows(), 30);
+  ASSERT_EQ(B.cols(), 36);
+
+  // B applied to a correction's element stresses is that correction's nodal force.
+  const KnownAnswer k(1e-12);
+  const material::RbfCorrection n = k.design.correction(k.truth);
+  VecX p(36);
+  for (int e = 0; e < 12; ++e)
+    p.segment<3>(3 * e) = n.correction(states[e].frame.stretches, states[e].stretch_rates);
+  const VecX f_n
+      = dofs.restrict(correction_force(geometry, n, frames.positions[0], frames.velocities[0]));
+  EXPECT_LE((B * p - f_n).norm(), 1e-12 * f_n.norm());
+
+  // An arbitrary (inconsistent) force: CGLS from zero gives the pseudo-inverse solution.
+  std::mt19937 rng(4);
+  std::normal_distribution<double> g(0.0, 1.0);
+  VecX full = VecX::Zero(3 * mesh.num_vertices());
+  for (Eigen::Index i = 0; i < full.size(); ++i)
+    full[i] = g(rng);
+  StressReconstructionOptions o;
+  o.lsqr_tolerance = 1e-13;
+  const ElementStressResult r
+      = reconstruct_element_stresses(geometry, dofs, frames.positions[0], full, o);
+  const VecX reference = Eigen::CompleteOrthogonalDecomposition<MatX>(B).solve(dofs.restrict(full));
+  // B has rank 27 of 30 (zero net force/torque directions) with condition ≈ 2e2 on its range;
+  // CGLS runs to 1e-13 on the normal equations. Measured difference 3e-13; 1e-8 is loose but
+  // far below the O(1) gap to any non-minimum-norm solution (the null space is 9-dimensional).
+  EXPECT_LT((r.stresses - reference).norm(), 1e-8 * reference.norm());
+  EXPECT_LT((B.transpose() * (B * r.stresses - dofs.restrict(full))).norm(),
+      1e-10 * (B.transpose() * dofs.restrict(full)).norm());
+
+  // A consistent force is reproduced, and by a stress no larger than the one that made it.
+  VecX consistent = VecX::Zero(full.size());
+  for (int i = 0; i < dofs.num_free(); ++i)
+    consistent[dofs.free_dofs()[i]] = f_n[i];
+  const ElementStressResult c
+      = reconstruct_element_stresses(geometry, dofs, frames.positions[0], consistent, o);
+  EXPECT_LT(c.residual_norm, 1e-9 * c.target_norm);
+  EXPECT_LE(c.stresses.norm(), p.norm() * (1 + 1e-12));
+}
+
+TEST(StressReconstructionLsqr, PipelineFitsButDirectMethodIsOptimal) {
+  const KnownAnswer k(1e-10);
+  StressReconstructionOptions o;
+  o.method = ReconstructionMethod::lsqr;
+  const StressReconstructionResult lsqr = reconstruct_rbf_correction(
+      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, k.targets, o);
+  const StressReconstructionResult direct = reconstruct_rbf_correction(
+      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, k.targets);
+  EXPECT_LE(lsqr.lsqr_max_relative_error, 1e-8);
+  EXPECT_GT(lsqr.lsqr_max_iterations, 0);
+  // The direct method minimises the force misfit over the same unknowns, so the LSQR pipeline
+  // (which fits min-norm stresses, Fig. 4) cannot do better; it still explains part of the force.
+  EXPECT_GE(lsqr.misfit.rms_residual, direct.misfit.rms_residual);
+  EXPECT_LT(lsqr.misfit.rms_residual, lsqr.misfit.rms_target);
+  std::cout << "[ lsqr     ] force misfit " << lsqr.misfit.rms_residual / lsqr.misfit.rms_target
+            << " of the target (direct " << direct.misfit.rms_residual / direct.misfit.rms_target
+            << "), max CGLS iterations " << lsqr.lsqr_max_iterations << "\n";
+  EXPECT_EQ(reconstruction_method_from_name(reconstruction_method_name(ReconstructionMethod::lsqr)),
+      ReconstructionMethod::lsqr);
+  EXPECT_THROW(reconstruction_method_from_name("qr"), InputError);
+}
+
+// Timing for docs/learning.md (not part of the suite: run with --gtest_also_run_disabled_tests).
+TEST(StressReconstruction, DISABLED_TimingLargeProblem) {
+  const mesh::TetMesh mesh = mesh::make_box_bar(Vec3(0.5, 0.25, 0.2), { 10, 5, 4 });
+  const ReconstructionMesh geometry(mesh);
+  const fem::DofMap dofs(mesh.num_vertices(), left_face(mesh));
+  const Frames frames = make_frames(mesh, 400, 5);
+  KMeansOptions km;
+  km.clusters = 50;
+  StretchSampleOptions so;
+  so.max_samples = 100000;
+  const auto t0 = std::chrono::steady_clock::now();
+  const RbfDesign design(
+      kmeans(collect_stretches(geometry, frames.positions, so), km).centres, design_options(1e-9));
+  const double kmeans_seconds
+      = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const material::RbfCorrection n = design.correction(random_unknowns(design, 2));
+  std::vector<VecX> targets;
+  for (int t = 0; t < 400; ++t)
+    targets.push_back(correction_force(geometry, n, frames.positions[t], frames.velocities[t]));
+  const std::clock_t cpu0 = std::clock(); // process CPU time: meaningful on a busy machine
+  const StressReconstructionResult r = reconstruct_rbf_correction(
+      geometry, dofs, design, frames.positions, frames.velocities, targets);
+  const double cpu_seconds = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  std::cout << mesh.num_tets() << " tets, " << dofs.num_free() << " free dofs, 400 frames, "
+            << design.num_unknowns() << " unknowns: k-means " << kmeans_seconds << " s, assembly "
+            << r.assembly_seconds << " s, solve " << r.solve_seconds << " s, misfit "
+            << r.misfit_seconds << " s (CPU time of all three " << cpu_seconds
+            << " s), relative misfit " << r.misfit.rms_residual / r.misfit.rms_target << "\n";
+  StressReconstructionOptions o;
+  o.method = ReconstructionMethod::lsqr;
+  o.frame_stride = 10;
+  const StressReconstructionResult l = reconstruct_rbf_correction(
+      geometry, dofs, design, frames.positions, frames.velocities, targets, o);
+  std::cout << "lsqr, 40 frames: CGLS " << l.assembly_seconds << " s (max " << l.lsqr_max_iterations
+            << " iterations), fit " << l.solve_seconds << " s, relative misfit "
+            << l.misfit.rms_residual / l.misfit.rms_target << "\n";
+}
