@@ -147,8 +147,16 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
 
       // 3. Constrained forward simulation: the starting trajectory (falls back to the forward one).
       t0 = Clock::now();
-      ForwardRun constrained = simulate_positions(with_correction(tracked_scene, state.correction), callbacks.progress);
-      const std::vector<VecX>& origin = constrained.completed ? constrained.positions : forward.positions;
+      const ForwardRun constrained =
+          simulate_positions(with_correction(tracked_scene, state.correction), callbacks.progress);
+      // The optimisation moves the forward trajectory within span Φ (x_i = forward_i + Φ z_i),
+      // starting from the constrained simulation projected onto that span. The projection
+      // keeps the start smooth: dragging a few observed vertices leaves sharp local dents
+      // (large point forces) that no reduced step could remove and no material explains.
+      std::vector<VecX> origin = forward.positions;
+      if (constrained.completed)
+        for (size_t i = 0; i < origin.size(); ++i)
+          origin[i].noalias() += basis.modes * (basis.modes.transpose() * (constrained.positions[i] - forward.positions[i]));
       record.seconds_constrained = seconds_since(t0);
       if (interrupted()) return false;
 
