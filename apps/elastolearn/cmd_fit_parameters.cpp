@@ -1,5 +1,6 @@
 // elastolearn fit-parameters scene.json --observations obs.h5 -o fitted.json [--frames N]
-//                           [--fit young,poisson,alpha0,alpha1] [--max-iterations K] [--tolerance T]
+//                           [--fit young,poisson,alpha0,alpha1] [--max-iterations K] [--tolerance
+//                           T]
 // The parameter-fitting baseline (paper 000's reference [14]): fit E, ν, α₀, α₁ of the scene's
 // nominal material to the observations and write them as a material file. docs/learning.md
 // "Parameter-fitting baseline".
@@ -27,12 +28,15 @@ struct FitOptions {
 };
 
 nlohmann::json to_json(const learn::NominalParameters& p) {
-  return { { "young", p.young }, { "poisson", p.poisson }, { "alpha0", p.alpha0 }, { "alpha1", p.alpha1 } };
+  return { { "young", p.young }, { "poisson", p.poisson }, { "alpha0", p.alpha0 },
+    { "alpha1", p.alpha1 } };
 }
 
 /// The start values from the scene's "material" object (inline or a referenced material file).
-learn::NominalParameters start_parameters(const io::JsonObject& material, material::ElasticModelType& type) {
-  type = material::elastic_model_type_from_string(material.string("model"), material.file() + ": " + material.field("model"));
+learn::NominalParameters start_parameters(
+    const io::JsonObject& material, material::ElasticModelType& type) {
+  type = material::elastic_model_type_from_string(
+      material.string("model"), material.file() + ": " + material.field("model"));
   learn::NominalParameters p;
   p.young = material.positive("young");
   p.poisson = material.number("poisson");
@@ -40,7 +44,8 @@ learn::NominalParameters start_parameters(const io::JsonObject& material, materi
     const io::JsonObject damping = material.object("damping");
     for (const char* key : { "alpha0", "alpha1" })
       if (damping.has(key) && !damping.json().at(key).is_number())
-        damping.fail(key, "is stretch-dependent; fit-parameters fits constant Rayleigh coefficients");
+        damping.fail(
+            key, "is stretch-dependent; fit-parameters fits constant Rayleigh coefficients");
     p.alpha0 = damping.number("alpha0", 0.0);
     p.alpha1 = damping.number("alpha1", 0.0);
   }
@@ -51,11 +56,14 @@ void run_fit(const FitOptions& o) {
   const io::SceneFile scene_file = io::read_scene_file(o.scene);
   const sim::Scene& scene = scene_file.scene;
   if (scene.material.correction)
-    throw InputError(o.scene, "material: the scene's material carries a correction; fit-parameters fits a nominal one");
+    throw InputError(o.scene,
+        "material: the scene's material carries a correction; fit-parameters fits a nominal one");
   const nlohmann::json root = io::read_json_file(o.scene);
-  io::MaterialFile fitted = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
-  const std::string material_source = root.at("material").is_string() ? root.at("material").get<std::string>() : o.scene;
-  material::ElasticModelType type{};
+  io::MaterialFile fitted
+      = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
+  const std::string material_source
+      = root.at("material").is_string() ? root.at("material").get<std::string>() : o.scene;
+  material::ElasticModelType type {};
   const learn::NominalParameters start
       = start_parameters(io::JsonObject(fitted.material, material_source, "material"), type);
 
@@ -67,17 +75,20 @@ void run_fit(const FitOptions& o) {
   options.validate();
 
   const double diagonal = scene.mesh.bounding_box_diagonal();
-  std::printf("fitting %s of %s: %d vertices, %d tets, %d of %d frames (dt = %g s), %d observed vertices, %s nominal\n",
+  std::printf("fitting %s of %s: %d vertices, %d tets, %d of %d frames (dt = %g s), %d observed "
+              "vertices, %s nominal\n",
       o.fit.c_str(), scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(),
-      options.frames < 0 ? scene.frames : options.frames, scene.frames, scene.dt, observed.num_observed(),
-      material::to_string(type).c_str());
+      options.frames < 0 ? scene.frames : options.frames, scene.frames, scene.dt,
+      observed.num_observed(), material::to_string(type).c_str());
   std::fflush(stdout);
   const ProgressCallback progress = [&](long, long, const std::string& line) {
-    if (o.quiet) return;
+    if (o.quiet)
+      return;
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
   };
-  const learn::ParameterFitReport report = learn::fit_parameters(scene, type, start, observed, options, progress);
+  const learn::ParameterFitReport report
+      = learn::fit_parameters(scene, type, start, observed, options, progress);
   if (report.stop == learn::FitStop::StartDiverged) {
     std::fprintf(stderr, "elastolearn: error: %s\n", report.message.c_str());
     throw CLI::RuntimeError(1);
@@ -95,23 +106,26 @@ void run_fit(const FitOptions& o) {
         { "rms_error_m", it.rms_error }, { "max_error_m", it.max_error }, { "lambda", it.lambda },
         { "rejected_steps", it.rejected_steps }, { "seconds", it.seconds } });
   nlohmann::json fitted_names = nlohmann::json::array();
-  for (auto p : options.parameters) fitted_names.push_back(learn::to_string(p));
-  fitted.training = { { "method", "parameter_fit" }, { "scene", o.scene }, { "observations", o.observations },
-    { "observed_vertices", observed.num_observed() }, { "fitted", fitted_names }, { "frames", report.frames },
-    { "initial", to_json(report.initial) }, { "final", to_json(report.fitted) },
-    { "initial_rms_error_m", report.initial_rms }, { "initial_max_error_m", report.initial_max },
-    { "final_rms_error_m", report.final_rms }, { "final_max_error_m", report.final_max },
-    { "iterations", report.iterations }, { "simulations", report.simulations },
-    { "diverged_simulations", report.diverged }, { "seconds", report.seconds },
-    { "stop", learn::to_string(report.stop) }, { "message", report.message }, { "history", history } };
+  for (auto p : options.parameters)
+    fitted_names.push_back(learn::to_string(p));
+  fitted.training = { { "method", "parameter_fit" }, { "scene", o.scene },
+    { "observations", o.observations }, { "observed_vertices", observed.num_observed() },
+    { "fitted", fitted_names }, { "frames", report.frames }, { "initial", to_json(report.initial) },
+    { "final", to_json(report.fitted) }, { "initial_rms_error_m", report.initial_rms },
+    { "initial_max_error_m", report.initial_max }, { "final_rms_error_m", report.final_rms },
+    { "final_max_error_m", report.final_max }, { "iterations", report.iterations },
+    { "simulations", report.simulations }, { "diverged_simulations", report.diverged },
+    { "seconds", report.seconds }, { "stop", learn::to_string(report.stop) },
+    { "message", report.message }, { "history", history } };
   io::write_material_file(o.output, fitted);
 
   std::printf("%s: %s\n", learn::to_string(report.stop).c_str(), report.message.c_str());
-  std::printf("observation error rms %.4g %% -> %.4g %%, max %.4g %% -> %.4g %% of the size (%.4g m); "
-              "%d iterations, %d simulations (%d diverged), %.1f s\n",
-      100 * report.initial_rms / diagonal, 100 * report.final_rms / diagonal, 100 * report.initial_max / diagonal,
-      100 * report.final_max / diagonal, diagonal, report.iterations, report.simulations, report.diverged,
-      report.seconds);
+  std::printf(
+      "observation error rms %.4g %% -> %.4g %%, max %.4g %% -> %.4g %% of the size (%.4g m); "
+      "%d iterations, %d simulations (%d diverged), %.1f s\n",
+      100 * report.initial_rms / diagonal, 100 * report.final_rms / diagonal,
+      100 * report.initial_max / diagonal, 100 * report.final_max / diagonal, diagonal,
+      report.iterations, report.simulations, report.diverged, report.seconds);
   std::printf("fitted: E %.6g Pa, nu %.5g, alpha0 %.5g 1/s, alpha1 %.5g s\n", report.fitted.young,
       report.fitted.poisson, report.fitted.alpha0, report.fitted.alpha1);
   std::printf("material: %s\n", o.output.c_str());
@@ -124,17 +138,27 @@ void run_fit(const FitOptions& o) {
 void add_fit_parameters_command(CLI::App& root) {
   auto o = std::make_shared<FitOptions>();
   auto* cmd = root.add_subcommand("fit-parameters",
-      "Fit E, nu and Rayleigh damping of the nominal material to observations (the baseline of learn)");
-  cmd->add_option("scene", o->scene, "scene with the start material (elastolearn-scene/1 JSON)")->required();
-  cmd->add_option("--observations", o->observations, "observation HDF5 (from observe, or your capture)")->required();
-  cmd->add_option("-o,--output", o->output, "material JSON to write (fitted nominal, no correction)")->required();
-  cmd->add_option("--fit", o->fit, "comma-separated parameters to fit: young, poisson, alpha0, alpha1")
+      "Fit E, nu and Rayleigh damping of the nominal material to observations (the baseline of "
+      "learn)");
+  cmd->add_option("scene", o->scene, "scene with the start material (elastolearn-scene/1 JSON)")
+      ->required();
+  cmd->add_option(
+         "--observations", o->observations, "observation HDF5 (from observe, or your capture)")
+      ->required();
+  cmd->add_option(
+         "-o,--output", o->output, "material JSON to write (fitted nominal, no correction)")
+      ->required();
+  cmd->add_option(
+         "--fit", o->fit, "comma-separated parameters to fit: young, poisson, alpha0, alpha1")
       ->capture_default_str();
   auto& l = o->library;
   cmd->add_option("--frames", l.frames, "fit the first N steps only (faster; default: all)");
-  cmd->add_option("--max-iterations", l.max_iterations, "Levenberg-Marquardt iterations")->capture_default_str();
-  cmd->add_option("--tolerance", l.tolerance, "stop below this relative improvement")->capture_default_str();
-  cmd->add_option("--fd-step", l.finite_difference_step, "finite-difference step in log E, logit nu, log alpha")
+  cmd->add_option("--max-iterations", l.max_iterations, "Levenberg-Marquardt iterations")
+      ->capture_default_str();
+  cmd->add_option("--tolerance", l.tolerance, "stop below this relative improvement")
+      ->capture_default_str();
+  cmd->add_option("--fd-step", l.finite_difference_step,
+         "finite-difference step in log E, logit nu, log alpha")
       ->capture_default_str();
   cmd->add_flag("--serial", o->serial, "run the finite-difference simulations one after the other");
   cmd->add_flag("-q,--quiet", o->quiet, "no per-iteration lines");

@@ -26,7 +26,8 @@ Run run(const std::string& arguments) {
   FILE* pipe = popen(command.c_str(), "r");
   Run r { -1, "" };
   std::array<char, 4096> buffer {};
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) r.output.append(buffer.data(), n);
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe))
+    r.output.append(buffer.data(), n);
   const int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
@@ -38,7 +39,8 @@ std::string bar_scene(const std::string& material) {
   return R"({
   "format": "elastolearn-scene/1",
   "mesh": {"type": "box", "size": [0.2, 0.05, 0.05], "cells": [8, 2, 2]},
-  "material": )" + material + R"(,
+  "material": )"
+      + material + R"(,
   "gravity": [0, -9.81, 0],
   "fixed": [{"min": "x"}],
   "time": {"dt": 0.005, "frames": 30}
@@ -74,7 +76,8 @@ class CliFitParametersTest : public ::testing::Test {
   fs::path m_dir;
 };
 
-const char* k_start_material = R"({"model": "corotated", "young": 1e5, "poisson": 0.3, "density": 1000,
+const char* k_start_material
+    = R"({"model": "corotated", "young": 1e5, "poisson": 0.3, "density": 1000,
                                    "damping": {"alpha0": 0.2, "alpha1": 1e-3}})";
 
 } // namespace
@@ -91,7 +94,8 @@ TEST_F(CliFitParametersTest, FitsYoungAndDampingAndWritesAMaterialFile) {
   // Noise-free data from the same model: the fit reaches the truth up to the finite-difference
   // and Newton-tolerance noise (far below 1 %, see tests/learn/test_parameter_fit.cpp).
   EXPECT_NEAR(fitted.material.at("young").get<double>() / 1.5e5, 1.0, 1e-2) << r.output;
-  EXPECT_NEAR(fitted.material.at("damping").at("alpha1").get<double>() / 3e-3, 1.0, 2e-2) << r.output;
+  EXPECT_NEAR(fitted.material.at("damping").at("alpha1").get<double>() / 3e-3, 1.0, 2e-2)
+      << r.output;
   EXPECT_EQ(fitted.material.at("damping").at("alpha0").get<double>(), 0.2); // not fitted
   EXPECT_EQ(fitted.material.at("poisson").get<double>(), 0.3);
   EXPECT_EQ(fitted.correction, nullptr);
@@ -108,22 +112,25 @@ TEST_F(CliFitParametersTest, BadOptionsNameTheProblemAndWriteNothing) {
   const auto obs = observe_truth();
   const auto scene = write("start.json", bar_scene(k_start_material));
   const auto out = m_dir / "fitted.json";
-  auto r = run("fit-parameters " + scene.string() + " --observations " + obs.string() + " -o " + out.string()
-      + " --fit young,stiffness");
+  auto r = run("fit-parameters " + scene.string() + " --observations " + obs.string() + " -o "
+      + out.string() + " --fit young,stiffness");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--fit"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("stiffness"), std::string::npos) << r.output;
   // An observation of a different motion length is refused with the file named.
   const auto longer = write("longer.json",
-      bar_scene(k_start_material).replace(bar_scene(k_start_material).find("\"frames\": 30"), 12, "\"frames\": 40"));
-  r = run("fit-parameters " + longer.string() + " --observations " + obs.string() + " -o " + out.string());
+      bar_scene(k_start_material)
+          .replace(bar_scene(k_start_material).find("\"frames\": 30"), 12, "\"frames\": 40"));
+  r = run("fit-parameters " + longer.string() + " --observations " + obs.string() + " -o "
+      + out.string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("obs.h5"), std::string::npos) << r.output;
   // A stretch-dependent damping cannot be a start for constant coefficients.
-  const auto splined = write("splined.json",
-      bar_scene(R"({"model": "corotated", "young": 1e5, "poisson": 0.3,
+  const auto splined
+      = write("splined.json", bar_scene(R"({"model": "corotated", "young": 1e5, "poisson": 0.3,
                     "damping": {"alpha1": {"stretches": [1, 1.1], "values": [0.001, 0.002]}}})"));
-  r = run("fit-parameters " + splined.string() + " --observations " + obs.string() + " -o " + out.string());
+  r = run("fit-parameters " + splined.string() + " --observations " + obs.string() + " -o "
+      + out.string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("material.damping.alpha1"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));

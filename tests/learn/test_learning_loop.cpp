@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 namespace elastolearn::learn {
 namespace {
 
@@ -69,18 +71,20 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   ASSERT_TRUE(run_learning(bar_scene(nominal, false), observed, small_options(), state));
   ASSERT_TRUE(state.best);
   ASSERT_FALSE(state.history.empty());
-  // The training fit improves by orders of magnitude (measured 4.3e-3 m → 3.5e-5 m RMS).
+  // The training fit improves by orders of magnitude (measured 4.3e-3 m → 5.6e-5 m RMS).
   EXPECT_LT(state.best_error, 0.02 * state.history.front().forward_error.rms);
 
   const double nominal_error = swing_error(bar_scene(truth, true), bar_scene(nominal, true));
   const double learned_error = swing_error(bar_scene(truth, true), with_correction(bar_scene(nominal, true), state.best));
   // Stored regression numbers (Release build, this configuration): nominal 4.304 %, learned
-  // 0.024 %. The issue asks for ≥ 5× below the nominal; we assert that and that we have not
-  // regressed by more than 4× from the stored learned figure (round-off in k-means/TBB sums
-  // can move it a little; a broken stage moves it by orders of magnitude).
+  // 0.0556 % (77× lower). The issue asks for ≥ 5× below the nominal; we assert that and that we
+  // have not regressed by more than 2× from the stored learned figure (a compiler's different
+  // rounding moves it a little; a broken stage moves it by orders of magnitude).
+  std::printf("[ measured ] err_L nominal %.4f %%, learned %.4f %% (best iteration %d)\n", nominal_error,
+              learned_error, state.best_iteration);
   EXPECT_NEAR(nominal_error, 4.304, 0.01);
   EXPECT_LT(learned_error, nominal_error / 5);
-  EXPECT_LT(learned_error, 4 * 0.024);
+  EXPECT_LT(learned_error, 2 * 0.0556);
 }
 
 TEST(LearningLoop, TruthEqualToNominalLearnsAlmostNothing) {

@@ -38,9 +38,8 @@ observe::Observation observe_truth(const sim::Scene& scene, const NominalParamet
   const sim::Scene truth_scene
       = learn::scene_with_parameters(scene, material::ElasticModelType::Corotated, truth);
   std::vector<Positions> frames;
-  const auto report = sim::run_simulation(truth_scene, [&](int, double, const VecX& x, const VecX&) {
-    frames.emplace_back(unflatten(x));
-  });
+  const auto report = sim::run_simulation(truth_scene,
+      [&](int, double, const VecX& x, const VecX&) { frames.emplace_back(unflatten(x)); });
   EXPECT_TRUE(report.completed) << report.message;
   const auto ids = observe::select_visible_vertices(scene.mesh, 0.3, 1);
   return observe::observe_vertices(frames, scene.dt, ids, 0.0, 1);
@@ -50,8 +49,8 @@ observe::Observation observe_truth(const sim::Scene& scene, const NominalParamet
 
 TEST(ParameterFit, RecoversYoungAndStiffnessDampingOfTheSameModel) {
   const sim::Scene scene = bar_scene(60);
-  const NominalParameters truth{ 1.5e5, 0.3, 0.0, 4e-3 };
-  const NominalParameters start{ 1e5, 0.3, 0.0, 1e-3 };
+  const NominalParameters truth { 1.5e5, 0.3, 0.0, 4e-3 };
+  const NominalParameters start { 1e5, 0.3, 0.0, 1e-3 };
   const auto obs = observe_truth(scene, truth);
 
   learn::ParameterFitOptions options;
@@ -91,14 +90,14 @@ TEST(ParameterFit, FewerFramesAndPoissonAlsoWork) {
   // and its bending stiffness (a weaker signal than E), but with zero-residual data both are
   // still recovered far better than 1e-3 (same argument as above).
   const sim::Scene scene = bar_scene(60);
-  const NominalParameters truth{ 1.2e5, 0.35, 0.0, 2e-3 };
+  const NominalParameters truth { 1.2e5, 0.35, 0.0, 2e-3 };
   const auto obs = observe_truth(scene, truth);
   learn::ParameterFitOptions options;
   options.parameters = { FitParameter::Young, FitParameter::Poisson };
   options.frames = 30;
   options.tolerance = 1e-3;
-  const auto report = learn::fit_parameters(scene, material::ElasticModelType::Corotated,
-      { 1e5, 0.25, 0.0, 2e-3 }, obs, options);
+  const auto report = learn::fit_parameters(
+      scene, material::ElasticModelType::Corotated, { 1e5, 0.25, 0.0, 2e-3 }, obs, options);
   EXPECT_EQ(report.frames, 30);
   EXPECT_NEAR(report.fitted.young / truth.young, 1.0, 1e-3) << report.message;
   EXPECT_NEAR(report.fitted.poisson / truth.poisson, 1.0, 1e-3) << report.message;
@@ -116,7 +115,7 @@ TEST(ParameterFit, DivergingTrialsAreRejectedNotFatal) {
   scene.newton.relative_tolerance = 1e-10;
   learn::ParameterFitOptions options;
   options.parameters = { FitParameter::Young };
-  const NominalParameters start{ 4e5, 0.3, 0.0, 2e-3 };
+  const NominalParameters start { 4e5, 0.3, 0.0, 2e-3 };
   const auto report
       = learn::fit_parameters(scene, material::ElasticModelType::Corotated, start, obs, options);
   EXPECT_GE(report.diverged, 1);
@@ -125,7 +124,8 @@ TEST(ParameterFit, DivergingTrialsAreRejectedNotFatal) {
   EXPECT_LT(report.fitted.young, start.young);
   EXPECT_GT(report.fitted.young, 1.5e5); // below that, this solver setting cannot simulate
   const auto check = sim::run_simulation(
-      learn::scene_with_parameters(scene, material::ElasticModelType::Corotated, report.fitted), {});
+      learn::scene_with_parameters(scene, material::ElasticModelType::Corotated, report.fitted),
+      {});
   EXPECT_TRUE(check.completed) << check.message;
 
   // A start that itself diverges (one Newton iteration never meets the tolerance) is a report
@@ -142,7 +142,7 @@ TEST(ParameterFit, DivergingTrialsAreRejectedNotFatal) {
 TEST(ParameterFit, BadInputIsRejectedWithTheField) {
   const sim::Scene scene = bar_scene(10);
   const auto obs = observe_truth(scene, { 1e5, 0.3, 0.0, 0.0 });
-  const NominalParameters start{ 1e5, 0.3, 0.0, 0.0 };
+  const NominalParameters start { 1e5, 0.3, 0.0, 0.0 };
   const auto fit = [&](const NominalParameters& p, const learn::ParameterFitOptions& o,
                        const observe::Observation& ob) {
     return learn::fit_parameters(scene, material::ElasticModelType::Corotated, p, ob, o);
@@ -160,7 +160,7 @@ TEST(ParameterFit, BadInputIsRejectedWithTheField) {
   EXPECT_THROW(fit(start, {}, bad_id), InputError);
 
   EXPECT_EQ(learn::fit_parameters_from_string("young, alpha1"),
-      (std::vector<FitParameter>{ FitParameter::Young, FitParameter::Alpha1 }));
+      (std::vector<FitParameter> { FitParameter::Young, FitParameter::Alpha1 }));
   EXPECT_THROW(learn::fit_parameters_from_string("young,young"), InputError);
   EXPECT_THROW(learn::fit_parameters_from_string("youngs"), InputError);
   EXPECT_THROW(learn::fit_parameters_from_string(""), InputError);

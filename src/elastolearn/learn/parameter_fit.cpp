@@ -34,22 +34,33 @@ struct ParameterTransform {
 
   double to_u(FitParameter which, const NominalParameters& p) const {
     switch (which) {
-    case FitParameter::Young: return std::log(p.young);
+    case FitParameter::Young:
+      return std::log(p.young);
     case FitParameter::Poisson: {
       const double s = p.poisson / kPoissonMax;
       return std::log(s / (1 - s));
     }
-    case FitParameter::Alpha0: return std::log(p.alpha0 + floor0);
-    case FitParameter::Alpha1: return std::log(p.alpha1 + floor1);
+    case FitParameter::Alpha0:
+      return std::log(p.alpha0 + floor0);
+    case FitParameter::Alpha1:
+      return std::log(p.alpha1 + floor1);
     }
     return 0;
   }
   void set(FitParameter which, double u, NominalParameters& p) const {
     switch (which) {
-    case FitParameter::Young: p.young = std::exp(u); break;
-    case FitParameter::Poisson: p.poisson = kPoissonMax / (1 + std::exp(-u)); break;
-    case FitParameter::Alpha0: p.alpha0 = std::max(0.0, std::exp(u) - floor0); break;
-    case FitParameter::Alpha1: p.alpha1 = std::max(0.0, std::exp(u) - floor1); break;
+    case FitParameter::Young:
+      p.young = std::exp(u);
+      break;
+    case FitParameter::Poisson:
+      p.poisson = kPoissonMax / (1 + std::exp(-u));
+      break;
+    case FitParameter::Alpha0:
+      p.alpha0 = std::max(0.0, std::exp(u) - floor0);
+      break;
+    case FitParameter::Alpha1:
+      p.alpha1 = std::max(0.0, std::exp(u) - floor1);
+      break;
     }
   }
 };
@@ -57,8 +68,8 @@ struct ParameterTransform {
 /// One forward simulation compared with the observation.
 struct Evaluation {
   bool completed = false;
-  std::string message;  ///< the simulation's reason when not completed
-  VecX residual;        ///< x_sim − x_obs at the observed vertices, frame-major, (frames+1)·k·3
+  std::string message; ///< the simulation's reason when not completed
+  VecX residual; ///< x_sim − x_obs at the observed vertices, frame-major, (frames+1)·k·3
   double cost = std::numeric_limits<double>::infinity(); ///< ‖residual‖²
   double max_error = 0; ///< max over (frame, vertex) of the error norm [m]
 
@@ -76,8 +87,8 @@ Evaluation evaluate(const sim::Scene& base, material::ElasticModelType type,
   const auto sink = [&](int frame, double, const VecX& x, const VecX&) {
     const Positions& observed = obs.positions[static_cast<size_t>(frame)];
     for (int j = 0; j < k; ++j) {
-      const Vec3 d = x.segment<3>(3 * obs.vertex_ids[static_cast<size_t>(j)])
-          - observed.row(j).transpose();
+      const Vec3 d
+          = x.segment<3>(3 * obs.vertex_ids[static_cast<size_t>(j)]) - observed.row(j).transpose();
       e.residual.segment<3>((static_cast<Eigen::Index>(frame) * k + j) * 3) = d;
       max_sq = std::max(max_sq, d.squaredNorm());
     }
@@ -103,21 +114,25 @@ std::string describe(const NominalParameters& p) {
 std::string describe(const ParameterFitIteration& it) {
   char buf[320];
   std::snprintf(buf, sizeof buf,
-      "iteration %d: rms %.4g m, max %.4g m | %s | lambda %.2g, %d rejected | %.1f s",
-      it.iteration, it.rms_error, it.max_error, describe(it.parameters).c_str(), it.lambda,
-      it.rejected_steps, it.seconds);
+      "iteration %d: rms %.4g m, max %.4g m | %s | lambda %.2g, %d rejected | %.1f s", it.iteration,
+      it.rms_error, it.max_error, describe(it.parameters).c_str(), it.lambda, it.rejected_steps,
+      it.seconds);
   return buf;
 }
 
 void check_start(const NominalParameters& p, const std::vector<FitParameter>& fitted) {
   if (!(p.young > 0 && std::isfinite(p.young)))
-    throw InputError("young", "start value must be positive and finite, got " + std::to_string(p.young));
+    throw InputError(
+        "young", "start value must be positive and finite, got " + std::to_string(p.young));
   if (!(p.poisson > -1 && p.poisson < 0.5))
-    throw InputError("poisson", "start value must be in (-1, 0.5), got " + std::to_string(p.poisson));
+    throw InputError(
+        "poisson", "start value must be in (-1, 0.5), got " + std::to_string(p.poisson));
   if (!(p.alpha0 >= 0 && std::isfinite(p.alpha0)))
-    throw InputError("alpha0", "start value must be >= 0 and finite, got " + std::to_string(p.alpha0));
+    throw InputError(
+        "alpha0", "start value must be >= 0 and finite, got " + std::to_string(p.alpha0));
   if (!(p.alpha1 >= 0 && std::isfinite(p.alpha1)))
-    throw InputError("alpha1", "start value must be >= 0 and finite, got " + std::to_string(p.alpha1));
+    throw InputError(
+        "alpha1", "start value must be >= 0 and finite, got " + std::to_string(p.alpha1));
   const bool fits_poisson
       = std::find(fitted.begin(), fitted.end(), FitParameter::Poisson) != fitted.end();
   if (fits_poisson && !(p.poisson > 0 && p.poisson < kPoissonMax))
@@ -134,21 +149,27 @@ std::string to_string(FitParameter parameter) {
 
 FitParameter fit_parameter_from_string(std::string_view name, const std::string& where) {
   for (size_t i = 0; i < kParameterNames.size(); ++i)
-    if (name == kParameterNames[i]) return static_cast<FitParameter>(i);
+    if (name == kParameterNames[i])
+      return static_cast<FitParameter>(i);
   throw InputError(where,
       "unknown parameter '" + std::string(name) + "' (valid: young, poisson, alpha0, alpha1)");
 }
 
-std::vector<FitParameter> fit_parameters_from_string(std::string_view list, const std::string& where) {
+std::vector<FitParameter> fit_parameters_from_string(
+    std::string_view list, const std::string& where) {
   std::vector<FitParameter> result;
   size_t begin = 0;
   while (begin <= list.size()) {
     size_t end = list.find(',', begin);
-    if (end == std::string_view::npos) end = list.size();
+    if (end == std::string_view::npos)
+      end = list.size();
     std::string_view token = list.substr(begin, end - begin);
-    while (!token.empty() && token.front() == ' ') token.remove_prefix(1);
-    while (!token.empty() && token.back() == ' ') token.remove_suffix(1);
-    if (token.empty()) throw InputError(where, "empty parameter name in '" + std::string(list) + "'");
+    while (!token.empty() && token.front() == ' ')
+      token.remove_prefix(1);
+    while (!token.empty() && token.back() == ' ')
+      token.remove_suffix(1);
+    if (token.empty())
+      throw InputError(where, "empty parameter name in '" + std::string(list) + "'");
     const FitParameter p = fit_parameter_from_string(token, where);
     if (std::find(result.begin(), result.end(), p) != result.end())
       throw InputError(where, "parameter '" + std::string(token) + "' is listed twice");
@@ -160,24 +181,32 @@ std::vector<FitParameter> fit_parameters_from_string(std::string_view list, cons
 
 std::string to_string(FitStop stop) {
   switch (stop) {
-  case FitStop::Converged: return "converged";
-  case FitStop::MaxIterations: return "max_iterations";
-  case FitStop::NoImprovingStep: return "no_improving_step";
-  case FitStop::StartDiverged: return "start_diverged";
-  case FitStop::Interrupted: return "interrupted";
+  case FitStop::Converged:
+    return "converged";
+  case FitStop::MaxIterations:
+    return "max_iterations";
+  case FitStop::NoImprovingStep:
+    return "no_improving_step";
+  case FitStop::StartDiverged:
+    return "start_diverged";
+  case FitStop::Interrupted:
+    return "interrupted";
   }
   return "unknown";
 }
 
 sim::Scene scene_with_parameters(
     const sim::Scene& scene, material::ElasticModelType type, const NominalParameters& parameters) {
-  const material::Lame lame = material::Lame::from_young_poisson(parameters.young, parameters.poisson);
+  const material::Lame lame
+      = material::Lame::from_young_poisson(parameters.young, parameters.poisson);
   sim::Scene result = scene;
   if (type == material::ElasticModelType::SplineEdited) {
-    const auto* edited = dynamic_cast<const material::SplineEditedModel*>(scene.material.elastic.get());
+    const auto* edited
+        = dynamic_cast<const material::SplineEditedModel*>(scene.material.elastic.get());
     if (!edited)
       throw InputError("material.model",
-          "spline_edited parameters need a scene whose material is spline-edited (it holds the spline)");
+          "spline_edited parameters need a scene whose material is spline-edited (it holds the "
+          "spline)");
     result.material.elastic = std::make_shared<material::SplineEditedModel>(
         edited->base_type(), lame, edited->region(), edited->spline());
   } else {
@@ -189,7 +218,8 @@ sim::Scene scene_with_parameters(
 }
 
 void ParameterFitOptions::validate() const {
-  if (parameters.empty()) throw InputError("fit.parameters", "choose at least one parameter to fit");
+  if (parameters.empty())
+    throw InputError("fit.parameters", "choose at least one parameter to fit");
   for (size_t i = 0; i < parameters.size(); ++i)
     for (size_t j = i + 1; j < parameters.size(); ++j)
       if (parameters[i] == parameters[j])
@@ -201,7 +231,8 @@ void ParameterFitOptions::validate() const {
   if (!(tolerance >= 0 && tolerance < 1))
     throw InputError("fit.tolerance", "must be in [0, 1), got " + std::to_string(tolerance));
   if (!(initial_lambda > 0 && std::isfinite(initial_lambda)))
-    throw InputError("fit.initial_lambda", "must be positive, got " + std::to_string(initial_lambda));
+    throw InputError(
+        "fit.initial_lambda", "must be positive, got " + std::to_string(initial_lambda));
   if (max_rejections < 1)
     throw InputError("fit.max_rejections", "must be >= 1, got " + std::to_string(max_rejections));
   if (!(finite_difference_step > 0 && finite_difference_step < 1))
@@ -210,7 +241,8 @@ void ParameterFitOptions::validate() const {
   if (!(max_step > 0 && std::isfinite(max_step)))
     throw InputError("fit.max_step", "must be positive, got " + std::to_string(max_step));
   if (!std::isfinite(error_tolerance))
-    throw InputError("fit.error_tolerance", "must be finite, got " + std::to_string(error_tolerance));
+    throw InputError(
+        "fit.error_tolerance", "must be finite, got " + std::to_string(error_tolerance));
   if (!std::isfinite(alpha0_floor) || !std::isfinite(alpha1_floor))
     throw InputError("fit.alpha_floor", "damping floors must be finite");
 }
@@ -228,11 +260,12 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
   if (frames > obs.num_frames() - 1)
     throw InputError("fit.frames",
         std::to_string(frames) + " steps requested but the observation has only "
-            + std::to_string(obs.num_frames() - 1) + " (frames 0.." + std::to_string(obs.num_frames() - 1) + ")");
+            + std::to_string(obs.num_frames() - 1) + " (frames 0.."
+            + std::to_string(obs.num_frames() - 1) + ")");
 
   const double duration = frames * scene.dt;
-  const ParameterTransform transform{
-    options.alpha0_floor > 0 ? options.alpha0_floor : 1e-2 / duration,
+  const ParameterTransform transform { options.alpha0_floor > 0 ? options.alpha0_floor
+                                                                : 1e-2 / duration,
     options.alpha1_floor > 0 ? options.alpha1_floor : 1e-2 * scene.dt };
   const auto& fitted = options.parameters;
   const int p = static_cast<int>(fitted.size());
@@ -256,7 +289,8 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
     it.rejected_steps = rejected;
     it.seconds = seconds_since(t0);
     report.history.push_back(it);
-    if (progress) progress(iteration, options.max_iterations, describe(it));
+    if (progress)
+      progress(iteration, options.max_iterations, describe(it));
   };
   auto finish = [&](const Evaluation& e, FitStop stop, std::string message) {
     report.final_rms = e.rms(samples);
@@ -289,7 +323,8 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
     // Transformed coordinates of the current parameters (re-derived each time, so a damping
     // clamped at 0 sits at log(floor) where its forward difference is informative).
     VecX u(p);
-    for (int i = 0; i < p; ++i) u[i] = transform.to_u(fitted[i], report.fitted);
+    for (int i = 0; i < p; ++i)
+      u[i] = transform.to_u(fitted[i], report.fitted);
 
     // Forward-difference Jacobian: one simulation per parameter (backwards if forwards diverges).
     MatX J = MatX::Zero(current.residual.size(), p);
@@ -305,20 +340,23 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
           return;
         }
         ++failures[static_cast<size_t>(i)];
-        if (interrupt_requested()) return;
+        if (interrupt_requested())
+          return;
       }
     };
     if (parallel) {
       tbb::parallel_for(0, p, column);
     } else {
-      for (int i = 0; i < p; ++i) column(i);
+      for (int i = 0; i < p; ++i)
+        column(i);
     }
     for (int i = 0; i < p; ++i) {
       report.simulations += runs[static_cast<size_t>(i)];
       report.diverged += failures[static_cast<size_t>(i)];
     }
     if (interrupt_requested())
-      return finish(current, FitStop::Interrupted, "interrupted; the best parameters so far are kept");
+      return finish(
+          current, FitStop::Interrupted, "interrupted; the best parameters so far are kept");
 
     const MatX JtJ = J.transpose() * J;
     const VecX gradient = J.transpose() * current.residual;
@@ -326,9 +364,11 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
     const double diag_max = JtJ.diagonal().maxCoeff();
     if (!(diag_max > 0))
       return finish(current, FitStop::NoImprovingStep,
-          "no fitted parameter changes the observed motion (or every perturbed simulation diverged)");
+          "no fitted parameter changes the observed motion (or every perturbed simulation "
+          "diverged)");
     std::vector<bool> active(static_cast<size_t>(p));
-    for (int i = 0; i < p; ++i) active[static_cast<size_t>(i)] = JtJ(i, i) > 1e-14 * diag_max;
+    for (int i = 0; i < p; ++i)
+      active[static_cast<size_t>(i)] = JtJ(i, i) > 1e-14 * diag_max;
 
     int rejected = 0;
     std::string last_failure;
@@ -347,17 +387,21 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
       }
       VecX rhs = -gradient;
       for (int i = 0; i < p; ++i)
-        if (!active[static_cast<size_t>(i)]) rhs[i] = 0;
+        if (!active[static_cast<size_t>(i)])
+          rhs[i] = 0;
       VecX delta = A.ldlt().solve(rhs);
       const double largest = delta.cwiseAbs().maxCoeff();
-      if (largest > options.max_step) delta *= options.max_step / largest;
+      if (largest > options.max_step)
+        delta *= options.max_step / largest;
 
       NominalParameters trial = report.fitted;
-      for (int i = 0; i < p; ++i) transform.set(fitted[i], u[i] + delta[i], trial);
+      for (int i = 0; i < p; ++i)
+        transform.set(fitted[i], u[i] + delta[i], trial);
       Evaluation e = evaluate(scene, type, trial, obs, frames);
       ++report.simulations;
       if (interrupt_requested())
-        return finish(current, FitStop::Interrupted, "interrupted; the best parameters so far are kept");
+        return finish(
+            current, FitStop::Interrupted, "interrupted; the best parameters so far are kept");
       if (e.completed && e.cost < current.cost) {
         improvement = (current.cost - e.cost) / current.cost;
         current = std::move(e);
@@ -365,7 +409,8 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
         lambda = std::max(lambda / 3, 1e-12);
         accepted = true;
       } else {
-        if (!e.completed) ++report.diverged;
+        if (!e.completed)
+          ++report.diverged;
         last_failure = e.completed ? "" : e.message;
         lambda *= e.completed ? 4 : 10; // a diverged trial was a long step: shrink harder
         if (++rejected >= options.max_rejections) {

@@ -17,10 +17,10 @@ namespace elastolearn::learn {
 
 /// The scalar parameters of the nominal model (constant Rayleigh damping).
 struct NominalParameters {
-  double young = 0;   ///< E [Pa], > 0
+  double young = 0; ///< E [Pa], > 0
   double poisson = 0; ///< ν, in (−1, 0.5)
-  double alpha0 = 0;  ///< mass-proportional damping [1/s], ≥ 0
-  double alpha1 = 0;  ///< stiffness-proportional damping [s], ≥ 0
+  double alpha0 = 0; ///< mass-proportional damping [1/s], ≥ 0
+  double alpha1 = 0; ///< stiffness-proportional damping [s], ≥ 0
 };
 
 /// A fittable parameter. Names (JSON and CLI): "young", "poisson", "alpha0", "alpha1".
@@ -28,10 +28,12 @@ enum class FitParameter { Young, Poisson, Alpha0, Alpha1 };
 
 std::string to_string(FitParameter parameter);
 /// Inverse of to_string; throws InputError(where, ...) listing the valid names.
-FitParameter fit_parameter_from_string(std::string_view name, const std::string& where = "parameter");
+FitParameter fit_parameter_from_string(
+    std::string_view name, const std::string& where = "parameter");
 /// A comma-separated list ("young,alpha1"); throws InputError(where, ...) on an unknown or
 /// repeated name or an empty list.
-std::vector<FitParameter> fit_parameters_from_string(std::string_view list, const std::string& where = "--fit");
+std::vector<FitParameter> fit_parameters_from_string(
+    std::string_view list, const std::string& where = "--fit");
 
 /// The scene with the nominal material replaced: the elastic model of `type` with Lamé
 /// parameters from (E, ν) and constant Rayleigh damping (α₀, α₁); density and any correction are
@@ -45,9 +47,9 @@ inline constexpr int kParallelFitMaxDofs = 20000;
 
 struct ParameterFitOptions {
   /// Which parameters move (the others stay at their start values). Non-empty, no repeats.
-  std::vector<FitParameter> parameters = { FitParameter::Young, FitParameter::Poisson,
-    FitParameter::Alpha0, FitParameter::Alpha1 };
-  int max_iterations = 20;    ///< Levenberg–Marquardt iterations (Jacobian evaluations), ≥ 1
+  std::vector<FitParameter> parameters
+      = { FitParameter::Young, FitParameter::Poisson, FitParameter::Alpha0, FitParameter::Alpha1 };
+  int max_iterations = 20; ///< Levenberg–Marquardt iterations (Jacobian evaluations), ≥ 1
   /// Simulated steps compared with the observation (frames 0..frames); −1 = all (T − 1).
   /// Fewer frames make every simulation proportionally faster.
   int frames = -1;
@@ -57,7 +59,7 @@ struct ParameterFitOptions {
   /// bounding-box diagonal (round-off: only reached by data from the same simulator).
   double error_tolerance = 0;
   double initial_lambda = 1e-3; ///< Levenberg–Marquardt damping λ (relative to diag JᵀJ)
-  int max_rejections = 8;       ///< rejected trial steps in a row before giving up
+  int max_rejections = 8; ///< rejected trial steps in a row before giving up
   /// Forward-difference step in the transformed parameters (log E, logit ν, log(α + floor)).
   double finite_difference_step = 1e-3;
   /// Largest step per transformed parameter in one iteration (e.g. 1.5: E changes by ≤ e^1.5).
@@ -77,37 +79,37 @@ struct ParameterFitOptions {
 
 /// Why the fit stopped.
 enum class FitStop {
-  Converged,       ///< relative improvement below tolerance (or the error is zero)
-  MaxIterations,   ///< iteration budget used
+  Converged, ///< relative improvement below tolerance (or the error is zero)
+  MaxIterations, ///< iteration budget used
   NoImprovingStep, ///< max_rejections trial steps in a row did not lower the objective
-  StartDiverged,   ///< the simulation with the start parameters failed; nothing was fitted
-  Interrupted,     ///< interrupt requested (Ctrl-C); the best parameters so far are returned
+  StartDiverged, ///< the simulation with the start parameters failed; nothing was fitted
+  Interrupted, ///< interrupt requested (Ctrl-C); the best parameters so far are returned
 };
 std::string to_string(FitStop stop);
 
 /// One accepted (or final) state of the fit.
 struct ParameterFitIteration {
-  int iteration = 0;             ///< 0 = start
+  int iteration = 0; ///< 0 = start
   NominalParameters parameters;
-  double rms_error = 0;          ///< √(mean over (frame, observed vertex) of ‖x_sim − x_obs‖²) [m]
-  double max_error = 0;          ///< max over (frame, observed vertex) of ‖x_sim − x_obs‖ [m]
-  double lambda = 0;             ///< LM damping after this iteration
-  int rejected_steps = 0;        ///< trial steps rejected in this iteration (diverged or worse)
-  double seconds = 0;            ///< wall time since the fit started
+  double rms_error = 0; ///< √(mean over (frame, observed vertex) of ‖x_sim − x_obs‖²) [m]
+  double max_error = 0; ///< max over (frame, observed vertex) of ‖x_sim − x_obs‖ [m]
+  double lambda = 0; ///< LM damping after this iteration
+  int rejected_steps = 0; ///< trial steps rejected in this iteration (diverged or worse)
+  double seconds = 0; ///< wall time since the fit started
 };
 
 struct ParameterFitReport {
   NominalParameters initial;
-  NominalParameters fitted;      ///< best parameters found (= initial if nothing improved)
+  NominalParameters fitted; ///< best parameters found (= initial if nothing improved)
   double initial_rms = 0, initial_max = 0; ///< observation errors of the start [m]
-  double final_rms = 0, final_max = 0;     ///< observation errors of `fitted` [m]
-  int iterations = 0;            ///< Jacobian evaluations
-  int simulations = 0;           ///< forward simulations run (including finite differences)
-  int diverged = 0;              ///< of those, simulations that failed (rejected or retried)
-  int frames = 0;                ///< simulated steps per simulation
-  double seconds = 0;            ///< total wall time
+  double final_rms = 0, final_max = 0; ///< observation errors of `fitted` [m]
+  int iterations = 0; ///< Jacobian evaluations
+  int simulations = 0; ///< forward simulations run (including finite differences)
+  int diverged = 0; ///< of those, simulations that failed (rejected or retried)
+  int frames = 0; ///< simulated steps per simulation
+  double seconds = 0; ///< total wall time
   FitStop stop = FitStop::MaxIterations;
-  std::string message;           ///< human-readable reason (names a divergence's frame)
+  std::string message; ///< human-readable reason (names a divergence's frame)
   std::vector<ParameterFitIteration> history; ///< start, then every accepted iteration
 };
 
