@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <support/cli_runner.hpp>
+
 #include <gtest/gtest.h>
 #include <string>
 #include <sys/wait.h>
@@ -14,21 +16,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
-  int exit_code;
-  std::string output; // stdout + stderr
-};
-
-Run run(const std::string& arguments) {
-  const std::string command = std::string(ELASTOLEARN_EXECUTABLE) + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  Run r{-1, ""};
-  std::array<char, 4096> buffer{};
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) r.output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using elastolearn::test::Run;
+using elastolearn::test::run;
 
 class CliTest : public ::testing::Test {
 protected:

@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <support/cli_runner.hpp>
+
 #include <gtest/gtest.h>
 #include <string>
 #include <sys/wait.h>
@@ -19,22 +21,8 @@ using namespace elastolearn;
 
 namespace {
 
-struct Run {
-  int exit_code;
-  std::string output; // stdout + stderr
-};
-
-Run run(const std::string& arguments) {
-  const std::string command = std::string(ELASTOLEARN_EXECUTABLE) + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  Run r { -1, "" };
-  std::array<char, 4096> buffer {};
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe))
-    r.output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using elastolearn::test::Run;
+using elastolearn::test::run;
 
 /// The truth: a neo-Hookean bar sagging under gravity (192 tets, 20 frames).
 const char* k_truth_scene = R"({

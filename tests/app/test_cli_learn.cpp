@@ -1,0 +1,98 @@
+// `elastolearn learn` end to end through files: simulate a truth, observe a third of its surface,
+// learn from a wrong nominal, evaluate on the training scene; bad observations are refused.
+#include <support/cli_runner.hpp>
+
+#include <elastolearn/io/material_file.hpp>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using elastolearn::test::run;
+
+namespace {
+
+/// The nominal scene: a corotated bar 1.75× too stiff (240 tets, 50 frames of 4 ms).
+const char* k_scene = R"({
+  "format": "elastolearn-scene/1",
+  "mesh": {"type": "box", "size": [0.4, 0.1, 0.1], "cells": [10, 2, 2]},
+  "material": {"model": "corotated", "young": 1.75e6, "poisson": 0.43, "density": 1000,
+               "damping": {"alpha0": 0.0, "alpha1": 0.01}},
+  "gravity": [0, -9.81, 0],
+  "fixed": [{"min": "x"}],
+  "time": {"dt": 4e-3, "frames": 50}
+})";
+
+const char* k_truth = R"({"format": "elastolearn-material/1", "correction": null,
+  "material": {"model": "neohookean", "young": 1e6, "poisson": 0.43, "density": 1000,
+               "damping": {"alpha0": 0.0, "alpha1": 0.01}}})";
+
+class CliLearnTest : public ::testing::Test {
+protected:
+  void SetUp() override {
+    m_dir = fs::temp_directory_path() / ("elastolearn_cli_learn_" + std::to_string(::getpid()));
+    fs::remove_all(m_dir);
+    fs::create_directories(m_dir);
+    std::ofstream(m_dir / "scene.json") << k_scene;
+    std::ofstream(m_dir / "truth.json") << k_truth;
+  }
+  void TearDown() override { fs::remove_all(m_dir); }
+  std::string path(const std::string& name) const { return (m_dir / name).string(); }
+  fs::path m_dir;
+};
+
+double number_after(const std::string& text, const std::string& label) {
+  std::smatch m;
+  const std::regex re(label + R"(\s+([0-9.eE+-]+))");
+  if (!std::regex_search(text, m, re)) return -1;
+  return std::stod(m[1]);
+}
+
+TEST_F(CliLearnTest, LearnsAndEvaluates) {
+  ASSERT_EQ(run("simulate " + path("scene.json") + " --material " + path("truth.json") + " -o " + path("truth.h5") + " -q").exit_code, 0);
+  ASSERT_EQ(run("observe " + path("truth.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code, 0);
+  const auto learned = run("learn " + path("scene.json") + " --observations " + path("obs.h5") + " -o " +
+                           path("learned.json") + " --max-iterations 3 --kernels 15 --modes 10 --report " +
+                           path("report") + " -q");
+  ASSERT_EQ(learned.exit_code, 0) << learned.output;
+  EXPECT_NE(learned.output.find("learned material:"), std::string::npos) << learned.output;
+  EXPECT_TRUE(fs::exists(path("report/convergence.csv")));
+  EXPECT_TRUE(fs::exists(path("learned.json.checkpoint.json")));
+  const auto file = elastolearn::io::read_material_file(path("learned.json"));
+  ASSERT_NE(file.correction, nullptr) << "a correction beat the nominal model";
+  EXPECT_EQ(file.training.at("history").size(), 4u);
+
+  const auto evaluated = run("evaluate " + path("scene.json") + " --material " + path("learned.json") + " --truth " +
+                             path("truth.h5") + " -q");
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
+  const double nominal = number_after(evaluated.output, "nominal"), learned_error = number_after(evaluated.output, "learned");
+  ASSERT_GT(nominal, 0) << evaluated.output;
+  ASSERT_GE(learned_error, 0) << evaluated.output;
+  EXPECT_LT(learned_error, nominal / 5) << evaluated.output;
+
+  // --resume of a finished run changes nothing and says where it resumed.
+  const auto resumed = run("learn " + path("scene.json") + " --observations " + path("obs.h5") + " -o " +
+                           path("learned2.json") + " --checkpoint " + path("learned.json.checkpoint.json") +
+                           " --max-iterations 3 --kernels 15 --modes 10 --resume -q");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("resuming"), std::string::npos);
+  const auto again = elastolearn::io::read_material_file(path("learned2.json"));
+  EXPECT_EQ(elastolearn::io::correction_to_json(*again.correction), elastolearn::io::correction_to_json(*file.correction));
+}
+
+TEST_F(CliLearnTest, RefusesObservationsOfAnotherLength) {
+  std::ofstream(m_dir / "short.json") << std::regex_replace(k_scene, std::regex("\"frames\": 50"), "\"frames\": 20");
+  ASSERT_EQ(run("simulate " + path("short.json") + " -o " + path("short.h5") + " -q").exit_code, 0);
+  ASSERT_EQ(run("observe " + path("short.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code, 0);
+  const auto r = run("learn " + path("scene.json") + " --observations " + path("obs.h5") + " -o " + path("l.json"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("obs.h5"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("frames"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("l.json")));
+}
+
+} // namespace
