@@ -94,16 +94,21 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
   A.add_elements([&](int e, Mat12& J) {
     const TetRestData& rest = m_rest[e];
     const ElementCache& c = m_cache[e];
-    const Mat9 H = (c_x + c_v * c.alpha.alpha1) *
-                   material::first_piola_derivative(
-                       c.frame, c.has_tangent ? c.tangent
-                                              : material::principal_tangent(c.frame, c.stress.stress,
-                                                                            c.stress.d_stretches, m_project_tangent));
+    const material::PrincipalTangent tangent =
+        c.has_tangent ? c.tangent
+                      : material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
+    const Mat9 H = (c_x + c_v * c.alpha.alpha1) * material::first_piola_derivative(c.frame, tangent);
     // The projected tangent is symmetric; the exact one need not be (non-symmetric corrections).
     J = element_matrix_from_tangent(H, rest, m_project_tangent);
     if (c.alpha.alpha0 != 0) J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
     if (correction && c_v != 0) {
-      const Mat3 d_rates = m_project_tangent ? symmetric_psd(c.stress.d_stretch_rates) : c.stress.d_stretch_rates;
+      // Project the damping tangent as a whole: the Rayleigh part α₁·block plus the correction's
+      // rate part may be PSD together even where the rate part alone is not (a learned Δα₁ < 0
+      // that lowers but does not reverse the nominal damping); projecting them separately would
+      // overstate the damping and stall Newton.
+      const Mat3 rayleigh = c.alpha.alpha1 * tangent.block;
+      const Mat3 d_rates = m_project_tangent ? Mat3(symmetric_psd(rayleigh + c.stress.d_stretch_rates) - rayleigh)
+                                             : c.stress.d_stretch_rates;
       if (!d_rates.isZero(0))
         J += c_v * element_matrix_from_tangent(material::first_piola_rate_derivative(c.frame, d_rates), rest);
     }
