@@ -92,6 +92,7 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
                           {"max_iterations", o.space_time.max_iterations},
                           {"tolerance", o.space_time.tolerance}}},
           {"centres", o.centres},
+          {"full_space", o.full_space},
           {"rbf", {{"epsilon", o.rbf.epsilon}, {"elastic_polynomial", o.rbf.elastic_polynomial},
                    {"fit_damping", o.rbf.fit_damping}, {"damping_polynomial", o.rbf.damping_polynomial},
                    {"regularization", o.rbf.regularization}}},

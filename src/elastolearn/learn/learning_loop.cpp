@@ -53,6 +53,37 @@ std::vector<Positions> as_positions(const std::vector<VecX>& frames) {
   return out;
 }
 
+/// `run` with the tracked vertices moved to their data at every frame.
+ForwardRun with_tracked_data(ForwardRun run, const sim::Scene& tracked_scene) {
+  if (!run.completed || !tracked_scene.tracked) return run;
+  const auto& tracked = *tracked_scene.tracked;
+  for (size_t i = 0; i < run.positions.size(); ++i)
+    for (size_t j = 0; j < tracked.vertices.size(); ++j)
+      run.positions[i].segment<3>(3 * tracked.vertices[j]) =
+          tracked.position_at(static_cast<int>(j), tracked.start_time + static_cast<double>(i) * tracked.dt);
+  return run;
+}
+
+/// The full-space variant: Φ = the identity on the free dofs (no reduction).
+PodBasis identity_basis(int num_vertices, const std::vector<int>& free_vertices) {
+  PodBasis basis;
+  const auto columns = static_cast<Eigen::Index>(3 * free_vertices.size());
+  basis.modes = MatX::Zero(3 * static_cast<Eigen::Index>(num_vertices), columns);
+  for (size_t i = 0; i < free_vertices.size(); ++i)
+    for (int c = 0; c < 3; ++c) basis.modes(3 * free_vertices[i] + c, static_cast<Eigen::Index>(3 * i + c)) = 1;
+  basis.captured_energy = 1;
+  return basis;
+}
+
+/// The last iteration's control-force RMS is below 95 % of every earlier one.
+bool control_forces_still_shrinking(const std::vector<IterationRecord>& history) {
+  if (history.size() < 2) return false;
+  const double last = history.back().control_force_rms;
+  for (size_t i = 0; i + 1 < history.size(); ++i)
+    if (!(last < 0.95 * history[i].control_force_rms)) return false;
+  return last > 0;
+}
+
 template <typename T> std::vector<T> without_first(const std::vector<T>& v) { return {v.begin() + 1, v.end()}; }
 
 } // namespace
@@ -66,6 +97,7 @@ void LearningOptions::validate() const {
   rbf.validate();
   reconstruction.validate();
   stretch_samples.validate();
+  if (full_space && max_full_space_dofs < 1) throw InputError("learn.max_full_space_dofs", "must be ≥ 1");
 }
 
 sim::Scene with_correction(const sim::Scene& scene, std::shared_ptr<const material::Correction> correction) {
@@ -108,6 +140,13 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
   const ReconstructionMesh reconstruction_mesh(scene.mesh);
   const std::vector<int> basis_vertices = free_vertices(scene);
   const sim::Scene tracked_scene = constrained_scene(scene, observed);
+  // Every free vertex observed (small meshes): the constrained trajectory is the data itself.
+  const bool all_free_tracked = tracked_scene.tracked && tracked_scene.tracked->vertices.size() == basis_vertices.size();
+  if (options.full_space && 3 * static_cast<long>(basis_vertices.size()) > options.max_full_space_dofs)
+    throw InputError("learn.full_space", "the full-space variant solves dense " + std::to_string(3 * basis_vertices.size()) +
+                                             "² blocks per frame; it is meant for meshes up to " +
+                                             std::to_string(options.max_full_space_dofs) +
+                                             " free dofs: use the reduced (POD) variant");
   TrajectoryPhysics nominal_physics(scene);
 
   while (!state.finished) {
@@ -127,14 +166,18 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
     const double error = forward.completed ? observation_error(forward.positions, observed).rms
                                            : std::numeric_limits<double>::infinity();
     if (forward.completed) record.forward_error = observation_error(forward.positions, observed);
-    if (forward.completed && (next.best_error < 0 || error < next.best_error)) {
+    // Progress is a better forward error, or (paper §3) control forces that still shrink clearly
+    // although the forward error does not show it yet; the best correction is chosen by the former.
+    const bool better_forward = forward.completed && (next.best_error < 0 || error < next.best_error);
+    if (better_forward) {
       next.best = state.correction;
       next.best_error = error;
       next.best_iteration = record.iteration;
-      next.iterations_without_improvement = 0;
-    } else {
-      ++next.iterations_without_improvement;
     }
+    if (better_forward || (forward.completed && control_forces_still_shrinking(state.history)))
+      next.iterations_without_improvement = 0;
+    else
+      ++next.iterations_without_improvement;
     if (!forward.completed || next.iterations_without_improvement >= options.patience ||
         record.iteration >= options.max_iterations) {
       next.finished = true;
@@ -143,15 +186,18 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       if (interrupted()) return false;
       // 2. POD basis of the forward simulation.
       t0 = Clock::now();
-      const PodBasis basis = pod_basis(as_positions(forward.positions), scene.mesh.rest_positions(), basis_vertices,
-                                       options.pod);
+      const PodBasis basis = options.full_space
+                                 ? identity_basis(scene.mesh.num_vertices(), basis_vertices)
+                                 : pod_basis(as_positions(forward.positions), scene.mesh.rest_positions(),
+                                             basis_vertices, options.pod);
       record.modes = basis.num_modes();
       record.seconds_pod = seconds_since(t0);
 
       // 3. Constrained forward simulation: the starting trajectory (falls back to the forward one).
       t0 = Clock::now();
       const ForwardRun constrained =
-          simulate_positions(with_correction(tracked_scene, state.correction), callbacks.progress);
+          all_free_tracked ? with_tracked_data(forward, tracked_scene)
+                           : simulate_positions(with_correction(tracked_scene, state.correction), callbacks.progress);
       // The optimisation moves the forward trajectory within span Φ (x_i = forward_i + Φ z_i),
       // starting from the constrained simulation projected onto that span. The projection
       // keeps the start smooth: dragging a few observed vertices leaves sharp local dents

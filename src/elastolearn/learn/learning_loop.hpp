@@ -10,7 +10,8 @@
 ///   5. control forces (Eq. 5) and stress reconstruction (Eqs. 10–13): the new correction's
 ///      nodal forces must equal the nominal model's residual along the optimised trajectory;
 ///   6. RBF centres re-clustered (k-means) over the trajectory's stretches each iteration.
-/// The loop stops when the forward error has not improved for `patience` iterations, or after
+/// The loop stops when neither the forward error nor the control forces (by 5 %) improved for
+/// `patience` iterations, or after
 /// `max_iterations` corrections. Every stage is deterministic, and an iteration depends only on
 /// the current correction, so a run resumed from a checkpoint reaches the same result.
 #include <elastolearn/core/progress.hpp>
@@ -35,6 +36,10 @@ struct LearningOptions {
   int max_iterations = 8; ///< corrections computed at most
   int patience = 2;       ///< stop after this many iterations without a better forward error
   PodOptions pod;         ///< reduced basis (max_modes, frame window and stride)
+  /// The full-space variant: no reduction, Φ = identity on the free dofs (small meshes only:
+  /// each Gauss–Newton step factors T dense blocks of that size).
+  bool full_space = false;
+  int max_full_space_dofs = 1500; ///< refuse the full-space variant above this many free dofs
   SpaceTimeOptions space_time;
   int centres = 40;       ///< RBF kernels m (k-means clusters)
   RbfFitOptions rbf;      ///< ε, polynomial tails, damping part, regularisation
