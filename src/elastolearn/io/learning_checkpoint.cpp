@@ -93,6 +93,7 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
                           {"tolerance", o.space_time.tolerance}}},
           {"centres", o.centres},
           {"full_space", o.full_space},
+          {"max_reconstruction_frames", o.max_reconstruction_frames},
           {"rbf", {{"epsilon", o.rbf.epsilon}, {"elastic_polynomial", o.rbf.elastic_polynomial},
                    {"fit_damping", o.rbf.fit_damping}, {"damping_polynomial", o.rbf.damping_polynomial},
                    {"regularization", o.rbf.regularization}}},

@@ -97,6 +97,7 @@ void LearningOptions::validate() const {
   rbf.validate();
   reconstruction.validate();
   stretch_samples.validate();
+  if (max_reconstruction_frames < 0) throw InputError("learn.max_reconstruction_frames", "must be ≥ 0");
   if (full_space && max_full_space_dofs < 1) throw InputError("learn.max_full_space_dofs", "must be ≥ 1");
 }
 
@@ -233,9 +234,14 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       kmeans_options.seed = options.seed + static_cast<std::uint64_t>(record.iteration);
       const KMeansResult clusters = kmeans(stretches, kmeans_options);
       const RbfDesign design(clusters.centres, rbf);
+      StressReconstructionOptions reconstruction_options = options.reconstruction;
+      if (options.max_reconstruction_frames > 0)
+        reconstruction_options.frame_stride =
+            std::max(reconstruction_options.frame_stride,
+                     (scene.frames + options.max_reconstruction_frames - 1) / options.max_reconstruction_frames);
       const StressReconstructionResult reconstructed = reconstruct_rbf_correction(
           reconstruction_mesh, physics.dofs(), design, without_first(optimized.positions), without_first(velocities),
-          without_first(targets), options.reconstruction);
+          without_first(targets), reconstruction_options);
       record.centres = design.num_centres();
       record.correction_misfit = reconstructed.misfit.rms_residual;
       record.correction_target = reconstructed.misfit.rms_target;

@@ -44,7 +44,12 @@ struct LearningOptions {
   int centres = 40;       ///< RBF kernels m (k-means clusters)
   RbfFitOptions rbf;      ///< ε, polynomial tails, damping part, regularisation
   StressReconstructionOptions reconstruction;
-  StretchSampleOptions stretch_samples; ///< samples for k-means
+  /// Use at most this many frames in the reconstruction (a larger frame stride when there are
+  /// more; 0 = all). Consecutive frames are nearly the same equations: 150 keep the fit's
+  /// information at a fraction of the cost on long, finely stepped runs.
+  int max_reconstruction_frames = 150;
+  /// Samples for k-means; capped so that clustering stays cheap on big meshes and long runs.
+  StretchSampleOptions stretch_samples = {1, 100000};
   std::uint64_t seed = 1; ///< k-means seeding
   /// Throws InputError("learn.<field>", ...) for an out-of-range field.
   void validate() const;
