@@ -12,7 +12,10 @@
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/nn_distillation.hpp>
+#include <elastolearn/material/nn_correction.hpp>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -26,7 +29,49 @@ struct LearnOptions {
   std::string reconstruction = "normal_equations";
   bool no_damping = false;
   elastolearn::learn::LearningOptions learning;
+  // --network: distil the best RBF into the network correction (docs/learning.md).
+  bool network = false;
+  std::vector<double> network_motion_scales{0.5, 1.0, 2.0};
+  elastolearn::learn::DistillationSampleOptions network_samples;
+  elastolearn::learn::NnDistillationOptions network_training;
 };
+
+/// Distil `teacher` into the network correction on states of the training scene at several
+/// motion amplitudes; print the fit; the network's provenance as JSON.
+std::shared_ptr<const elastolearn::material::Correction> distil_network(const LearnOptions& o,
+                                                                         const elastolearn::sim::Scene& scene,
+                                                                         const elastolearn::material::Correction& teacher,
+                                                                         nlohmann::json& provenance) {
+  using namespace elastolearn;
+  const auto start = std::chrono::steady_clock::now();
+  learn::DistillationSampleReport sampled;
+  const learn::StressSamples samples =
+      learn::distillation_samples(scene, o.network_motion_scales, teacher, o.network_samples, &sampled);
+  const double seconds_sampling = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const auto& m : sampled.messages) std::printf("network samples: %s\n", m.c_str());
+  const learn::NnDistillationResult r = learn::distill_nn_correction(samples, o.network_training);
+  std::printf("network: %d + %d states (%d recorded of %ld, %d jittered; %d/%zu motions completed), %d epochs; "
+              "RMS relative to the RBF teacher: training %.2f %%, validation %.2f %% (teacher RMS %.4g Pa); "
+              "sampling %.1f s, training %.1f s\n",
+              r.training_samples, r.validation_samples, sampled.recorded, sampled.states_seen, sampled.jittered,
+              sampled.scenes_completed, o.network_motion_scales.size(), r.training.epochs,
+              100 * r.relative_training_rms(), 100 * r.relative_validation_rms(), r.target_rms, seconds_sampling,
+              r.training.seconds);
+  provenance = {{"teacher", io::correction_to_json(teacher)},
+                {"network",
+                 {{"motion_scales", o.network_motion_scales},
+                  {"recorded_states", sampled.recorded},
+                  {"jittered_states", sampled.jittered},
+                  {"training_states", r.training_samples},
+                  {"validation_states", r.validation_samples},
+                  {"epochs", r.training.epochs},
+                  {"training_rms_pa", r.training_rms},
+                  {"validation_rms_pa", r.validation_rms},
+                  {"teacher_rms_pa", r.target_rms},
+                  {"seconds_sampling", seconds_sampling},
+                  {"seconds_training", r.training.seconds}}}};
+  return std::make_shared<const material::NnCorrection>(r.correction);
+}
 
 void write_report(const std::filesystem::path& dir, const elastolearn::learn::LearningState& state,
                   const nlohmann::json& summary) {
@@ -117,6 +162,12 @@ void run_learn(const LearnOptions& o) {
                       {"options", inputs.options},
                       {"seconds", total_seconds},
                       {"history", history}};
+  if (o.network && state.best) {
+    nlohmann::json provenance;
+    learned.correction = distil_network(o, scene, *state.best, provenance);
+    learned.training["teacher"] = provenance["teacher"]; // the RBF, so that nothing is lost
+    learned.training["network"] = provenance["network"];
+  }
   io::write_material_file(o.output, learned);
   if (!o.report.empty()) write_report(o.report, state, learned.training);
 
@@ -127,7 +178,7 @@ void run_learn(const LearnOptions& o) {
               100 * state.history[static_cast<size_t>(std::max(0, state.best_iteration))].forward_error.max / diagonal,
               100 * first.max / diagonal, total_seconds);
   std::printf("learned material: %s (%s)\n", o.output.c_str(),
-              state.best ? io::describe_correction(*state.best).c_str() : "no correction beat the nominal model");
+              learned.correction ? io::describe_correction(*learned.correction).c_str() : "no correction beat the nominal model");
   if (!o.report.empty()) std::printf("report: %s/convergence.csv, report.json\n", o.report.c_str());
 }
 
@@ -158,6 +209,16 @@ void add_learn_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_flag("--no-damping", o->no_damping, "do not learn the damping correction");
   cmd->add_option("--seed", l.seed, "k-means seed")->capture_default_str();
+  cmd->add_flag("--network", o->network,
+                "distil the learned RBF into the network correction and save that (the RBF goes to training.teacher)");
+  cmd->add_option("--network-motion-scales", o->network_motion_scales,
+                  "motion amplitudes simulated to sample the network's training states")
+      ->capture_default_str();
+  cmd->add_option("--network-samples", o->network_samples.recorded_samples, "element states recorded for the network")
+      ->capture_default_str();
+  cmd->add_option("--network-rate-jitter", o->network_samples.rate_jitter,
+                  "stretch-rate jitter of the network's samples, relative to the RMS recorded rate")
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "no progress line");
   cmd->callback([o] { run_learn(*o); });
 }

@@ -64,10 +64,10 @@ material::NnCorrection::Parameters nn_parameters(unsigned seed) {
   material::NnCorrection::Parameters p;
   fill(p.input_mean, rng);
   p.input_scale = p.input_scale.array() + 1.0 / 3.0;
-  fill(p.output_mean, rng);
-  p.output_scale << 1e5 / 3, 2e5 / 7, 3e5 / 11;
+  p.output_mean = awkward(rng);
+  p.output_scale = 2e5 / 7;
   std::normal_distribution<double> g(0.0, 0.5);
-  const int widths[] = { 6, 6, 6, 3 };
+  const int widths[] = { 6, 6, 6, 1 };
   for (int k = 0; k + 1 < 4; ++k) {
     material::NnCorrection::Layer l;
     l.weight.resize(widths[k + 1], widths[k]);
@@ -181,7 +181,7 @@ TEST(MaterialFile, NnRoundTripIsBitExact) {
     EXPECT_EQ(p.layers[k].bias, q.layers[k].bias) << "layer " << k;
   }
   expect_same_function(*original, *back);
-  EXPECT_EQ(describe_correction(*back), "nn, 6-6-6-3");
+  EXPECT_EQ(describe_correction(*back), "nn, 6-6-6-1");
 }
 
 TEST(MaterialFile, NominalOnlyFileGivesTheSceneMaterialModel) {
@@ -281,6 +281,15 @@ TEST(MaterialFile, BadFilesNameTheFileAndField) {
   j = material_file_to_json(nn);
   j["correction"]["input_scale"][3] = 0.0;
   expect_bad(j, { "bad.json: correction.input_scale", "> 0" });
+  // A file of the former per-slot network (3 outputs) is refused with a pointed message.
+  j = material_file_to_json(nn);
+  j["correction"]["output_mean"] = Json::array({ 1.0, 2.0, 3.0 });
+  expect_bad(j, { "bad.json: correction.output_mean", "number" });
+  j = material_file_to_json(nn);
+  j["correction"]["layers"][2]["weight"] = Json::array({ j["correction"]["layers"][2]["weight"][0],
+      j["correction"]["layers"][2]["weight"][0], j["correction"]["layers"][2]["weight"][0] });
+  j["correction"]["layers"][2]["bias"] = Json::array({ 0.0, 0.0, 0.0 });
+  expect_bad(j, { "bad.json: correction.layers[2].weight", "expected 1" });
 }
 
 TEST(MaterialFile, BrokenJsonNamesTheLine) {

@@ -1,12 +1,16 @@
-// NnCorrection (paper 000 §6.2, Eq. 1): exact gradients (finite differences), permutation
-// symmetry, agreement with a direct evaluation of the documented formula, parameter validation.
+// NnCorrection (paper 000 §6.2, Eq. 1): agreement with a direct evaluation of the documented
+// formula, exact gradients (finite differences), isotropy (permutation symmetry, equal outputs at
+// equal stretches, a stress that does not depend on the SVD's frame and is continuous across a
+// repeated stretch), parameter validation.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/material/nn_correction.hpp>
+#include <elastolearn/material/principal_stress.hpp>
 
 #include <support/finite_difference.hpp>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -17,19 +21,20 @@ using namespace elastolearn::test;
 
 namespace {
 
-/// A 6 → 6 → 6 → 3 network (the paper's Fig. 5) with random weights of unit size, inputs
-/// standardised around rest with scales 0.1 (stretches) and 0.5 1/s (rates), outputs ~1e3 Pa.
+/// A 6 → 6 → 6 → 1 network (the paper's Fig. 5 widths) with random weights of unit size, inputs
+/// standardised around rest with scales ~0.1 (stretches), 0.01 (half the squared stretch gap),
+/// 0.5 1/s (rates) and 0.05 1/s (the gap-rate product), output ~1e3 Pa.
 NnCorrection::Parameters test_parameters(const std::vector<int>& hidden = { 6, 6 }) {
   std::mt19937 rng(5);
   std::normal_distribution<double> g(0.0, 1.0);
   NnCorrection::Parameters p;
-  p.input_mean << 1.0, 1.0, 1.0, 0.0, 0.0, 0.0;
-  p.input_scale << 0.1, 0.1, 0.12, 0.5, 0.5, 0.4;
-  p.output_mean = Vec3(10, -20, 5);
-  p.output_scale = Vec3(1e3, 2e3, 1.5e3);
+  p.input_mean << 1.0, 2.0, 0.01, 0.0, 0.0, 0.0;
+  p.input_scale << 0.1, 0.15, 0.01, 0.5, 0.8, 0.05;
+  p.output_mean = 10;
+  p.output_scale = 1.5e3;
   int in = 6;
   std::vector<int> widths = hidden;
-  widths.push_back(3);
+  widths.push_back(1);
   for (int out : widths) {
     NnCorrection::Layer l;
     l.weight.resize(out, in);
@@ -44,43 +49,67 @@ NnCorrection::Parameters test_parameters(const std::vector<int>& hidden = { 6, 6
   return p;
 }
 
-/// The documented formula, evaluated with Eigen (allocating) as an independent reference.
+/// The documented formula, evaluated with Eigen (allocating) and the view built from its
+/// definition (directions taken cyclically, not sorted by index) as an independent reference.
 Vec3 reference_output(const NnCorrection::Parameters& p, const Vec3& s, const Vec3& f) {
-  VecX a(6);
-  a << s, f;
-  a = (a - p.input_mean).cwiseQuotient(p.input_scale);
-  for (std::size_t k = 0; k < p.layers.size(); ++k) {
-    a = p.layers[k].weight * a + p.layers[k].bias;
-    if (k + 1 < p.layers.size())
-      a = a.unaryExpr([](double z) { return z > 0 ? z : std::expm1(z); });
+  Vec3 n;
+  for (int k = 0; k < 3; ++k) {
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    VecX x(6);
+    x << s[k], s[a] + s[b], std::pow(s[a] - s[b], 2) / 2, f[k], f[a] + f[b], (s[a] - s[b]) * (f[a] - f[b]);
+    x = (x - p.input_mean).cwiseQuotient(p.input_scale);
+    for (std::size_t l = 0; l < p.layers.size(); ++l) {
+      x = p.layers[l].weight * x + p.layers[l].bias;
+      if (l + 1 < p.layers.size())
+        x = x.unaryExpr([](double z) { return z > 0 ? z : std::expm1(z); });
+    }
+    n[k] = p.output_mean + p.output_scale * x[0];
   }
-  return p.output_mean + p.output_scale.cwiseProduct(a.head<3>());
+  return n;
+}
+
+/// P = U diag(N(σ, ḟ)) Vᵀ [Pa] of a correction alone (the nominal P̂ is isotropic and plays no
+/// part in the frame question) at F, Ḟ, for a given principal frame of F.
+Mat3 corrected_piola(const Correction& n, const PrincipalFrame& frame, const Mat3& F_rate) {
+  return first_piola(frame, n.correction(frame.stretches, stretch_rates(frame, F_rate)));
+}
+
+Mat3 rotation(double angle, const Vec3& axis) {
+  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
 }
 
 } // namespace
 
 TEST(NnCorrection, MatchesTheDocumentedFormula) {
-  // Sorted inputs go straight into the network; the loops and Eigen's products sum in different
-  // orders, and eᶻ − 1 vs expm1 differ by ~1e-16: agreement to 1e-12 relative of ~1e3 Pa.
+  // The loops and Eigen's products sum in different orders, and eᶻ − 1 vs expm1 differ by
+  // ~1e-16: agreement to 1e-12 relative of ~1e3 Pa. Unsorted inputs: every view is exercised.
   const auto p = test_parameters();
   const NnCorrection n(p);
-  const Vec3 s(1.2, 1.05, 0.9), f(0.3, -0.7, 0.2);
-  const Vec3 expected = reference_output(p, s, f);
-  EXPECT_LT((n.correction(s, f) - expected).norm(), 1e-12 * expected.norm());
+  for (const Vec3& s : { Vec3(1.2, 1.05, 0.9), Vec3(0.9, 1.25, 1.02), Vec3(1.0, 0.8, 1.1) }) {
+    const Vec3 f(0.3, -0.7, 0.2);
+    const Vec3 expected = reference_output(p, s, f);
+    EXPECT_LT((n.correction(s, f) - expected).norm(), 1e-12 * expected.norm()) << s.transpose();
+  }
   EXPECT_EQ(n.name(), "nn");
+  // nn_input is the documented view, and swapping the other two directions leaves it unchanged.
+  const Vec3 s(1.0, 2.0, 3.0), f(0.5, -1.0, 4.0);
+  NnInput expected;
+  expected << 1.0, 5.0, 0.5, 0.5, 3.0, (2.0 - 3.0) * (-1.0 - 4.0);
+  EXPECT_EQ(nn_input(s, f, 0), expected);
+  EXPECT_EQ(nn_input(Vec3(1.0, 3.0, 2.0), Vec3(0.5, 4.0, -1.0), 0), expected);
 }
 
 TEST(NnCorrection, GradientMatchesFiniteDifference) {
   // The network is smooth except where a pre-activation crosses 0 (ELU's second derivative
   // jumps there, the first does not). At these fixed states no crossing lies within the FD
-  // stencil (4·1e-5), so the O(h⁴) truncation error is ~1e-12 relative and round-off in the
-  // quotient of values ~1e3 Pa is ~1e-16·1e3/1e-5 ≈ 1e-8 Pa against gradients ~1e4: 1e-7 tolerance.
+  // stencil (4·1e-5), so the O(h⁴) truncation error is ~1e-12 relative and round-off in the quotient of values ~1e3 Pa is ~1e-16·1e3/1e-5 ≈ 1e-8 Pa
+  // against gradients ~1e4: 1e-7 tolerance.
   for (const auto& hidden : { std::vector<int> { 6, 6 }, std::vector<int> { 12 },
-           std::vector<int> { 32, 8, 5 } }) {
+           std::vector<int> { 32, 8, 5 }, std::vector<int> {} }) {
     const NnCorrection n(test_parameters(hidden));
     for (const Vec3& s : { Vec3(1.15, 0.97, 0.88), Vec3(0.9, 1.25, 1.02), Vec3(1.1, 0.95, -0.2) }) {
       for (const Vec3& r : { Vec3(0.3, -0.5, 0.1), Vec3(-1.2, 0.4, 0.9) }) {
-        SCOPED_TRACE(testing::Message() << "widths " << hidden.size() << " stretches "
+        SCOPED_TRACE(testing::Message() << "hidden layers " << hidden.size() << " stretches "
                                         << s.transpose() << " rates " << r.transpose());
         Mat3 ds, dr;
         n.correction_gradient(s, r, ds, dr);
@@ -103,22 +132,117 @@ TEST(NnCorrection, PermutationSymmetric) {
   const Vec3 ns = n.correction(s, r);
   Mat3 ds, dr;
   n.correction_gradient(s, r, ds, dr);
-  Eigen::Matrix3i perms;
-  perms << 1, 0, 2, 2, 0, 1, 2, 1, 0;
-  for (int k = 0; k < 3; ++k) {
-    // N(Pσ, Pḟ) = P N(σ, ḟ) and the gradients permute on both sides. Exact: the network sees
-    // the same sorted numbers.
+  std::array<int, 3> perm { 0, 1, 2 };
+  while (std::next_permutation(perm.begin(), perm.end())) {
+    // N(Pσ, Pḟ) = P N(σ, ḟ) and the gradients permute on both sides. Exact: every direction
+    // sees the same numbers (commutative sums, a squared difference and a product of two
+    // swapped differences do not depend on the order of the other two).
     Eigen::PermutationMatrix<3> P;
-    P.indices() = perms.row(k).transpose();
-    const Vec3 ps = P.transpose() * s, pr = P.transpose() * r;
-    EXPECT_EQ(n.correction(ps, pr), P.transpose() * ns);
+    P.indices() << perm[0], perm[1], perm[2];
+    const Vec3 ps = P * s, pr = P * r;
+    EXPECT_EQ(n.correction(ps, pr), P * ns);
     Mat3 pds, pdr;
     n.correction_gradient(ps, pr, pds, pdr);
-    EXPECT_EQ(pds, P.transpose() * ds * P);
-    EXPECT_EQ(pdr, P.transpose() * dr * P);
+    EXPECT_EQ(pds, P * ds * P.transpose());
+    EXPECT_EQ(pdr, P * dr * P.transpose());
   }
   // A clone evaluates identically.
   EXPECT_EQ(n.clone()->correction(s, r), ns);
+}
+
+TEST(NnCorrection, EqualStretchesGiveExactlyEqualOutputs) {
+  // Both directions of a repeated stretch evaluate the same network on bit-identical inputs —
+  // at zero rate (the elastic part) and at equal rates — whatever the other rate is.
+  const NnCorrection n(test_parameters());
+  for (const Vec3& s : { Vec3(1.1, 1.1, 0.9), Vec3(0.8, 1.2, 1.2), Vec3(1.05, 0.7, 1.05),
+           Vec3::Ones().eval() }) {
+    for (const Vec3& rates : { Vec3::Zero().eval(), Vec3(0.2, 0.2, 0.2), Vec3(0.4, 0.4, -0.3),
+             Vec3(0.4, -0.3, 0.4), Vec3(-0.3, 0.4, 0.4) }) {
+      const Vec3 out = n.correction(s, rates);
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+          if (s[i] == s[j] && rates[i] == rates[j]) {
+            EXPECT_EQ(out[i], out[j]) << "stretches " << s.transpose() << " rates " << rates.transpose();
+          }
+        }
+      }
+    }
+  }
+  // The outputs approach each other continuously as two stretches meet: Lipschitz, with
+  // slopes ∂g/∂σ ~ output_scale/input_scale ~1e4–1e5 Pa.
+  const Vec3 out = n.correction(Vec3(1.1 + 1e-7, 1.1, 0.9), Vec3::Zero());
+  EXPECT_LT(std::abs(out[0] - out[1]), 1e-7 * 1e5);
+}
+
+TEST(NnCorrection, GradientIsContinuousAtEqualStretches) {
+  // The inputs are smooth in σ (no max/min), so ∂N/∂σ has no kink where two stretches meet:
+  // either side of σ₂ = σ₃ agrees with the value at the tie to O(h × curvature) — curvature
+  // ~ output_scale/input_scale² ~1e7 Pa, so ~1 Pa for h = 1e-7 against gradients ~1e4–1e5.
+  // A max/min view would jump by |∂g/∂max − ∂g/∂min| ~ the gradient itself.
+  const NnCorrection n(test_parameters());
+  const Vec3 r(0.3, -0.5, 0.1);
+  const double h = 1e-7;
+  Mat3 ds0, dr0, ds_plus, dr_plus, ds_minus, dr_minus;
+  n.correction_gradient(Vec3(1.1, 1.0, 1.0), r, ds0, dr0);
+  n.correction_gradient(Vec3(1.1, 1.0 + h, 1.0), r, ds_plus, dr_plus);
+  n.correction_gradient(Vec3(1.1, 1.0, 1.0 + h), r, ds_minus, dr_minus);
+  EXPECT_LT((ds_plus - ds0).norm(), 10.0) << ds0.norm();
+  EXPECT_LT((ds_minus - ds0).norm(), 10.0) << ds0.norm();
+  EXPECT_LT((dr_plus - dr0).norm(), 10.0) << dr0.norm();
+  EXPECT_GT(ds0.norm(), 1e3); // the bound is meaningful
+}
+
+TEST(NnCorrection, StressIsContinuousAcrossARepeatedStretch) {
+  const NnCorrection n(test_parameters());
+  const Mat3 R = rotation(0.7, Vec3(1, 2, 3)), Q = rotation(-0.4, Vec3(-2, 1, 1));
+  const Mat3 F_rate = (Mat3() << 0.3, -0.8, 0.2, 0.5, 0.1, -0.6, -0.4, 0.7, 0.9).finished();
+  const auto F_at = [&](double t) { return Mat3(R * Vec3(1.1, 1 + t, 1 - t).asDiagonal() * Q.transpose()); };
+  const double scale = 1.5e3; // |N| ~ output_scale
+
+  // At the tie (σ₂ = σ₃ = 1) U and V are unique only up to a common rotation in the degenerate
+  // plane. At zero rate the stress is the same for any such choice: round-off only (1e-12 of
+  // |N|), whereas 3 independent outputs would differ by their fitting error.
+  const PrincipalFrame frame = principal_frame(F_at(0));
+  for (double angle : { 0.3, 1.0, 2.5 }) {
+    PrincipalFrame turned = frame;
+    const Mat3 G = rotation(angle, Vec3::UnitX());
+    turned.U = frame.U * G;
+    turned.V = frame.V * G;
+    ASSERT_LT((turned.U * turned.stretches.asDiagonal() * turned.V.transpose() - F_at(0)).norm(), 1e-12);
+    EXPECT_LT((corrected_piola(n, turned, Mat3::Zero()) - corrected_piola(n, frame, Mat3::Zero())).norm(),
+        1e-12 * scale)
+        << "angle " << angle;
+  }
+
+  // Along F(t) = R diag(1.1, 1 + t, 1 − t) Qᵀ with a generic rate Ḟ (ḟ₂ ≠ ḟ₃), σ₂ and σ₃ swap
+  // at t = 0 and so do the SVD's columns. The stress is Lipschitz in t: the jump over
+  // [−h, h] is ≤ 2h × slope (~1e5 Pa) — 2e-2 Pa for h = 1e-7. The same network fed the rates
+  // ordered like the stretches (the rejected alternative) jumps by O(|N|) = O(1e3 Pa) there.
+  const double h = 1e-7;
+  const Mat3 before = corrected_piola(n, principal_frame(F_at(-h)), F_rate);
+  const Mat3 after = corrected_piola(n, principal_frame(F_at(h)), F_rate);
+  EXPECT_LT((after - before).norm(), 2 * h * 1e5);
+
+  struct RatesOrderedByStretch final : Correction {
+    const NnCorrection& net;
+    explicit RatesOrderedByStretch(const NnCorrection& n) : net(n) {}
+    std::string name() const override { return "sorted-rates"; }
+    Vec3 correction(const Vec3& s, const Vec3& f) const override {
+      Vec3 out;
+      for (int k = 0; k < 3; ++k) {
+        const int a = (k + 1) % 3, b = (k + 2) % 3, hi = s[b] > s[a] ? b : a, lo = hi == a ? b : a;
+        NnInput x;
+        x << s[k], s[hi], s[lo], f[k], f[hi], f[lo];
+        out[k] = net.evaluate(x);
+      }
+      return out;
+    }
+    void correction_gradient(const Vec3&, const Vec3&, Mat3&, Mat3&) const override {}
+    std::unique_ptr<Correction> clone() const override { return nullptr; }
+  } sorted_rates(n);
+  const Mat3 jump = corrected_piola(sorted_rates, principal_frame(F_at(h)), F_rate)
+      - corrected_piola(sorted_rates, principal_frame(F_at(-h)), F_rate);
+  EXPECT_GT(jump.norm(), 1e3 * (after - before).norm()) << "the test would not see a discontinuity";
 }
 
 TEST(NnCorrection, RejectsBadParameters) {
@@ -138,6 +262,10 @@ TEST(NnCorrection, RejectsBadParameters) {
     expect_error(p, "nn_correction.layers");
   }
   {
+    auto p = test_parameters(std::vector<int>(NnCorrection::max_hidden_layers + 1, 2));
+    expect_error(p, "nn_correction.layers");
+  }
+  {
     auto p = test_parameters();
     p.layers[0].weight = MatX::Ones(6, 5); // 5 inputs instead of 6
     expect_error(p, "nn_correction.layers[0].weight");
@@ -149,8 +277,8 @@ TEST(NnCorrection, RejectsBadParameters) {
   }
   {
     auto p = test_parameters();
-    p.layers[2].weight = MatX::Ones(2, 6); // 2 outputs instead of 3
-    p.layers[2].bias = VecX::Ones(2);
+    p.layers[2].weight = MatX::Ones(3, 6); // 3 outputs (the old per-direction network)
+    p.layers[2].bias = VecX::Ones(3);
     expect_error(p, "nn_correction.layers[2].weight");
   }
   {
@@ -184,12 +312,12 @@ TEST(NnCorrection, RejectsBadParameters) {
   }
   {
     auto p = test_parameters();
-    p.output_scale[1] = -1;
+    p.output_scale = -1;
     expect_error(p, "nn_correction.output_scale");
   }
   {
     auto p = test_parameters();
-    p.output_mean[0] = nan;
+    p.output_mean = nan;
     expect_error(p, "nn_correction.output_mean");
   }
 }

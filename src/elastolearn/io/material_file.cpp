@@ -57,8 +57,8 @@ Json nn_to_json(const material::NnCorrection& c) {
         Json { { "weight", rows_to_json(layer.weight) }, { "bias", vector_to_json(layer.bias) } });
   return Json { { "type", "nn" }, { "input_mean", vector_to_json(p.input_mean) },
     { "input_scale", vector_to_json(p.input_scale) },
-    { "output_mean", vector_to_json(p.output_mean) },
-    { "output_scale", vector_to_json(p.output_scale) }, { "layers", std::move(layers) } };
+    { "output_mean", p.output_mean }, { "output_scale", p.output_scale },
+    { "layers", std::move(layers) } };
 }
 
 // ---- reading ---------------------------------------------------------------------------------
@@ -160,8 +160,9 @@ std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
   material::NnCorrection::Parameters p;
   p.input_mean = read_vector(o, "input_mean", 6);
   p.input_scale = read_vector(o, "input_scale", 6);
-  p.output_mean = read_vector(o, "output_mean", 3);
-  p.output_scale = read_vector(o, "output_scale", 3);
+  // Scalars: one network g shared by the three principal directions (NnCorrection).
+  p.output_mean = o.number("output_mean");
+  p.output_scale = o.number("output_scale");
   const auto layers = o.objects("layers");
   if (layers.empty())
     o.fail("layers", "expected at least one layer");

@@ -103,6 +103,11 @@ void shuffle_in_place(std::vector<int>& values, std::mt19937_64& rng) {
 void MlpTrainingOptions::validate() const {
   if (hidden_widths.empty())
     fail("hidden_widths", "is empty; at least one hidden layer is required");
+  if (hidden_widths.size() > std::size_t(material::NnCorrection::max_hidden_layers)) {
+    fail("hidden_widths",
+        "has " + str(hidden_widths.size()) + " layers, at most "
+            + str(material::NnCorrection::max_hidden_layers) + " are supported");
+  }
   for (int w : hidden_widths) {
     if (w < 1 || w > material::NnCorrection::max_width) {
       fail("hidden_widths",

@@ -18,7 +18,9 @@
 namespace elastolearn::learn {
 
 struct MlpTrainingOptions {
-  std::vector<int> hidden_widths { 6, 6 }; ///< the paper's 6 → 6 → 6 → 3; each 1..NnCorrection::max_width
+  /// Hidden layer widths: the paper's 6 → 6 → 6 (→ 1 for the shared per-direction network of
+  /// NnCorrection); each 1..NnCorrection::max_width, at most NnCorrection::max_hidden_layers.
+  std::vector<int> hidden_widths { 6, 6 };
   bool batch_norm = true; ///< batch normalisation before each ELU (paper §6.2)
   int batch_size = 256; ///< samples per Adam step (capped at the training-set size)
   int max_epochs = 400; ///< passes over the training set

@@ -26,8 +26,8 @@ template <typename T> std::string str(T v) {
 
 using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
-/// Sample j in stable descending stretch order, rates and target permuted alike (as
-/// NnCorrection and RbfCorrection evaluate).
+/// Sample j in stable descending stretch order, rates and target permuted alike (the order
+/// principal_frame reports; the corrections themselves are permutation-equivariant).
 void sorted_sample(const StressSamples& samples, Eigen::Index j, Vec3& s, Vec3& f, Vec3& y) {
   const Vec3 s0 = samples.stretches.row(j).transpose();
   std::array<int, 3> p { 0, 1, 2 };
@@ -39,34 +39,45 @@ void sorted_sample(const StressSamples& samples, Eigen::Index j, Vec3& s, Vec3& 
   }
 }
 
-/// Row-wise mean and standard deviation of the columns `cols` of `m`; a (numerically) constant
-/// row gets scale 1 so that standardisation stays finite.
-void row_statistics(const MatX& m, const std::vector<int>& cols, VecX& mean, VecX& scale) {
-  const Eigen::Index rows = m.rows();
-  mean = VecX::Zero(rows);
-  for (int c : cols)
-    mean += m.col(c);
-  mean /= double(cols.size());
-  VecX var = VecX::Zero(rows);
-  for (int c : cols)
-    var += (m.col(c) - mean).cwiseAbs2();
-  var /= double(cols.size());
-  scale = var.cwiseSqrt();
-  for (Eigen::Index r = 0; r < rows; ++r) {
+/// Row-wise mean and standard deviation over the columns of `m`; a (numerically) constant row
+/// gets scale 1 so that standardisation stays finite.
+void row_statistics(const MatX& m, VecX& mean, VecX& scale) {
+  mean = m.rowwise().mean();
+  scale = ((m.colwise() - mean).rowwise().squaredNorm() / double(m.cols())).cwiseSqrt();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
     if (!(scale[r] > 1e-12 * std::max(1.0, std::abs(mean[r]))))
       scale[r] = 1;
   }
 }
 
-/// RMS of ‖N(σ_j, ḟ_j) − y_j‖ over the columns `cols` of X (6 × n) and Y (3 × n).
-double rms_error(const material::Correction& n, const MatX& x, const MatX& y,
-    const std::vector<int>& cols) {
+/// RMS over the states `states` of ‖N(σ_j, ḟ_j) − N_teacher,j‖ [Pa] (one state = 3 directions).
+double rms_error(const material::Correction& n, const StressSamples& samples,
+    const std::vector<int>& states) {
   double sum = 0;
-  for (int c : cols) {
-    const Vec3 out = n.correction(x.col(c).head<3>(), x.col(c).tail<3>());
-    sum += (out - y.col(c)).squaredNorm();
+  for (int j : states) {
+    const Vec3 out = n.correction(
+        samples.stretches.row(j).transpose(), samples.stretch_rates.row(j).transpose());
+    sum += (out - samples.targets.row(j).transpose()).squaredNorm();
   }
-  return std::sqrt(sum / double(cols.size()));
+  return std::sqrt(sum / double(states.size()));
+}
+
+/// The training rows of the states `states`: per state and direction k, x = nn_input(σ, ḟ, k)
+/// (a column of `inputs`, 6 × 3·|states|) and N_teacher,k (an entry of `targets`, 1 × …).
+void direction_rows(const StressSamples& samples, const std::vector<int>& states, MatX& inputs,
+    MatX& targets) {
+  const auto rows = static_cast<Eigen::Index>(3 * states.size());
+  inputs.resize(6, rows);
+  targets.resize(1, rows);
+  Eigen::Index c = 0;
+  for (int j : states) {
+    const Vec3 s = samples.stretches.row(j).transpose();
+    const Vec3 f = samples.stretch_rates.row(j).transpose();
+    for (int k = 0; k < 3; ++k, ++c) {
+      inputs.col(c) = material::nn_input(s, f, k);
+      targets(0, c) = samples.targets(j, k);
+    }
+  }
 }
 
 } // namespace
@@ -191,6 +202,7 @@ std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const 
       fail("motion_scales", "contains a non-finite factor " + str(a));
     sim::Scene s = scene;
     s.name = scene.name + "_x" + str(a);
+    s.gravity *= a;
     s.initial.velocity *= a;
     s.initial.angular_velocity *= a;
     for (auto& l : s.initial.static_loads)
@@ -220,14 +232,8 @@ NnDistillationResult distill_nn_correction(
       || !samples.targets.allFinite()) {
     fail("samples", "contain a non-finite value");
   }
-  // Columns are samples, in the sorted order the network sees.
-  MatX x(6, n), y(3, n);
-  for (Eigen::Index j = 0; j < n; ++j) {
-    Vec3 s, f, t;
-    sorted_sample(samples, j, s, f, t);
-    x.col(j) << s, f;
-    y.col(j) = t;
-  }
+  // The split is over states, so that the three direction rows of a state are never on both
+  // sides of it.
   std::vector<int> order(static_cast<std::size_t>(n));
   std::iota(order.begin(), order.end(), 0);
   std::mt19937_64 rng(o.training.seed + 0x5bd1e995ULL);
@@ -244,32 +250,34 @@ NnDistillationResult distill_nn_correction(
   std::sort(valid.begin(), valid.end());
   std::sort(train.begin(), train.end());
 
+  // One row per state and direction: the shared scalar network g is fitted to all three.
+  MatX train_x, train_y, valid_x, valid_y;
+  direction_rows(samples, train, train_x, train_y);
+  direction_rows(samples, valid, valid_x, valid_y);
   VecX in_mean, in_scale, out_mean, out_scale;
-  row_statistics(x, train, in_mean, in_scale);
-  row_statistics(y, train, out_mean, out_scale);
-  const auto standardised = [&](const MatX& m, const VecX& mean, const VecX& scale,
-                                const std::vector<int>& cols) {
-    MatX r(m.rows(), static_cast<Eigen::Index>(cols.size()));
-    for (std::size_t c = 0; c < cols.size(); ++c)
-      r.col(static_cast<Eigen::Index>(c)) = (m.col(cols[c]) - mean).cwiseQuotient(scale);
-    return r;
+  row_statistics(train_x, in_mean, in_scale);
+  row_statistics(train_y, out_mean, out_scale);
+  const auto standardise = [](MatX& m, const VecX& mean, const VecX& scale) {
+    m = (m.colwise() - mean).array().colwise() / scale.array();
   };
-  const MlpTrainingResult trained = train_mlp(standardised(x, in_mean, in_scale, train),
-      standardised(y, out_mean, out_scale, train), standardised(x, in_mean, in_scale, valid),
-      standardised(y, out_mean, out_scale, valid), o.training);
+  standardise(train_x, in_mean, in_scale);
+  standardise(valid_x, in_mean, in_scale);
+  standardise(train_y, out_mean, out_scale);
+  standardise(valid_y, out_mean, out_scale);
+  const MlpTrainingResult trained = train_mlp(train_x, train_y, valid_x, valid_y, o.training);
 
   material::NnCorrection::Parameters p;
   p.input_mean = in_mean;
   p.input_scale = in_scale;
-  p.output_mean = out_mean;
-  p.output_scale = out_scale;
+  p.output_mean = out_mean[0];
+  p.output_scale = out_scale[0];
   p.layers = fold_batch_norm(trained.network);
   NnDistillationResult result { material::NnCorrection(std::move(p)), trained.report };
   result.training_samples = static_cast<int>(train.size());
   result.validation_samples = static_cast<int>(valid.size());
-  result.training_rms = rms_error(result.correction, x, y, train);
-  result.validation_rms = rms_error(result.correction, x, y, valid);
-  result.target_rms = std::sqrt(y.squaredNorm() / double(n));
+  result.training_rms = rms_error(result.correction, samples, train);
+  result.validation_rms = rms_error(result.correction, samples, valid);
+  result.target_rms = std::sqrt(samples.targets.squaredNorm() / double(n));
   return result;
 }
 

@@ -2,7 +2,9 @@
 /// \file Distillation of a learned correction (the RBF of the learning loop) into the network
 /// correction of paper 000 §6.2: "We use the learned RBF parametric model and run many
 /// simulations while recording principal stretches and stretch rates of elements", then train
-/// the 6 → 6 → 6 → 3 network (learn/mlp_training.hpp) on the teacher's outputs at those states.
+/// the network (learn/mlp_training.hpp) on the teacher's outputs at those states. The paper's
+/// 6 → 6 → 6 → 3 network becomes one 6 → 6 → 6 → 1 network g shared by the three principal
+/// directions (material::NnCorrection): each state gives three training rows (x_k, N_k).
 /// Rationale and measured numbers: docs/learning.md ("Neural-network correction").
 #include <elastolearn/learn/mlp_training.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
@@ -25,8 +27,11 @@ struct DistillationSampleOptions {
   /// = recorded · (1 + jitter_copies)). ≥ 0.
   int jitter_copies = 1;
   double stretch_jitter = 0.02; ///< standard deviation of the Gaussian stretch jitter [-]
-  /// Standard deviation of the rate jitter, relative to the RMS recorded stretch rate [-].
-  double rate_jitter = 0.25;
+  /// Standard deviation of the rate jitter, relative to the RMS recorded stretch rate [-]. Large on
+  /// purpose: other motions (and Newton trials) reach rates far above the recorded ones, and a
+  /// network only learns the teacher's rate response where the samples vary the rates
+  /// (docs/learning.md: 0.25 made Newton fail at the first step, 10 at a faster test motion).
+  double rate_jitter = 50;
   std::uint64_t seed = 1; ///< subsampling and jitter (same seed, same samples)
   /// Throws InputError("distillation.<field>", ...) for an out-of-range field.
   void validate() const;
@@ -58,9 +63,11 @@ StressSamples distillation_samples(const sim::Scene& scene, std::span<const doub
     const material::Correction& teacher, const DistillationSampleOptions& options,
     DistillationSampleReport* report = nullptr);
 
-/// Copies of `scene` whose motion is scaled by each factor: initial velocity and angular
+/// Copies of `scene` whose motion is scaled by each factor: gravity, initial velocity and angular
 /// velocity, static (initial) loads, point loads and keyframe amplitudes/offsets are multiplied
-/// by the factor (gravity and the mesh are kept), and the copy's name gets a "_x<factor>" suffix.
+/// by the factor (the mesh and material are kept), and the copy's name gets a "_x<factor>"
+/// suffix. Every driver is scaled alike, so in the linear regime the displacements scale by the
+/// factor (a scene driven by gravity alone, e.g. a droop, would otherwise not change at all).
 /// Training on several amplitudes covers more of the stretch space than the one observed motion.
 /// Throws InputError("distillation.motion_scales", ...) for a non-finite factor.
 std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const double> scales);
@@ -75,8 +82,8 @@ struct NnDistillationOptions {
 struct NnDistillationResult {
   material::NnCorrection correction; ///< the folded network with its standardisation
   MlpTrainingReport training; ///< losses in standardised units, history, epochs, time
-  int training_samples = 0;
-  int validation_samples = 0;
+  int training_samples = 0; ///< states in the training split (3 rows each)
+  int validation_samples = 0; ///< states in the validation split (3 rows each)
   double training_rms = 0; ///< √(mean ‖N_nn − N_teacher‖²) over the training split [Pa]
   double validation_rms = 0; ///< idem over the validation split [Pa]
   double target_rms = 0; ///< √(mean ‖N_teacher‖²) over all samples [Pa]
@@ -84,11 +91,13 @@ struct NnDistillationResult {
   double relative_validation_rms() const { return validation_rms / target_rms; }
 };
 
-/// Train the network correction on `samples` (targets = the teacher's outputs): sort each sample
-/// descending (as NnCorrection evaluates), split off a random validation set, standardise inputs
-/// and outputs with the training split's mean and standard deviation (a constant column gets
-/// scale 1), train (train_mlp), fold batch norm, and measure the RMS errors of the resulting
-/// NnCorrection in Pa. Deterministic for a given seed.
+/// Train the network correction on `samples` (targets = the teacher's outputs): split the states
+/// into a random validation set and a training set (the three direction rows of a state stay
+/// together), turn each state into three rows (material::nn_input(σ, ḟ, k), N_teacher,k),
+/// standardise inputs and the scalar output with the training rows' mean and standard deviation
+/// (a constant input gets scale 1), train (train_mlp), fold batch norm, and measure the RMS errors
+/// of the resulting NnCorrection in Pa per state (‖ΔN‖ over the 3 directions). Samples need not
+/// be sorted. Deterministic for a given seed.
 /// Throws InputError for bad options or samples (empty, mismatched, non-finite, fewer than
 /// 2 samples in a split).
 NnDistillationResult distill_nn_correction(

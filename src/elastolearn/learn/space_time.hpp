@@ -6,9 +6,9 @@
 /// (3n × r, zero rows at prescribed dofs) the POD basis. Objective (Gauss–Newton on)
 ///   E(z) = ½ Σ_{i=1..T} ‖s Φᵀ r_i(x)‖²  +  ½ λ² Σ_{i=0..T} ‖S x_i − s_i‖²
 /// with r_i the discrete equation of motion (TrajectoryPhysics, Eq. 2/3), S the observed dofs
-/// and s_i their data (Eq. 4), and s = h²/m̄ (m̄ the mean vertex mass), which turns forces into
-/// the position defect they cause in one step, so that both terms are in metres and λ is
-/// dimensionless. r_i couples x_i, x_{i−1}, x_{i−2}, so JᵀJ is block-banded in time with block
+/// and s_i their data (Eq. 4), and s = τ²/m̄ (m̄ the mean vertex mass, τ = 1 % of the duration
+/// T·h), which turns forces into the displacement they cause over τ, so that both terms are in
+/// metres, λ is dimensionless and the balance does not depend on the time step. r_i couples x_i, x_{i−1}, x_{i−2}, so JᵀJ is block-banded in time with block
 /// bandwidth 2: each Gauss–Newton step is one banded block Cholesky solve, O(T r³). As in the
 /// paper, the Jacobian uses the force's projected tangent (the correction's gradient is kept,
 /// since it is part of the simulator's tangent too: it changes convergence, not the solution).
