@@ -156,7 +156,9 @@ void run_evaluate(const EvaluateOptions& opts) {
   }
   const auto max_ratio = ratio(nominal.error.max, learned.error.max);
   const auto mean_ratio = ratio(nominal.error.mean, learned.error.mean);
-  if (max_ratio && mean_ratio)
+  if (!nominal.report.completed || !learned.report.completed)
+    std::printf("improvement: not measured (a simulation stopped early; see below)\n");
+  else if (max_ratio && mean_ratio)
     std::printf(
         "improvement: err_L %.3gx lower, mean error %.3gx lower\n", *max_ratio, *mean_ratio);
   else
