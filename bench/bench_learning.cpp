@@ -1,0 +1,259 @@
+// The learning benchmark of issue 3 (paper 000's Table 1, with our own simulator as ground
+// truth): per case, simulate the truth's training motion, observe a fraction of the surface
+// vertices, learn a correction of the nominal model (learn::run_learning), fit the nominal
+// model's parameters to the same observations (the baseline, learn::fit_parameters), then compare
+// nominal / fitted / learned with the truth on a different, larger test motion.
+// err_L = max vertex position error over the test trajectory, % of the rest bounding-box diagonal.
+//
+//   bench_learning [--quick] [--data DIR] [--modes R --kernels M ...] [CASE ...]   (no case = all; --help)
+//
+// A plain program with a table printout (not Google Benchmark): each case runs once and takes
+// seconds to minutes. Set-up and measured numbers: docs/benchmarks_learning.md.
+#include "learning_cases.hpp"
+
+#include <elastolearn/observe/visible_vertices.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+namespace {
+
+using namespace elastolearn;
+using namespace bench_learning;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+struct Row {
+  std::string name;
+  int tets = 0, frames = 0, observed = 0, modes = 0, iterations = 0, kernels = 0, best_iteration = -1;
+  double visible = 1;
+  double train_deformation = 0, test_deformation = 0; ///< max displacement, % of diagonal
+  double forward = 0, constrained = 0, space_time = 0, reconstruction = 0, pod = 0, learn_total = 0;
+  double fit_seconds = 0;
+  double err_nominal = -1, err_fit = -1, err_learned = -1; ///< test err_L [%] (−1: diverged)
+  double train_nominal = -1, train_learned = -1;          ///< training err_L at the observed vertices [%]
+  double target = 0;
+  std::string fitted;
+};
+
+sim::Scene with_material(sim::Scene s, const fem::MaterialModel& m) {
+  s.material = m;
+  return s;
+}
+
+/// Max vertex displacement from rest over the trajectory, % of the diagonal.
+double deformation(const std::vector<VecX>& frames, const mesh::TetMesh& mesh) {
+  const VecX rest = flatten(mesh.rest_positions());
+  double worst = 0;
+  for (const auto& x : frames)
+    for (Eigen::Index v = 0; v < x.size() / 3; ++v) worst = std::max(worst, (x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
+  return 100 * worst / mesh.bounding_box_diagonal();
+}
+
+/// Forward simulation of a scene; throws if it does not complete (the truth must).
+std::vector<VecX> simulate_or_throw(const sim::Scene& scene, const std::string& what) {
+  auto run = learn::simulate_positions(scene);
+  if (!run.completed) throw InputError(what, "simulation failed: " + run.message);
+  return std::move(run.positions);
+}
+
+/// err_L of `scene`'s simulation against the truth frames; −1 if it diverged.
+double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
+  const auto run = learn::simulate_positions(scene);
+  if (!run.completed) {
+    std::fprintf(stderr, "   (diverged: %s)\n", run.message.c_str());
+    return -1;
+  }
+  return learn::as_percent_of(learn::position_error(run.positions, truth), scene.mesh.bounding_box_diagonal()).max;
+}
+
+bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and stop (for tuning scenes)
+/// Overrides of the learning options for every case (−1: keep the case's).
+int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1;
+
+void apply_overrides(learn::LearningOptions& o) {
+  if (g_modes > 0) o.pod.max_modes = g_modes;
+  if (g_kernels > 0) o.centres = g_kernels;
+  if (g_iterations >= 0) o.max_iterations = g_iterations;
+  if (g_patience > 0) o.patience = g_patience;
+}
+
+Row run_case(const LearningCase& c) {
+  Row row;
+  row.name = c.name;
+  row.tets = c.train.mesh.num_tets();
+  row.frames = c.train.frames;
+  row.visible = c.visible_fraction;
+  row.target = c.target_err_l;
+  const double size = c.train.mesh.bounding_box_diagonal();
+  std::printf("\n== %s: %s\n   truth: %s\n   nominal: %s\n   %s\n   dt %g s, %d frames, %zu fixed vertices, %d vertices\n",
+              c.name.c_str(), c.mesh_label.c_str(), c.truth_label.c_str(), c.nominal_label.c_str(),
+              c.motion_label.c_str(), c.train.dt, c.train.frames, c.train.fixed_vertices.size(),
+              c.train.mesh.num_vertices());
+  std::fflush(stdout);
+
+  auto t0 = Clock::now();
+  const auto truth_train = simulate_or_throw(with_material(c.train, c.truth), c.name + " truth (train)");
+  const auto truth_test = simulate_or_throw(with_material(c.test, c.truth), c.name + " truth (test)");
+  row.train_deformation = deformation(truth_train, c.train.mesh);
+  row.test_deformation = deformation(truth_test, c.test.mesh);
+  std::vector<Positions> frames;
+  for (const auto& x : truth_train) frames.emplace_back(unflatten(x));
+  const auto ids = observe::select_visible_vertices(c.train.mesh, c.visible_fraction, 1);
+  const auto observed = observe::observe_vertices(frames, c.train.dt, ids, 0.0, 1);
+  row.observed = observed.num_observed();
+  std::printf("   truth simulated in %.1f s: max displacement train %.1f %%, test %.1f %% of the diagonal (%.3f m); "
+              "observing %d of %zu surface vertices\n",
+              seconds_since(t0), row.train_deformation, row.test_deformation, size, row.observed,
+              c.train.mesh.surface_vertices().size());
+  std::fflush(stdout);
+  if (g_truth_only) return row;
+
+  // Learning.
+  learn::LearningState state;
+  learn::LearningCallbacks callbacks;
+  callbacks.iteration = [&](const learn::IterationRecord& r) {
+    if (r.forward_completed)
+      std::printf("   iteration %d: forward rms %.4f %%, max %.4f %%", r.iteration, 100 * r.forward_error.rms / size,
+                  100 * r.forward_error.max / size);
+    else
+      std::printf("   iteration %d:", r.iteration);
+    if (r.modes > 0)
+      std::printf("; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N; "
+                  "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
+                  r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target, r.seconds_forward,
+                  r.seconds_constrained, r.seconds_space_time, r.space_time_iterations, r.seconds_reconstruction);
+    else if (!r.forward_completed)
+      std::printf(" -> this correction's forward simulation DIVERGED (%.1f s); the loop stops\n", r.seconds_forward);
+    else
+      std::printf(" (final forward check, %.1f s)\n", r.seconds_forward);
+    std::fflush(stdout);
+  };
+  t0 = Clock::now();
+  learn::run_learning(c.train, observed, c.options, state, callbacks);
+  row.learn_total = seconds_since(t0);
+  for (const auto& r : state.history) {
+    row.forward += r.seconds_forward;
+    row.pod += r.seconds_pod;
+    row.constrained += r.seconds_constrained;
+    row.space_time += r.seconds_space_time;
+    row.reconstruction += r.seconds_reconstruction;
+    if (r.modes > 0) ++row.iterations;
+    row.modes = std::max(row.modes, r.modes);
+    row.kernels = std::max(row.kernels, r.centres);
+  }
+  row.best_iteration = state.best_iteration;
+  if (!state.history.empty()) row.train_nominal = 100 * state.history.front().forward_error.max / size;
+  for (const auto& r : state.history)
+    if (r.iteration == state.best_iteration) row.train_learned = 100 * r.forward_error.max / size;
+  std::printf("   learned in %.1f s (%d corrections, best: iteration %d)\n", row.learn_total, row.iterations,
+              state.best_iteration);
+  std::fflush(stdout);
+
+  // Parameter-fit baseline on the same observations.
+  t0 = Clock::now();
+  const auto fit = learn::fit_parameters(c.train, c.nominal_type, c.nominal, observed, c.fit);
+  row.fit_seconds = seconds_since(t0);
+  char fitted[256];
+  std::snprintf(fitted, sizeof fitted, "E %.3g, ν %.3f, α₀ %.3g, α₁ %.3g", fit.fitted.young, fit.fitted.poisson,
+                fit.fitted.alpha0, fit.fitted.alpha1);
+  row.fitted = fitted;
+  std::printf("   parameter fit in %.1f s (%d iterations, %d simulations, %s): %s; observation rms %.3f %% -> %.3f %%\n",
+              row.fit_seconds, fit.iterations, fit.simulations, learn::to_string(fit.stop).c_str(), fitted,
+              100 * fit.initial_rms / size, 100 * fit.final_rms / size);
+  std::fflush(stdout);
+
+  // Test motion.
+  t0 = Clock::now();
+  row.err_nominal = err_l(c.test, truth_test);
+  row.err_fit = err_l(learn::scene_with_parameters(c.test, c.nominal_type, fit.fitted), truth_test);
+  row.err_learned = err_l(learn::with_correction(c.test, state.best), truth_test);
+  std::printf("   test err_L: nominal %.3f %%, parameter fit %.3f %%, learned %.3f %% (target ≤ %.1f %%; %.1f s)\n",
+              row.err_nominal, row.err_fit, row.err_learned, row.target, seconds_since(t0));
+  std::fflush(stdout);
+  return row;
+}
+
+const std::vector<std::string> kCases = {"turtle",        "dragon",       "sphere-tension", "sphere-compression",
+                                         "bar-damping1",  "bar-damping2", "sparse-13",      "sparse-6"};
+
+LearningCase make_case(const std::string& name, const fs::path& data, bool quick) {
+  if (name == "turtle") return turtle(data, quick, 1.0);
+  if (name == "sparse-13") return turtle(data, quick, 0.13);
+  if (name == "sparse-6") return turtle(data, quick, 0.06);
+  if (name == "dragon") return dragon(data, quick);
+  if (name == "sphere-tension") return sphere(false, quick);
+  if (name == "sphere-compression") return sphere(true, quick);
+  if (name == "bar-damping1") return bar_damping(1, quick);
+  if (name == "bar-damping2") return bar_damping(2, quick);
+  throw InputError("case", "unknown case '" + name + "'");
+}
+
+std::string err(double e) {
+  char buf[32];
+  if (e < 0) return "diverged";
+  std::snprintf(buf, sizeof buf, "%.3f", e);
+  return buf;
+}
+
+void print_table(const std::vector<Row>& rows) {
+  std::printf("\n| case | tets | frames | observed | modes | iter | kernels | forward s | constrained s | space-time s | "
+              "reconstr. s | learn total s | fit s | deform. train/test %% | err_L nominal %% | err_L fit %% | "
+              "err_L learned %% | target %% |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const auto& r : rows)
+    std::printf("| %s | %d | %d | %d (%.0f %%) | %d | %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f / %.1f | "
+                "%s | %s | %s | ≤ %.1f |\n",
+                r.name.c_str(), r.tets, r.frames, r.observed, 100 * r.visible, r.modes, r.iterations, r.kernels,
+                r.forward, r.constrained, r.space_time, r.reconstruction, r.learn_total, r.fit_seconds,
+                r.train_deformation, r.test_deformation, err(r.err_nominal).c_str(), err(r.err_fit).c_str(),
+                err(r.err_learned).c_str(), r.target);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  bool quick = false;
+  fs::path data = fs::temp_directory_path() / "elastolearn-cgal-data";
+  std::vector<std::string> names;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--quick") quick = true;
+    else if (a == "--truth-only") g_truth_only = true;
+    else if (a == "--modes" && i + 1 < argc) g_modes = std::stoi(argv[++i]);
+    else if (a == "--kernels" && i + 1 < argc) g_kernels = std::stoi(argv[++i]);
+    else if (a == "--iterations" && i + 1 < argc) g_iterations = std::stoi(argv[++i]);
+    else if (a == "--patience" && i + 1 < argc) g_patience = std::stoi(argv[++i]);
+    else if (a == "--data" && i + 1 < argc) data = argv[++i];
+    else if (a == "--help" || a == "-h") {
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [CASE ...]\ncases:");
+      for (const auto& n : kCases) std::printf(" %s", n.c_str());
+      std::printf(" (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
+                  "data/meshes are (extracted there if missing)\n");
+      return 0;
+    } else if (a == "all") names.insert(names.end(), kCases.begin(), kCases.end());
+    else if (a == "sparse-views") names.insert(names.end(), {"turtle", "sparse-13", "sparse-6"});
+    else names.push_back(a);
+  }
+  if (names.empty()) names = kCases;
+  std::printf("bench_learning%s: %zu case(s), %u hardware threads\n", quick ? " --quick" : "", names.size(),
+              std::thread::hardware_concurrency());
+  std::vector<Row> rows;
+  int status = 0;
+  for (const auto& name : names) {
+    try {
+      LearningCase c = make_case(name, data, quick);
+      apply_overrides(c.options);
+      std::printf("\n%s: learning with ≤ %d modes, %d kernels, ≤ %d iterations, patience %d\n", name.c_str(),
+                  c.options.pod.max_modes, c.options.centres, c.options.max_iterations, c.options.patience);
+      rows.push_back(run_case(c));
+      print_table(rows);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "case %s failed: %s\n", name.c_str(), e.what());
+      status = 1;
+    }
+  }
+  print_table(rows);
+  return status;
+}
