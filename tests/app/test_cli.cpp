@@ -19,21 +19,7 @@ namespace {
 using elastolearn::test::Run;
 using elastolearn::test::run;
 
-class CliTest : public ::testing::Test {
-protected:
-  void SetUp() override {
-    m_dir = fs::temp_directory_path() / ("elastolearn_cli_" + std::to_string(::getpid()) + "_" +
-                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(m_dir);
-    fs::create_directories(m_dir);
-  }
-  void TearDown() override { fs::remove_all(m_dir); }
-  fs::path write(const std::string& name, const std::string& text) {
-    std::ofstream(m_dir / name) << text;
-    return m_dir / name;
-  }
-  fs::path m_dir;
-};
+using CliTest = elastolearn::test::CliTestFolder;
 
 const char* kSmallScene = R"({
   "format": "elastolearn-scene/1",

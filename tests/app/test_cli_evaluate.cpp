@@ -39,20 +39,8 @@ const char* k_truth_material
     = R"({"model": "neohookean", "young": 1e5, "poisson": 0.4, "density": 1000,
   "damping": {"alpha0": 0.1, "alpha1": 0.001}})";
 
-class CliEvaluateTest : public ::testing::Test {
+class CliEvaluateTest : public elastolearn::test::CliTestFolder {
   protected:
-  void SetUp() override {
-    m_dir = fs::temp_directory_path()
-        / ("elastolearn_cli_evaluate_" + std::to_string(::getpid()) + "_"
-            + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(m_dir);
-    fs::create_directories(m_dir);
-  }
-  void TearDown() override { fs::remove_all(m_dir); }
-  fs::path write(const std::string& name, const std::string& text) {
-    std::ofstream(m_dir / name) << text;
-    return m_dir / name;
-  }
   /// The truth scene with its material replaced by `material` (JSON text of the "material" value).
   fs::path scene_with_material(const std::string& name, const std::string& material) {
     std::string text = k_truth_scene;
@@ -69,7 +57,6 @@ class CliEvaluateTest : public ::testing::Test {
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return out;
   }
-  fs::path m_dir;
 };
 
 const char* k_nominal_material

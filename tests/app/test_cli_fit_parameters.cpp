@@ -35,20 +35,8 @@ std::string bar_scene(const std::string& material) {
 })";
 }
 
-class CliFitParametersTest : public ::testing::Test {
+class CliFitParametersTest : public elastolearn::test::CliTestFolder {
   protected:
-  void SetUp() override {
-    m_dir = fs::temp_directory_path()
-        / ("elastolearn_cli_fit_" + std::to_string(::getpid()) + "_"
-            + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(m_dir);
-    fs::create_directories(m_dir);
-  }
-  void TearDown() override { fs::remove_all(m_dir); }
-  fs::path write(const std::string& name, const std::string& text) {
-    std::ofstream(m_dir / name) << text;
-    return m_dir / name;
-  }
   /// Simulate the truth (E = 1.5e5, α₁ = 3e-3) and observe half of its surface vertices.
   fs::path observe_truth() {
     const auto truth = write("truth.json",
@@ -61,7 +49,6 @@ class CliFitParametersTest : public ::testing::Test {
     EXPECT_EQ(o.exit_code, 0) << o.output;
     return obs;
   }
-  fs::path m_dir;
 };
 
 const char* k_start_material

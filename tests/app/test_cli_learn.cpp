@@ -31,18 +31,14 @@ const char* k_truth = R"({"format": "elastolearn-material/1", "correction": null
   "material": {"model": "neohookean", "young": 1e6, "poisson": 0.43, "density": 1000,
                "damping": {"alpha0": 0.0, "alpha1": 0.01}}})";
 
-class CliLearnTest : public ::testing::Test {
+class CliLearnTest : public elastolearn::test::CliTestFolder {
 protected:
   void SetUp() override {
-    m_dir = fs::temp_directory_path() / ("elastolearn_cli_learn_" + std::to_string(::getpid()));
-    fs::remove_all(m_dir);
-    fs::create_directories(m_dir);
-    std::ofstream(m_dir / "scene.json") << k_scene;
-    std::ofstream(m_dir / "truth.json") << k_truth;
+    CliTestFolder::SetUp();
+    write("scene.json", k_scene);
+    write("truth.json", k_truth);
   }
-  void TearDown() override { fs::remove_all(m_dir); }
   std::string path(const std::string& name) const { return (m_dir / name).string(); }
-  fs::path m_dir;
 };
 
 double number_after(const std::string& text, const std::string& label) {

@@ -1,10 +1,15 @@
 #pragma once
 /// \file Run the built `elastolearn` executable (ELASTOLEARN_EXECUTABLE) with arguments and
-/// capture its exit code and output, for the end-to-end CLI tests.
+/// capture its exit code and output, and give each end-to-end CLI test its own folder.
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace elastolearn::test {
 
@@ -23,5 +28,25 @@ inline Run run(const std::string& arguments) {
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+/// Fixture base: a fresh temporary folder per test (suite, test and process in its name, so
+/// parallel ctest runs never share one), removed afterwards.
+class CliTestFolder : public ::testing::Test {
+protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    m_dir = std::filesystem::temp_directory_path() / ("elastolearn_" + std::string(info->test_suite_name()) + "_" +
+                                                      info->name() + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(m_dir);
+    std::filesystem::create_directories(m_dir);
+  }
+  void TearDown() override { std::filesystem::remove_all(m_dir); }
+  /// Write `text` to `name` in the folder; returns its path.
+  std::filesystem::path write(const std::string& name, const std::string& text) const {
+    std::ofstream(m_dir / name) << text;
+    return m_dir / name;
+  }
+  std::filesystem::path m_dir;
+};
 
 } // namespace elastolearn::test
