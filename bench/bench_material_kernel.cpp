@@ -1,6 +1,6 @@
 // Per-element material kernel cost, one core: the inversion-safe SVD (principal_frame), the stress
 // P = U P̂ Vᵀ, the projected tangent dP/dF, and the whole element as fem/elastic_force.cpp runs it
-// per Newton iteration (F, SVD, corrected principal stress, P, projected dP/dF, the 12×12 element
+// per Newton iteration (F, SVD, corrected principal stress, P, projected tangent, the 12×12 element
 // matrix). Each iteration takes the next of 1024 deformation gradients (mild random, rotated,
 // compressed, near-repeated and inverted), so branch prediction sees a realistic mix.
 // Eigen's JacobiSVD is timed alongside as the reference the kernel replaces.
@@ -172,6 +172,8 @@ void BM_SvdStressTangent(benchmark::State& state) {
 }
 BENCHMARK(BM_SvdStressTangent);
 
+/// Projected element stiffness through the 9×9 dP/dF (first_piola_derivative, then
+/// element_matrix_from_tangent on its upper triangle).
 void BM_ElementMatrixFromTangent(benchmark::State& state) {
   const auto& in = prepared();
   fem::TetRestData rest;
@@ -182,15 +184,33 @@ void BM_ElementMatrixFromTangent(benchmark::State& state) {
     const Mat9 H = material::first_piola_derivative(in[k].frame, in[k].stress.stress,
                                                     in[k].stress.d_stretches, true);
     benchmark::DoNotOptimize(H);
-    Mat12 K = fem::element_matrix_from_tangent(H, rest);
+    Mat12 K = fem::element_matrix_from_tangent(H, rest, true);
     benchmark::DoNotOptimize(K);
     k = (k + 1) & (kStates - 1);
   }
 }
 BENCHMARK(BM_ElementMatrixFromTangent);
 
+/// The same matrix straight from the eigen-form tangent (fem::element_stiffness), as
+/// fem/elastic_force.cpp computes it.
+void BM_ElementStiffness(benchmark::State& state) {
+  const auto& in = prepared();
+  fem::TetRestData rest;
+  rest.volume = 1.0 / 6.0;
+  rest.gradients << -1, 1, 0, 0, -1, 0, 1, 0, -1, 0, 0, 1;
+  int k = 0;
+  for (auto _ : state) {
+    const auto tangent =
+        material::principal_tangent(in[k].frame, in[k].stress.stress, in[k].stress.d_stretches, true);
+    Mat12 K = fem::element_stiffness(in[k].frame, tangent, rest);
+    benchmark::DoNotOptimize(K);
+    k = (k + 1) & (kStates - 1);
+  }
+}
+BENCHMARK(BM_ElementStiffness);
+
 /// The whole per-element Newton-iteration kernel of fem/elastic_force.cpp (no correction, no
-/// damping): F from the vertex positions, SVD, stress, P, force, projected dP/dF, 12×12 matrix.
+/// damping): F from the vertex positions, cold SVD, stress, P, force, projected tangent, 12×12 matrix.
 void BM_Element(benchmark::State& state) {
   const auto& F = states();
   const auto& model = corotated();
@@ -209,8 +229,8 @@ void BM_Element(benchmark::State& state) {
         material::corrected_principal_stress(model, nullptr, frame.stretches, Vec3::Zero());
     const Mat3 P = material::first_piola(frame, stress.stress);
     Eigen::Matrix<double, 3, 4> force = -rest.volume * P * rest.gradients;
-    const Mat9 H = material::first_piola_derivative(frame, stress.stress, stress.d_stretches, true);
-    Mat12 K = fem::element_matrix_from_tangent(H, rest);
+    const auto tangent = material::principal_tangent(frame, stress.stress, stress.d_stretches, true);
+    Mat12 K = fem::element_stiffness(frame, tangent, rest);
     benchmark::DoNotOptimize(force);
     benchmark::DoNotOptimize(K);
     k = (k + 1) & (kStates - 1);

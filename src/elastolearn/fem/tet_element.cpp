@@ -39,4 +39,34 @@ Mat12 element_matrix_from_tangent(const Mat9& H, const TetRestData& rest, bool s
   return K;
 }
 
+Mat12 element_stiffness(const material::PrincipalFrame& frame, const material::PrincipalTangent& t,
+                        const TetRestData& rest, double scale) {
+  const double s = scale * rest.volume;
+  const Eigen::Matrix<double, 3, 4> g = frame.V.transpose() * rest.gradients; // ĝ_a, rotated
+  // A: the block term; D: the diagonal entries' weights (A_ii on the diagonal, a_il off it);
+  // B: the transposed-entry weights b_ij (zero diagonal). All symmetric except A, D if the block is not.
+  const Mat3 A = s * t.block;
+  Mat3 D = A, B = Mat3::Zero();
+  static constexpr int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  for (int m = 0; m < 3; ++m) {
+    const int i = pairs[m][0], j = pairs[m][1];
+    D(i, j) = D(j, i) = 0.5 * s * (t.twist[m] + t.flip[m]);
+    B(i, j) = B(j, i) = 0.5 * s * (t.twist[m] - t.flip[m]);
+  }
+  const bool symmetric = t.block == t.block.transpose();
+  const Mat3& U = frame.U;
+  Mat12 K;
+  for (int b = 0; b < 4; ++b)
+    for (int a = 0; a < (symmetric ? b + 1 : 4); ++a) {
+      const Mat3 O = g.col(a) * g.col(b).transpose(); // O(i, j) = ĝ_a[i] ĝ_b[j]
+      Mat3 local = O.cwiseProduct(A) + O.transpose().cwiseProduct(B);
+      local.diagonal() = D * O.diagonal();
+      K.block<3, 3>(3 * a, 3 * b).noalias() = U * local * U.transpose();
+    }
+  // Mirror the upper triangle (also within the diagonal blocks, which rounding leaves slightly
+  // non-symmetric).
+  if (symmetric) K.triangularView<Eigen::StrictlyLower>() = K.transpose();
+  return K;
+}
+
 } // namespace elastolearn::fem

@@ -102,8 +102,11 @@ public:
                             "CG needs whole-vertex row triplets");
           m_block_row[t] = row / 3;
           float* v = m_block_values.data() + 9 * static_cast<size_t>(t);
-          for (int k = 0; k < 3; ++k)
-            for (int i = 0; i < 3; ++i) v[3 * k + i] = static_cast<float>(values[c[k] + local + i]);
+          for (int i = 0; i < 3; ++i) {
+            v[2 * i] = static_cast<float>(values[c[0] + local + i]);
+            v[2 * i + 1] = static_cast<float>(values[c[1] + local + i]);
+            v[6 + i] = static_cast<float>(values[c[2] + local + i]);
+          }
         }
       }
     });
@@ -158,22 +161,27 @@ private:
     return true; // the caller's true-residual test reports the failure
   }
 
-  /// y = A x with the float block copy: per 3×3 block one index load and 9 multiply-adds.
+  /// y = A x with the float block copy: per 3×3 block one index load and 9 multiply-adds, the
+  /// first two output rows as one 2-wide vector (see m_block_values' layout).
   void multiply_single(const VecX& x, VecX& y) const {
+    using Vec2 = Eigen::Vector2d;
+    using Vec2f = Eigen::Vector2f;
     const int blocks = static_cast<int>(m_block_outer.size()) - 1;
     const double* xp = x.data();
     tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 256), [&](const tbb::blocked_range<int>& r) {
       for (int J = r.begin(); J < r.end(); ++J) {
-        double y0 = 0, y1 = 0, y2 = 0;
+        Vec2 y01 = Vec2::Zero(), y2 = Vec2::Zero();
+        double y2_last = 0;
         for (int t = m_block_outer[J]; t < m_block_outer[J + 1]; ++t) {
           const double* xi = xp + 3 * m_block_row[t];
           const float* v = m_block_values.data() + 9 * static_cast<size_t>(t);
-          const double x0 = xi[0], x1 = xi[1], x2 = xi[2];
-          y0 += double(v[0]) * x0 + double(v[1]) * x1 + double(v[2]) * x2;
-          y1 += double(v[3]) * x0 + double(v[4]) * x1 + double(v[5]) * x2;
-          y2 += double(v[6]) * x0 + double(v[7]) * x1 + double(v[8]) * x2;
+          y01 += Eigen::Map<const Vec2f>(v).cast<double>() * xi[0] +
+                 Eigen::Map<const Vec2f>(v + 2).cast<double>() * xi[1] +
+                 Eigen::Map<const Vec2f>(v + 4).cast<double>() * xi[2];
+          y2 += Eigen::Map<const Vec2f>(v + 6).cast<double>().cwiseProduct(Eigen::Map<const Vec2>(xi));
+          y2_last += double(v[8]) * xi[2];
         }
-        y[3 * J] = y0, y[3 * J + 1] = y1, y[3 * J + 2] = y2;
+        y[3 * J] = y01[0], y[3 * J + 1] = y01[1], y[3 * J + 2] = y2[0] + y2[1] + y2_last;
       }
     });
   }
@@ -205,7 +213,9 @@ private:
   const fem::SparseMatrix* m_matrix = nullptr;
   std::vector<int> m_block_outer;     ///< vertex column J → its blocks [outer[J], outer[J+1])
   std::vector<int> m_block_row;       ///< block → vertex row I
-  std::vector<float> m_block_values;  ///< block → 9 values, v[3k + i] = A(3I + i, 3J + k)
+  /// block → 9 values: v[2i + k] = A(3I + i, 3J + k) for k = 0, 1, then v[6 + i] = A(3I + i, 3J + 2)
+  /// (columns 0 and 1 interleaved, so y_J's first two rows form one 2-wide product).
+  std::vector<float> m_block_values;
   VecX m_inverse_diagonal, m_r, m_z, m_p, m_q;
   int m_iterations = 0;
 };
