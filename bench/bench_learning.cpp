@@ -70,14 +70,22 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
 }
 
 bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and stop (for tuning scenes)
+bool g_no_fit = false;     ///< --no-fit: skip the parameter-fit baseline (for tuning the learning)
 /// Overrides of the learning options for every case (−1: keep the case's).
 int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1;
+double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1;
+bool g_linear_tail = false, g_full_space = false;
 
 void apply_overrides(learn::LearningOptions& o) {
   if (g_modes > 0) o.pod.max_modes = g_modes;
   if (g_kernels > 0) o.centres = g_kernels;
   if (g_iterations >= 0) o.max_iterations = g_iterations;
   if (g_patience > 0) o.patience = g_patience;
+  if (g_regularization >= 0) o.rbf.regularization = g_regularization;
+  if (g_damping_regularization >= 0) o.rbf.damping_regularization = g_damping_regularization;
+  if (g_linear_tail) o.rbf.quadratic_tail = false;
+  if (g_full_space) o.full_space = true;
+  if (g_position_weight > 0) o.space_time.position_weight = g_position_weight;
 }
 
 Row run_case(const LearningCase& c) {
@@ -126,7 +134,8 @@ Row run_case(const LearningCase& c) {
                   r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target, r.seconds_forward,
                   r.seconds_constrained, r.seconds_space_time, r.space_time_iterations, r.seconds_reconstruction);
     else if (!r.forward_completed)
-      std::printf(" -> this correction's forward simulation DIVERGED (%.1f s); the loop stops\n", r.seconds_forward);
+      std::printf(" -> this correction's forward simulation DIVERGED (%.1f s); %s\n", r.seconds_forward,
+                  r.damped_update ? "trying half its step" : "the loop stops");
     else
       std::printf(" (final forward check, %.1f s)\n", r.seconds_forward);
     std::fflush(stdout);
@@ -152,18 +161,22 @@ Row run_case(const LearningCase& c) {
               state.best_iteration);
   std::fflush(stdout);
 
-  // Parameter-fit baseline on the same observations.
+  // Parameter-fit baseline on the same observations (all parameters nominal with --no-fit).
   t0 = Clock::now();
-  const auto fit = learn::fit_parameters(c.train, c.nominal_type, c.nominal, observed, c.fit);
-  row.fit_seconds = seconds_since(t0);
-  char fitted[256];
-  std::snprintf(fitted, sizeof fitted, "E %.3g, ν %.3f, α₀ %.3g, α₁ %.3g", fit.fitted.young, fit.fitted.poisson,
-                fit.fitted.alpha0, fit.fitted.alpha1);
-  row.fitted = fitted;
-  std::printf("   parameter fit in %.1f s (%d iterations, %d simulations, %s): %s; observation rms %.3f %% -> %.3f %%\n",
-              row.fit_seconds, fit.iterations, fit.simulations, learn::to_string(fit.stop).c_str(), fitted,
-              100 * fit.initial_rms / size, 100 * fit.final_rms / size);
-  std::fflush(stdout);
+  learn::ParameterFitReport fit;
+  fit.fitted = c.nominal;
+  if (!g_no_fit) {
+    fit = learn::fit_parameters(c.train, c.nominal_type, c.nominal, observed, c.fit);
+    row.fit_seconds = seconds_since(t0);
+    char fitted[256];
+    std::snprintf(fitted, sizeof fitted, "E %.3g, ν %.3f, α₀ %.3g, α₁ %.3g", fit.fitted.young, fit.fitted.poisson,
+                  fit.fitted.alpha0, fit.fitted.alpha1);
+    row.fitted = fitted;
+    std::printf("   parameter fit in %.1f s (%d iterations, %d simulations, %s): %s; observation rms %.3f %% -> %.3f %%\n",
+                row.fit_seconds, fit.iterations, fit.simulations, learn::to_string(fit.stop).c_str(), fitted,
+                100 * fit.initial_rms / size, 100 * fit.final_rms / size);
+    std::fflush(stdout);
+  }
 
   // Test motion.
   t0 = Clock::now();
@@ -221,13 +234,19 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--quick") quick = true;
     else if (a == "--truth-only") g_truth_only = true;
+    else if (a == "--no-fit") g_no_fit = true;
     else if (a == "--modes" && i + 1 < argc) g_modes = std::stoi(argv[++i]);
     else if (a == "--kernels" && i + 1 < argc) g_kernels = std::stoi(argv[++i]);
     else if (a == "--iterations" && i + 1 < argc) g_iterations = std::stoi(argv[++i]);
     else if (a == "--patience" && i + 1 < argc) g_patience = std::stoi(argv[++i]);
+    else if (a == "--regularization" && i + 1 < argc) g_regularization = std::stod(argv[++i]);
+    else if (a == "--damping-regularization" && i + 1 < argc) g_damping_regularization = std::stod(argv[++i]);
+    else if (a == "--linear-tail") g_linear_tail = true;
+    else if (a == "--full-space") g_full_space = true;
+    else if (a == "--position-weight" && i + 1 < argc) g_position_weight = std::stod(argv[++i]);
     else if (a == "--data" && i + 1 < argc) data = argv[++i];
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_learning [--quick] [--truth-only] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [CASE ...]\ncases:");
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--regularization L] [--damping-regularization L] [--linear-tail] [--full-space] [--position-weight W] [CASE ...]\ncases:");
       for (const auto& n : kCases) std::printf(" %s", n.c_str());
       std::printf(" (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
                   "data/meshes are (extracted there if missing)\n");

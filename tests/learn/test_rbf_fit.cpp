@@ -1,5 +1,5 @@
 // RBF fit (paper 000 §6.1): recovers an RBF correction exactly when the truth is one, recovers a
-// known smooth elastic + damping correction from synthetic samples (issue 3, "Tests"), and the
+// known smooth elastic correction from synthetic samples (issue 3, "Tests"), and the
 // Tikhonov term and the input checks behave as documented.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/kmeans.hpp>
@@ -7,6 +7,8 @@
 #include <elastolearn/material/corotated.hpp>
 
 #include <gtest/gtest.h>
+
+#include <iostream>
 
 #include <algorithm>
 #include <functional>
@@ -18,12 +20,6 @@ using namespace elastolearn::learn;
 namespace {
 
 using Truth = std::function<Vec3(const Vec3& stretches, const Vec3& rates)>;
-
-/// Damping tangent of a corotated nominal with E = 5e4 Pa, ν = 0.4.
-Mat3 corotated_tangent() {
-  const material::CorotatedModel model(material::Lame::from_young_poisson(5e4, 0.4));
-  return material::rest_principal_tangent(model);
-}
 
 /// N samples with sorted stretches uniform in [0.8, 1.25] and rates N(0, 0.5²) [1/s].
 StressSamples make_samples(int n, unsigned seed, const Truth& truth) {
@@ -68,14 +64,11 @@ double relative_error(const material::Correction& n, const StressSamples& test) 
 } // namespace
 
 TEST(RbfFit, RecoversAnRbfCorrectionExactly) {
-  const Mat3 D = corotated_tangent();
   const StressSamples probe
       = make_samples(500, 1, [](const Vec3&, const Vec3&) { return Vec3(Vec3::Zero()); });
   const MatX centres = centres_for(probe, 12);
   RbfFitOptions options;
-  options.damping_tangent = D;
   options.regularization = 0; // exact data: no bias wanted
-  options.damping_regularization = 0;
   const RbfDesign design(centres, options);
   std::mt19937 rng(2);
   std::normal_distribution<double> g(0.0, 1.0);
@@ -83,12 +76,13 @@ TEST(RbfFit, RecoversAnRbfCorrectionExactly) {
   for (auto& v : x)
     v = g(rng);
   x.head(design.elastic_unknowns()) *= 1e3; // elastic weights [Pa]
-  x.tail(design.damping_unknowns()) *= 1e-2; // damping weights [s]
+  // Stress samples carry no damping information: the fit leaves Δα₁'s unknowns at zero.
+  x.tail(design.damping_unknowns()).setZero();
   const material::RbfCorrection truth = design.correction(x);
   const Truth f = [&](const Vec3& s, const Vec3& r) { return truth.correction(s, r); };
 
   const RbfFitResult fit = fit_rbf_correction(design, make_samples(3000, 3, f));
-  // Exact data, a full-rank design (3000 samples ≫ 29 unknowns): the solution is recovered to
+  // Exact data, a full-rank design (3000 samples ≫ 15 unknowns): the solution is recovered to
   // the conditioning of the normal equations (measured 1e-12 relative; allow 1e-8).
   EXPECT_LE((fit.unknowns - x).norm(), 1e-8 * x.norm());
   EXPECT_LE(relative_error(fit.correction, make_samples(500, 4, f)), 1e-9);
@@ -97,29 +91,52 @@ TEST(RbfFit, RecoversAnRbfCorrectionExactly) {
 }
 
 TEST(RbfFit, RecoversAKnownSmoothCorrection) {
-  // Truth: a cubic, permutation-symmetric stiffening (a = 5e4 Pa) with volumetric coupling, and a
-  // stretch-dependent Rayleigh correction Δα₁ = 0.02 (1 + 3‖σ − 1‖²) s acting through D.
-  const Mat3 D = corotated_tangent();
-  const Truth truth = [&](const Vec3& s, const Vec3& r) {
+  // Truth: a cubic, permutation-symmetric stiffening (a = 5e4 Pa) with volumetric coupling.
+  const Truth truth = [&](const Vec3& s, const Vec3&) {
     const Vec3 e = s.array() - 1.0;
-    const Vec3 elastic = 5e4 * e.array().cube().matrix() + 2e4 * e.sum() * e.cwiseAbs2();
-    const double alpha = 0.02 * (1 + 3 * e.squaredNorm());
-    return Vec3(elastic + alpha * D * r);
+    return Vec3(5e4 * e.array().cube().matrix() + 2e4 * e.sum() * e.cwiseAbs2());
   };
   const StressSamples train = make_samples(4000, 10, truth);
-  RbfFitOptions options;
-  options.damping_tangent = D;
-  const RbfDesign design(centres_for(train, 80), options);
+  const RbfDesign design(centres_for(train, 80), RbfFitOptions {});
   const RbfFitResult fit = fit_rbf_correction(design, train);
-  // 80 kernels (the paper uses 40–80) + linear tails over a 0.45-wide stretch box: held-out error
-  // measured 1.0 % (the elastic part alone 4 %, the damping part far better: see below).
+  // 80 kernels (the paper uses 40–80) + linear tail over a 0.45-wide stretch box: held-out error
+  // measured 6.3 % (a cubic truth: the kernels carry its third-order part).
   const StressSamples test = make_samples(1000, 11, truth);
-  EXPECT_LT(relative_error(fit.correction, test), 0.02);
-  // The damping part alone is recovered: Δα₁ at a few stretches within 2 % of the truth.
-  for (const Vec3& s : { Vec3(1.1, 1.0, 0.9), Vec3(1.2, 1.15, 0.85), Vec3(1, 1, 1) }) {
-    const double alpha = 0.02 * (1 + 3 * (s.array() - 1.0).matrix().squaredNorm());
-    EXPECT_NEAR(fit.correction.damping_correction(s), alpha, 0.02 * alpha) << s.transpose();
+  const double error = relative_error(fit.correction, test);
+  std::cout << "[ smooth   ] held-out relative error " << error << "\n";
+  EXPECT_LT(error, 0.1);
+  EXPECT_EQ(fit.correction.stiffness_damping(Vec3(1.1, 1.0, 0.9)), 0.0);
+}
+
+TEST(RbfFit, QuadraticTailExtrapolatesAQuadraticDifference) {
+  // The leading difference between two hyperelastic models is quadratic in the strain (e.g.
+  // StVK − corotated: P̂ᵢ ≈ 3μεᵢ² + λεᵢΣε + ½λΣε² + … beyond the shared linear part). Fitted on
+  // stretches within ±10 %, the quadratic tail reproduces it at 25–30 % stretch; a linear tail
+  // with kernels does not.
+  const double mu = 1.8e4, lambda = 7e4;
+  const Truth truth = [&](const Vec3& s, const Vec3&) {
+    const Vec3 e = s.array() - 1.0;
+    return Vec3(3 * mu * e.cwiseAbs2() + lambda * e.sum() * e + Vec3::Constant(0.5 * lambda * e.squaredNorm()));
+  };
+  StressSamples train = make_samples(3000, 31, truth);
+  for (Eigen::Index j = 0; j < train.stretches.rows(); ++j) { // squeeze [0.8, 1.25] into [0.9, 1.1]
+    const Vec3 s = Vec3::Ones() + (train.stretches.row(j).transpose() - Vec3::Constant(1.025)) * (0.2 / 0.45);
+    train.stretches.row(j) = s.transpose();
+    train.targets.row(j) = truth(s, Vec3::Zero()).transpose();
   }
+  const Vec3 far(1.3, 1.0, 0.8);
+  const double target = truth(far, Vec3::Zero()).norm();
+  RbfFitOptions quadratic, linear;
+  linear.quadratic_tail = false;
+  const MatX centres = centres_for(train, 20);
+  const RbfFitResult q = fit_rbf_correction(RbfDesign(centres, quadratic), train);
+  const RbfFitResult l = fit_rbf_correction(RbfDesign(centres, linear), train);
+  const double q_error = (q.correction.correction(far, Vec3::Zero()) - truth(far, Vec3::Zero())).norm() / target;
+  const double l_error = (l.correction.correction(far, Vec3::Zero()) - truth(far, Vec3::Zero())).norm() / target;
+  std::cout << "[ extrap.  ] relative error at (1.3, 1.0, 0.8): quadratic tail " << q_error << ", linear tail " << l_error << "\n";
+  // The truth lies in the quadratic tail's span: only the Tikhonov bias (λ = 1e-9) remains.
+  EXPECT_LT(q_error, 1e-4);
+  EXPECT_GT(l_error, 0.05);
 }
 
 TEST(RbfFit, ErrorShrinksWithMoreKernels) {
@@ -160,7 +177,7 @@ TEST(RbfFit, ElasticOnlyFitIgnoresRatesAndSortsSamples) {
   RbfFitOptions options;
   options.fit_damping = false;
   const RbfDesign design(centres_for(train, 20), options);
-  EXPECT_EQ(design.num_unknowns(), 20 + 3);
+  EXPECT_EQ(design.num_unknowns(), 20 + 3 + 4); // kernels, linear and quadratic tails
   const RbfFitResult a = fit_rbf_correction(design, train),
                      b = fit_rbf_correction(design, shuffled);
   EXPECT_LE((a.unknowns - b.unknowns).norm(), 1e-9 * a.unknowns.norm());
@@ -198,10 +215,10 @@ TEST(RbfFit, RejectsBadInput) {
   StressSamples nan = s;
   nan.targets(4, 1) = std::nan("");
   EXPECT_THROW(fit_rbf_correction(design, nan), InputError);
-  // λ = 0 and damping from zero stretch rates: the damping unknowns are undetermined.
+  // λ = 0 and every sample at the same stretches: the 6 elastic unknowns are undetermined.
   RbfFitOptions exact;
-  exact.regularization = exact.damping_regularization = 0;
+  exact.regularization = 0;
   const RbfDesign unregularised(MatX::Identity(3, 3) + MatX::Ones(3, 3), exact);
-  s.stretch_rates.setZero();
+  for (Eigen::Index j = 0; j < s.stretches.rows(); ++j) s.stretches.row(j) = Eigen::RowVector3d(1.1, 1.0, 0.9);
   EXPECT_THROW(fit_rbf_correction(unregularised, s), InputError);
 }

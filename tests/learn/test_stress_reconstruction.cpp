@@ -1,5 +1,6 @@
 // Stress reconstruction (paper 000 §6.1, Eqs. 10–13): the nodal-force operator agrees with
-// fem::ElasticForce, a known RBF correction (elastic + damping) is recovered from the nodal forces
+// fem::ElasticForce (elastic part and Δα₁ stiffness damping), a known RBF correction (elastic +
+// damping) is recovered from the nodal forces
 // it produces, and the LSQR option returns the minimum-norm least-squares element stresses.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/fem/elastic_force.hpp>
@@ -7,6 +8,7 @@
 #include <elastolearn/learn/stress_reconstruction.hpp>
 #include <elastolearn/learn/stress_reconstruction_lsqr.hpp>
 #include <elastolearn/material/corotated.hpp>
+#include <elastolearn/material/rayleigh_damping.hpp>
 #include <elastolearn/mesh/primitives.hpp>
 
 #include <Eigen/QR>
@@ -26,6 +28,15 @@ namespace {
 std::shared_ptr<const material::CorotatedModel> nominal() {
   return std::make_shared<material::CorotatedModel>(material::Lame::from_young_poisson(5e4, 0.4));
 }
+
+/// Rayleigh α₁ = 0.1 s (default): large enough that α₁ + Δα₁ stays > 0 for the random Δα₁ of
+/// the tests.
+std::shared_ptr<const material::RayleighDamping> rayleigh(double alpha1 = 0.1) {
+  return std::make_shared<material::RayleighDamping>(0.0, alpha1);
+}
+
+/// The nominal material of the reconstruction (elastic model and Rayleigh damping).
+fem::MaterialModel nominal_material(double alpha1 = 0.1) { return { nominal(), nullptr, rayleigh(alpha1), 1000 }; }
 
 /// Smoothly deformed, rotated and moving frames of `mesh`: x = R (X + A X + s(X)) + c with a
 /// random affine part (|A_ij| ≤ 0.12) and a sine bend along x, v = W X + cos bend (|W_ij| ≤ 1/s).
@@ -76,11 +87,11 @@ std::vector<int> left_face(const mesh::TetMesh& mesh) {
 }
 
 /// Nodal forces of `correction` through an independent path: ElasticForce with the correction
-/// minus ElasticForce without (same nominal, no damping model).
+/// minus ElasticForce without (same nominal, Rayleigh α₁ = 0.1 s so that α₁ + Δα₁ stays > 0).
 VecX elastic_force_difference(const mesh::TetMesh& mesh, const material::RbfCorrection& correction,
-    const VecX& x, const VecX& v) {
-  fem::ElasticForce with(mesh, { nominal(), correction.clone(), nullptr, 1000 });
-  fem::ElasticForce without(mesh, { nominal(), nullptr, nullptr, 1000 });
+    const VecX& x, const VecX& v, double alpha1) {
+  fem::ElasticForce with(mesh, { nominal(), correction.clone(), rayleigh(alpha1), 1000 });
+  fem::ElasticForce without(mesh, { nominal(), nullptr, rayleigh(alpha1), 1000 });
   VecX f = VecX::Zero(x.size()), f0 = VecX::Zero(x.size());
   with.add_force({ x, v }, f);
   without.add_force({ x, v }, f0);
@@ -89,7 +100,6 @@ VecX elastic_force_difference(const mesh::TetMesh& mesh, const material::RbfCorr
 
 RbfFitOptions design_options(double regularization) {
   RbfFitOptions o;
-  o.damping_tangent = material::rest_principal_tangent(*nominal());
   o.regularization = regularization;
   o.damping_regularization = regularization;
   return o;
@@ -108,20 +118,25 @@ VecX random_unknowns(const RbfDesign& design, unsigned seed) {
 
 struct KnownAnswer {
   mesh::TetMesh mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 6, 2, 2 });
-  ReconstructionMesh geometry { mesh };
+  double alpha1;
+  ReconstructionMesh geometry;
   fem::DofMap dofs { mesh.num_vertices(), left_face(mesh) };
   Frames frames = make_frames(mesh, 10, 7);
   RbfDesign design;
   VecX truth;
   std::vector<VecX> targets;
 
-  explicit KnownAnswer(double regularization)
-      : design(centres(), design_options(regularization)) {
+  /// `damped`: the truth has a Δα₁ part and the nominal Rayleigh α₁ = 0.1 s (else no damping).
+  explicit KnownAnswer(double regularization, bool damped = true)
+      : alpha1(damped ? 0.1 : 0.0)
+      , geometry(mesh, nominal_material(alpha1))
+      , design(centres(), design_options(regularization)) {
     truth = random_unknowns(design, 11);
+    if (!damped) truth.tail(design.damping_unknowns()).setZero();
     const material::RbfCorrection n = design.correction(truth);
     for (size_t t = 0; t < frames.positions.size(); ++t)
       targets.push_back(
-          elastic_force_difference(mesh, n, frames.positions[t], frames.velocities[t]));
+          elastic_force_difference(mesh, n, frames.positions[t], frames.velocities[t], alpha1));
   }
   MatX centres() const {
     KMeansOptions k;
@@ -222,7 +237,8 @@ TEST(StressReconstruction, RejectsInconsistentFrames) {
 }
 
 TEST(StressReconstructionLsqr, MinimumNormLeastSquaresStresses) {
-  // 12 tets (36 stresses) and 12 vertices, 2 fixed: 30 free dofs, so B has a null space.
+  // 12 tets (36 stresses) and 12 vertices, 2 fixed: 30 free dofs, so B has a null space. No
+  // nominal model: correction_force is then the elastic part B p̂ alone.
   const mesh::TetMesh mesh = mesh::make_box_bar(Vec3(0.2, 0.1, 0.1), { 2, 1, 1 });
   const ReconstructionMesh geometry(mesh);
   const fem::DofMap dofs(mesh.num_vertices(), { 0, 3 });
@@ -272,7 +288,8 @@ TEST(StressReconstructionLsqr, MinimumNormLeastSquaresStresses) {
 }
 
 TEST(StressReconstructionLsqr, PipelineFitsButDirectMethodIsOptimal) {
-  const KnownAnswer k(1e-10);
+  // An elastic truth: the LSQR pipeline fits element stresses, which carry no Δα₁.
+  const KnownAnswer k(1e-10, false);
   StressReconstructionOptions o;
   o.method = ReconstructionMethod::lsqr;
   const StressReconstructionResult lsqr = reconstruct_rbf_correction(
@@ -296,7 +313,7 @@ TEST(StressReconstructionLsqr, PipelineFitsButDirectMethodIsOptimal) {
 // Timing for docs/learning.md (not part of the suite: run with --gtest_also_run_disabled_tests).
 TEST(StressReconstruction, DISABLED_TimingLargeProblem) {
   const mesh::TetMesh mesh = mesh::make_box_bar(Vec3(0.5, 0.25, 0.2), { 10, 5, 4 });
-  const ReconstructionMesh geometry(mesh);
+  const ReconstructionMesh geometry(mesh, nominal_material());
   const fem::DofMap dofs(mesh.num_vertices(), left_face(mesh));
   const Frames frames = make_frames(mesh, 400, 5);
   KMeansOptions km;

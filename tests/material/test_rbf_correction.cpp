@@ -18,7 +18,7 @@ using namespace elastolearn::test;
 namespace {
 
 /// m = 6 centres around rest, random weights of realistic size (elastic ~1e3 Pa, damping ~1e-2 s),
-/// linear tails, and the damping tangent of a corotated nominal (E = 5e4 Pa, ν = 0.4).
+/// and linear tails.
 RbfCorrection::Parameters test_parameters(double epsilon) {
   std::mt19937 rng(17);
   std::normal_distribution<double> g(0.0, 1.0);
@@ -35,9 +35,9 @@ RbfCorrection::Parameters test_parameters(double epsilon) {
   p.own_slope = 5e3;
   p.other_slope = -2e3;
   p.constant = 10;
+  p.quadratic = Eigen::Vector4d(3e4, -2e4, 1e4, 4e4);
   p.damping_slope = 0.01;
   p.damping_constant = 0.03;
-  p.damping_tangent = rest_principal_tangent(CorotatedModel(Lame::from_young_poisson(5e4, 0.4)));
   p.epsilon = epsilon;
   return p;
 }
@@ -119,7 +119,7 @@ TEST(RbfCorrection, EqualStretchesGiveEqualStresses) {
   // unique there). Exact equality: both directions evaluate the same view of the stretches.
   const RbfCorrection n(test_parameters(1e-3));
   for (const Vec3& s : { Vec3(1.1, 1.1, 0.9), Vec3(0.8, 1.2, 1.2), Vec3(1.05, 0.7, 1.05), Vec3::Ones().eval() }) {
-    const Vec3 rates = Vec3(0.2, 0.2, 0.2); // equal rates too: the damping part is D ḟ, equivariant
+    const Vec3 rates = Vec3(0.2, 0.2, 0.2);
     const Vec3 out = n.correction(s, rates);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
@@ -131,35 +131,46 @@ TEST(RbfCorrection, EqualStretchesGiveEqualStresses) {
   EXPECT_LT(std::abs(out[0] - out[1]), 1e-7 * 1e5) << "Lipschitz with the slopes ~1e4–1e5 Pa";
 }
 
-TEST(RbfCorrection, SplitsIntoElasticAndDampingParts) {
+TEST(RbfCorrection, ElasticAndDampingPartsAreTheDocumentedRbfs) {
   const RbfCorrection n(test_parameters(1e-3));
   const auto& p = n.parameters();
   const Vec3 s(1.15, 0.97, 0.88), r(0.3, -0.5, 0.1);
-  // N(σ, ḟ) − N(σ, 0) = Δα₁(σ) D ḟ, and both parts are the documented RBF + linear tail.
-  const double alpha = n.damping_correction(s);
+  // N(σ) and Δα₁(σ) are the documented RBF + linear tail; N does not see the stretch rates (the
+  // damping acts through Δα₁ on the nominal stiffness, fem::ElasticForce).
   double expected_alpha = p.damping_slope * (s.sum() - 3) + p.damping_constant;
   Vec3 expected_elastic;
   for (int k = 0; k < 3; ++k) {
     const Vec3 y = stretch_view(s, k);
-    expected_elastic[k] = p.own_slope * (y[0] - 1) + p.other_slope * (y[1] + y[2] - 2) + p.constant;
+    expected_elastic[k] = p.own_slope * (y[0] - 1) + p.other_slope * (y[1] + y[2] - 2) + p.constant +
+                          p.quadratic[0] * (y[0] - 1) * (y[0] - 1) + p.quadratic[1] * (y[0] - 1) * (y[1] + y[2] - 2) +
+                          p.quadratic[2] * (y[1] + y[2] - 2) * (y[1] + y[2] - 2) +
+                          p.quadratic[3] * (y[1] - 1) * (y[2] - 1);
     for (int i = 0; i < 6; ++i)
       expected_elastic[k] += p.weights[i] * rbf_kernel((y - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
   }
   for (int i = 0; i < 6; ++i) // s is sorted descending already
     expected_alpha += p.damping_weights[i] * rbf_kernel((s - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
   EXPECT_EQ(stretch_view(Vec3(1.0, 2.0, 3.0), 0), Vec3(1.0, 3.0, 2.0));
-  EXPECT_NEAR(alpha, expected_alpha, 1e-14);
+  EXPECT_NEAR(n.stiffness_damping(s), expected_alpha, 1e-14);
+  // Δα₁ is a symmetric function of the stretches.
+  EXPECT_NEAR(n.stiffness_damping(Vec3(s[2], s[0], s[1])), expected_alpha, 1e-14);
   EXPECT_LE((n.elastic_correction(s) - expected_elastic).norm(), 1e-10);
-  const Vec3 damping = n.correction(s, r) - n.correction(s, Vec3::Zero());
-  EXPECT_LE((damping - alpha * p.damping_tangent * r).norm(), 1e-9 * damping.norm());
+  EXPECT_EQ(n.correction(s, r), n.correction(s, Vec3::Zero()));
   Mat3 ds, dr;
   n.correction_gradient(s, r, ds, dr);
-  EXPECT_LE((dr - alpha * p.damping_tangent).norm(), 1e-12 * dr.norm());
-  // The corotated tangent is 2μI + λ11ᵀ.
-  const Lame lame = Lame::from_young_poisson(5e4, 0.4);
-  EXPECT_LE(
-      (p.damping_tangent - (2 * lame.mu * Mat3::Identity() + lame.lambda * Mat3::Ones())).norm(),
-      1e-9 * lame.lambda);
+  EXPECT_TRUE(dr.isZero(0));
+  EXPECT_TRUE(n.has_damping());
+}
+
+TEST(RbfCorrection, DampingFloorBoundsTheDampingCorrection) {
+  RbfCorrection::Parameters p = test_parameters(1e-3);
+  p.damping_weights.resize(0);
+  p.damping_slope = 1.0; // Δα₁ = Σσ − 3 + a₀
+  p.damping_constant = 0;
+  p.damping_floor = -0.05;
+  const RbfCorrection n(p);
+  EXPECT_NEAR(n.stiffness_damping(Vec3(1.1, 1.0, 1.0)), 0.1, 1e-14);
+  EXPECT_EQ(n.stiffness_damping(Vec3(0.9, 0.9, 1.0)), -0.05); // −0.2 clamped
 }
 
 TEST(RbfCorrection, LinearTailIsAnIsotropicLameChange) {
@@ -179,12 +190,14 @@ TEST(RbfCorrection, ZeroWithoutWeightsAndWithoutDampingPart) {
   RbfCorrection::Parameters p = test_parameters(1e-3);
   p.weights.setZero();
   p.own_slope = p.other_slope = p.constant = 0;
+  p.quadratic.setZero();
   p.damping_weights.resize(0); // no damping RBF; the damping tail alone remains
   p.damping_slope = 0;
   p.damping_constant = 0;
   const RbfCorrection n(p);
   EXPECT_EQ(n.correction(Vec3(1.2, 1.0, 0.7), Vec3(1, 2, 3)), Vec3::Zero());
-  EXPECT_EQ(n.damping_correction(Vec3(1.2, 1.0, 0.7)), 0.0);
+  EXPECT_EQ(n.stiffness_damping(Vec3(1.2, 1.0, 0.7)), 0.0);
+  EXPECT_FALSE(n.has_damping());
   EXPECT_EQ(n.name(), "rbf");
   const auto copy = n.clone();
   EXPECT_EQ(copy->correction(Vec3(1.2, 1.0, 0.7), Vec3(1, 2, 3)), Vec3::Zero());
@@ -207,5 +220,26 @@ TEST(RbfCorrection, RejectsInconsistentParameters) {
   expect_error([](auto& p) { p.centres(2, 1) = std::nan(""); }, "centres");
   expect_error([](auto& p) { p.own_slope = std::nan(""); }, "own_slope");
   expect_error([](auto& p) { p.epsilon = -1; }, "epsilon");
-  expect_error([](auto& p) { p.damping_tangent(0, 0) = INFINITY; }, "damping_tangent");
+  expect_error([](auto& p) { p.damping_constant = INFINITY; }, "damping_constant");
+  expect_error([](auto& p) { p.quadratic[2] = std::nan(""); }, "quadratic");
+}
+
+TEST(RbfCorrection, BlendIsTheWeightedSumOfTwoCorrections) {
+  RbfCorrection::Parameters pa = test_parameters(1e-3), pb = test_parameters(1e-3);
+  pb.centres.array() += 0.05;
+  pb.weights *= -0.7;
+  pb.damping_weights.resize(0); // b without a damping RBF
+  pb.quadratic *= 2;
+  const RbfCorrection a(pa), b(pb);
+  const RbfCorrection half = blend(a, &b, 0.25), none = blend(a, nullptr, 0.5);
+  EXPECT_EQ(half.num_centres(), 12);
+  for (const Vec3& s : { Vec3(1.2, 1.0, 0.9), Vec3(0.95, 0.9, 0.8), Vec3(1.1, 1.1, 1.0) }) {
+    EXPECT_LE((half.correction(s, Vec3::Zero()) - (0.75 * a.correction(s, Vec3::Zero()) + 0.25 * b.correction(s, Vec3::Zero()))).norm(),
+              1e-9 * a.correction(s, Vec3::Zero()).norm());
+    EXPECT_NEAR(half.stiffness_damping(s), 0.75 * a.stiffness_damping(s) + 0.25 * b.stiffness_damping(s), 1e-14);
+    EXPECT_LE((none.correction(s, Vec3::Zero()) - 0.5 * a.correction(s, Vec3::Zero())).norm(), 1e-9 * a.correction(s, Vec3::Zero()).norm());
+  }
+  pb.epsilon = 0.1;
+  const RbfCorrection smoother(pb);
+  EXPECT_THROW(blend(a, &smoother, 0.5), InputError);
 }

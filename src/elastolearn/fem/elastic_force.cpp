@@ -5,6 +5,8 @@
 #include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+
 namespace elastolearn::fem {
 
 namespace {
@@ -16,6 +18,12 @@ Mat3 symmetric_psd(const Mat3& a) {
   if (eig.eigenvalues().minCoeff() >= 0) return s;
   return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
          eig.eigenvectors().transpose();
+}
+
+/// a·A + b·B of two eigen-form tangents (the eigen-form is linear in dP/dF).
+material::PrincipalTangent weighted_sum(double a, const material::PrincipalTangent& A, double b,
+                                        const material::PrincipalTangent& B) {
+  return {a * A.block + b * B.block, a * A.twist + b * B.twist, a * A.flip + b * B.flip};
 }
 
 } // namespace
@@ -60,11 +68,19 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
       c.stress = material::corrected_principal_stress(*elastic, correction, c.frame.stretches, rates);
       Mat3 P = material::first_piola(c.frame, c.stress.stress);
       c.alpha = damping ? damping->coefficients(c.frame.stretches[0]) : material::RayleighCoefficients{};
+      // A learned Δα₁ scales the same stiffness as α₁ (paper Eq. 13); the total never turns negative.
+      if (correction) c.alpha.alpha1 = std::max(0.0, c.alpha.alpha1 + correction->stiffness_damping(c.frame.stretches));
       c.has_tangent = false;
       if (c.alpha.alpha1 != 0) {
         // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 9×9
-        // or 12×12 (the eigen-form tangent is kept for the Jacobian).
-        c.tangent = material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
+        // or 12×12 (the eigen-form tangent is kept for the Jacobian). K_e is the nominal model's
+        // stiffness: a correction changes the elastic stress; the damping is Rayleigh's on the
+        // nominal stiffness, scaled by α₁ + Δα₁ (this keeps the learned damping linear in Δα₁).
+        c.tangent = correction ? material::principal_tangent(c.frame, elastic->principal_stress(c.frame.stretches),
+                                                             elastic->principal_stress_derivative(c.frame.stretches),
+                                                             m_project_tangent)
+                               : material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches,
+                                                             m_project_tangent);
         c.has_tangent = true;
         P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
       }
@@ -94,19 +110,24 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
   A.add_elements([&](int e, Mat12& J) {
     const TetRestData& rest = m_rest[e];
     const ElementCache& c = m_cache[e];
-    const material::PrincipalTangent tangent =
-        c.has_tangent ? c.tangent
-                      : material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
-    const Mat9 H = (c_x + c_v * c.alpha.alpha1) * material::first_piola_derivative(c.frame, tangent);
-    // The projected tangent is symmetric; the exact one need not be (non-symmetric corrections).
-    J = element_matrix_from_tangent(H, rest, m_project_tangent);
+    // c_x K_e + c_v α₁ K_e^nominal as one eigen-form tangent (both PSD when projected, so their
+    // sum is too); without a correction the two stiffnesses are the same.
+    material::PrincipalTangent tangent =
+        c.has_tangent && !correction
+            ? c.tangent
+            : material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
+    double scale = c_x + c_v * c.alpha.alpha1;
+    if (correction && c.has_tangent) {
+      tangent = weighted_sum(c_x, tangent, c_v * c.alpha.alpha1, c.tangent);
+      scale = 1;
+    }
+    J = element_stiffness(c.frame, tangent, rest, scale);
     if (c.alpha.alpha0 != 0) J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
-    if (correction && c_v != 0) {
+    if (correction && c_v != 0 && !c.stress.d_stretch_rates.isZero(0)) {
       // Project the damping tangent as a whole: the Rayleigh part α₁·block plus the correction's
-      // rate part may be PSD together even where the rate part alone is not (a learned Δα₁ < 0
-      // that lowers but does not reverse the nominal damping); projecting them separately would
-      // overstate the damping and stall Newton.
-      const Mat3 rayleigh = c.alpha.alpha1 * tangent.block;
+      // rate part may be PSD together even where the rate part alone is not; projecting them
+      // separately would overstate the damping and stall Newton.
+      const Mat3 rayleigh = c.has_tangent ? Mat3(c.alpha.alpha1 * c.tangent.block) : Mat3::Zero();
       const Mat3 d_rates = m_project_tangent ? Mat3(symmetric_psd(rayleigh + c.stress.d_stretch_rates) - rayleigh)
                                              : c.stress.d_stretch_rates;
       if (!d_rates.isZero(0))

@@ -25,8 +25,11 @@ struct MaterialModel {
 /// Elastic (+correction) and Rayleigh damping forces of all tets, with their Jacobians.
 ///
 /// Per element: F = Σ x_a g_aᵀ, SVD F = U F̂ Vᵀ, P = U (P̂ + N) Vᵀ, f_a = −vol P g_a;
-/// K_e = vol Bᵀ (dP/dF)_psd B; damping force −α₁ K_e v_e − α₀ (ρ vol/4) v_e with (α₀, α₁) from
-/// the element's largest stretch; the correction's rate dependence adds D_e = vol Bᵀ ∂P/∂Ḟ B
+/// K_e = vol Bᵀ (dP/dF)_psd B of the corrected model; damping force −(α₁ + Δα₁) K_e^nom v_e −
+/// α₀ (ρ vol/4) v_e with (α₀, α₁) from the element's largest stretch,
+/// Δα₁ = Correction::stiffness_damping(F̂) (paper Eq. 13; α₁ + Δα₁ kept ≥ 0) and K_e^nom the
+/// nominal (uncorrected) model's stiffness; the correction's rate dependence adds
+/// D_e = vol Bᵀ ∂P/∂Ḟ B
 /// (symmetrised, clamped PSD). The Jacobian drops ∂K/∂x·v (Rayleigh) and the variation of
 /// Ḟ̂ through U, V (correction): standard, and the residual is still exact.
 /// Element loops run in parallel (oneTBB): forces into per-element buffers gathered without

@@ -42,6 +42,7 @@ learn::IterationRecord read_record(const JsonObject& o) {
   r.iteration = o.integer("iteration");
   r.forward_error = read_error(o.object("forward_error"));
   r.forward_completed = o.boolean("forward_completed", true);
+  r.damped_update = o.boolean("damped_update", false);
   r.control_force_rms = o.number("control_force_rms");
   r.space_time_initial = o.number("space_time_initial");
   r.space_time_objective = o.number("space_time_objective");
@@ -65,6 +66,7 @@ nlohmann::json iteration_record_to_json(const learn::IterationRecord& r) {
   return {{"iteration", r.iteration},
           {"forward_error", error_json(r.forward_error)},
           {"forward_completed", r.forward_completed},
+          {"damped_update", r.damped_update},
           {"control_force_rms", r.control_force_rms},
           {"space_time_initial", r.space_time_initial},
           {"space_time_objective", r.space_time_objective},
@@ -95,8 +97,10 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
           {"full_space", o.full_space},
           {"max_reconstruction_frames", o.max_reconstruction_frames},
           {"rbf", {{"epsilon", o.rbf.epsilon}, {"elastic_polynomial", o.rbf.elastic_polynomial},
+                   {"quadratic_tail", o.rbf.quadratic_tail},
                    {"fit_damping", o.rbf.fit_damping}, {"damping_polynomial", o.rbf.damping_polynomial},
-                   {"regularization", o.rbf.regularization}}},
+                   {"regularization", o.rbf.regularization},
+                   {"damping_regularization", o.rbf.damping_regularization}}},
           {"reconstruction", {{"method", learn::reconstruction_method_name(o.reconstruction.method)},
                               {"frame_stride", o.reconstruction.frame_stride}}},
           {"stretch_samples", {{"frame_stride", o.stretch_samples.frame_stride},

@@ -44,9 +44,9 @@ Json rbf_to_json(const material::RbfCorrection& c) {
   return Json { { "type", "rbf" }, { "epsilon", p.epsilon }, { "centres", rows_to_json(p.centres) },
     { "weights", vector_to_json(p.weights) }, { "own_slope", p.own_slope },
     { "other_slope", p.other_slope }, { "constant", p.constant },
+    { "quadratic", vector_to_json(p.quadratic) },
     { "damping_weights", vector_to_json(p.damping_weights) }, { "damping_slope", p.damping_slope },
-    { "damping_constant", p.damping_constant },
-    { "damping_tangent", rows_to_json(p.damping_tangent) }, { "damping_floor", floor } };
+    { "damping_constant", p.damping_constant }, { "damping_floor", floor } };
 }
 
 Json nn_to_json(const material::NnCorrection& c) {
@@ -123,7 +123,7 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
 
 std::shared_ptr<const material::Correction> rbf_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "epsilon", "centres", "weights", "own_slope", "other_slope",
-      "constant", "damping_weights", "damping_slope", "damping_constant", "damping_tangent",
+      "constant", "quadratic", "damping_weights", "damping_slope", "damping_constant",
       "damping_floor" });
   material::RbfCorrection::Parameters p;
   p.epsilon = o.number("epsilon");
@@ -132,6 +132,8 @@ std::shared_ptr<const material::Correction> rbf_from_json(const JsonObject& o) {
   p.own_slope = o.number("own_slope", 0.0);
   p.other_slope = o.number("other_slope", 0.0);
   p.constant = o.number("constant", 0.0);
+  if (o.has("quadratic"))
+    p.quadratic = read_vector(o, "quadratic", 4);
   if (o.has("damping_weights")) {
     p.damping_weights = read_vector(o, "damping_weights");
     if (p.damping_weights.size() != 0 && p.damping_weights.size() != p.centres.rows()) {
@@ -142,12 +144,6 @@ std::shared_ptr<const material::Correction> rbf_from_json(const JsonObject& o) {
   }
   p.damping_slope = o.number("damping_slope", 0.0);
   p.damping_constant = o.number("damping_constant", 0.0);
-  const bool damped
-      = p.damping_weights.size() > 0 || p.damping_slope != 0 || p.damping_constant != 0;
-  if (o.has("damping_tangent"))
-    p.damping_tangent = read_rows(o, "damping_tangent", 3, 3);
-  else if (damped)
-    o.fail("damping_tangent", "missing required field (the damping correction needs it)");
   if (o.has("damping_floor") && !o.json().at("damping_floor").is_null())
     p.damping_floor = o.number("damping_floor");
   return construct(
@@ -198,7 +194,7 @@ std::shared_ptr<const material::Correction> correction_from_json(const JsonObjec
 std::string describe_correction(const material::Correction& correction) {
   if (const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&correction)) {
     std::string s = "rbf, " + std::to_string(rbf->num_centres()) + " centres";
-    if (rbf->parameters().damping_weights.size() > 0)
+    if (rbf->has_damping())
       s += ", with damping correction";
     return s;
   }

@@ -131,14 +131,9 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
   observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, "observations");
   auto interrupted = [&] { return callbacks.interrupted && callbacks.interrupted(); };
 
-  RbfFitOptions rbf = options.rbf;
-  rbf.damping_tangent = material::rest_principal_tangent(*scene.material.elastic);
-  // α₁ + Δα₁ ≥ 0: the learned damping may cancel the nominal one, never turn negative.
-  // Δα₁ ≥ 0: the learned damping adds to the nominal one. Allowing α₁ + Δα₁ ≥ 0 instead (floor
-  // −α₁) made the bar example's first corrected step stall in Newton at the tolerance (measured;
-  // see docs/learning.md, "Damping floor"), so lowering the damping is left out for now.
-  rbf.damping_floor = 0.0;
-  const ReconstructionMesh reconstruction_mesh(scene.mesh);
+  // The learned Δα₁ may lower the nominal damping; fem::ElasticForce keeps α₁ + Δα₁ ≥ 0.
+  const RbfFitOptions& rbf = options.rbf;
+  const ReconstructionMesh reconstruction_mesh(scene.mesh, scene.material);
   const std::vector<int> basis_vertices = free_vertices(scene);
   const sim::Scene tracked_scene = constrained_scene(scene, observed);
   // Every free vertex observed (small meshes): the constrained trajectory is the data itself.
@@ -179,11 +174,15 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       next.iterations_without_improvement = 0;
     else
       ++next.iterations_without_improvement;
-    if (!forward.completed || next.iterations_without_improvement >= options.patience ||
-        record.iteration >= options.max_iterations) {
+    if (next.iterations_without_improvement >= options.patience || record.iteration >= options.max_iterations)
       next.finished = true;
-    }
-    if (!next.finished) {
+    if (!forward.completed && !next.finished) {
+      // C_k overshot (its simulation diverged): halve the step from the best correction and try
+      // that. Deterministic, so a resumed run takes the same path.
+      next.correction =
+          std::make_shared<material::RbfCorrection>(material::blend(*state.correction, next.best.get(), 0.5));
+      record.damped_update = true;
+    } else if (!next.finished) {
       if (interrupted()) return false;
       // 2. POD basis of the forward simulation.
       t0 = Clock::now();

@@ -11,8 +11,9 @@
 ///      nodal forces must equal the nominal model's residual along the optimised trajectory;
 ///   6. RBF centres re-clustered (k-means) over the trajectory's stretches each iteration.
 /// The loop stops when neither the forward error nor the control forces (by 5 %) improved for
-/// `patience` iterations, or after
-/// `max_iterations` corrections. Every stage is deterministic, and an iteration depends only on
+/// `patience` iterations, or after `max_iterations` corrections. A correction whose forward
+/// simulation diverges counts as no improvement and is replaced by ½ (C_k + best) (a damped
+/// update, no trajectory stages) while patience lasts. Every stage is deterministic, and an iteration depends only on
 /// the current correction, so a run resumed from a checkpoint reaches the same result.
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/kmeans.hpp>
@@ -60,6 +61,8 @@ struct IterationRecord {
   int iteration = 0;                ///< k (0: the nominal model)
   ErrorSummary forward_error;       ///< of C_k's forward simulation at the observed vertices [m]
   bool forward_completed = true;    ///< false if C_k's forward simulation diverged
+  /// C_k diverged and C_{k+1} = ½ (C_k + best) was tried instead (a damped update).
+  bool damped_update = false;
   double control_force_rms = 0;     ///< √(mean r²) of the optimised trajectory [N]
   double space_time_initial = 0;    ///< E at the constrained simulation
   double space_time_objective = 0;  ///< E after optimisation

@@ -113,6 +113,7 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   std::mt19937_64 rng(o.seed);
   long seen = 0;
   const std::shared_ptr<const material::Correction> shared_teacher = teacher.clone();
+  const material::ElasticModel& nominal = *scenes.front().material.elastic;
 
   for (const sim::Scene& original : scenes) {
     sim::Scene scene = original;
@@ -177,7 +178,12 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
     sorted_sample(out, j, s, f, unused);
     out.stretches.row(j) = s.transpose();
     out.stretch_rates.row(j) = f.transpose();
-    out.targets.row(j) = teacher.correction(s, f).transpose();
+    Vec3 target = teacher.correction(s, f);
+    // The teacher's damping correction as a principal stress (paper §6.2): Δα₁ (∂P̂/∂σ) ḟ of the
+    // nominal model, the part of the force −Δα₁ K_e v_e that a function of (σ, ḟ) can carry.
+    if (const double delta_alpha1 = teacher.stiffness_damping(s); delta_alpha1 != 0)
+      target += delta_alpha1 * (nominal.principal_stress_derivative(s) * f);
+    out.targets.row(j) = target.transpose();
   }
   if (!out.targets.allFinite())
     fail("teacher", "the teacher correction returned a non-finite value");

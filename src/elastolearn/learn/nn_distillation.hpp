@@ -49,8 +49,10 @@ struct DistillationSampleReport {
 /// has), record each element's principal stretches and stretch rates (sorted descending, rates
 /// permuted alike) at every frame_stride-th frame, keep a uniform random subsample of
 /// `recorded_samples` states over all scenes, add `jitter_copies` Gaussian-jittered copies of each,
-/// and evaluate the teacher on all of them: targets = N_teacher(σ, ḟ) [Pa], which for the RBF
-/// of the learning loop is the elastic RBF plus the Δα₁ damping stress (paper §6.2).
+/// and evaluate the teacher on all of them: targets = N_teacher(σ, ḟ) + Δα₁(σ) (∂P̂/∂σ) ḟ [Pa],
+/// the elastic correction plus the damping correction's principal stress with the first scene's
+/// nominal model (paper §6.2: the network carries both; it sees only the stretch-rate part of
+/// the damping, not the shear modes that −Δα₁ K_e v_e also damps).
 /// A simulation that diverges contributes the frames before it (reported). Deterministic.
 /// Throws InputError for bad options, no scenes, or no recorded state at all.
 StressSamples distillation_samples(std::span<const sim::Scene> scenes,

@@ -36,8 +36,6 @@ void RbfFitOptions::validate() const {
     fail("damping_regularization", "must be finite and ≥ 0, got " + str(damping_regularization));
   if (std::isnan(damping_floor) || damping_floor > 0)
     fail("damping_floor", "must be ≤ 0 (or −infinity), got " + str(damping_floor));
-  if (!damping_tangent.allFinite())
-    fail("damping_tangent", "contains a non-finite value");
 }
 
 RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_options(options) {
@@ -47,11 +45,11 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_o
   if (!centres.allFinite()) fail("centres", "contains a non-finite value");
   m_centres = centres;
   const int m = static_cast<int>(centres.rows());
-  m_elastic = m + (options.elastic_polynomial ? 3 : 0);
+  m_elastic = m + (options.elastic_polynomial ? 3 : 0) + (options.elastic_polynomial && options.quadratic_tail ? 4 : 0);
   m_damping = options.fit_damping ? m + (options.damping_polynomial ? 2 : 0) : 0;
 }
 
-void RbfDesign::output_matrix(const Vec3& stretches, const Vec3& stretch_rates, Eigen::Ref<OutputMatrix> out) const {
+void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
   const Eigen::Index m = m_centres.rows();
   const double eps = m_options.epsilon;
   for (int k = 0; k < 3; ++k) {
@@ -62,20 +60,21 @@ void RbfDesign::output_matrix(const Vec3& stretches, const Vec3& stretch_rates, 
       out(k, m) = y[0] - 1;
       out(k, m + 1) = y[1] + y[2] - 2;
       out(k, m + 2) = 1;
+      if (m_options.quadratic_tail) out.block<1, 4>(k, m + 3) = material::quadratic_tail_basis(y).transpose();
     }
   }
+}
+
+void RbfDesign::damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd> out) const {
   if (m_damping == 0) return;
+  const Eigen::Index m = m_centres.rows();
   Vec3 s = stretches;
   std::sort(s.data(), s.data() + 3, std::greater<>());
-  const Vec3 rate_stress = m_options.damping_tangent * stretch_rates;
-  auto damping = out.rightCols(m_damping);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    const double phi = material::rbf_kernel((s - m_centres.row(i).transpose()).squaredNorm(), eps);
-    damping.col(i) = phi * rate_stress;
-  }
+  for (Eigen::Index i = 0; i < m; ++i)
+    out[i] = material::rbf_kernel((s - m_centres.row(i).transpose()).squaredNorm(), m_options.epsilon);
   if (m_options.damping_polynomial) {
-    damping.col(m) = (s.sum() - 3) * rate_stress;
-    damping.col(m + 1) = rate_stress;
+    out[m] = s.sum() - 3;
+    out[m + 1] = 1;
   }
 }
 
@@ -90,6 +89,7 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
     p.own_slope = x[m];
     p.other_slope = x[m + 1];
     p.constant = x[m + 2];
+    if (m_options.quadratic_tail) p.quadratic = x.segment<4>(m + 3);
   }
   if (m_damping > 0) {
     const auto v = x.tail(m_damping);
@@ -98,7 +98,6 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
       p.damping_slope = v[m];
       p.damping_constant = v[m + 1];
     }
-    p.damping_tangent = m_options.damping_tangent;
     p.damping_floor = m_options.damping_floor;
   }
   return material::RbfCorrection(std::move(p));
@@ -144,7 +143,7 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
                         str(samples.targets.rows()) + " targets");
   if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite() || !samples.targets.allFinite())
     fail("samples", "contain a non-finite value");
-  const int u = design.num_unknowns();
+  const int u = design.elastic_unknowns();
   MatX normal = MatX::Zero(u, u);
   VecX rhs = VecX::Zero(u);
   MatX stacked(3 * k_chunk, u);
@@ -153,8 +152,7 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
   for (Eigen::Index start = 0; start < n; start += k_chunk) {
     const Eigen::Index c = std::min(k_chunk, n - start);
     for (Eigen::Index j = 0; j < c; ++j) {
-      design.output_matrix(samples.stretches.row(start + j).transpose(),
-                           samples.stretch_rates.row(start + j).transpose(), a);
+      design.output_matrix(samples.stretches.row(start + j).transpose(), a);
       stacked.middleRows(3 * j, 3) = a;
       targets.segment<3>(3 * j) = samples.targets.row(start + j).transpose();
     }
@@ -163,7 +161,8 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
     rhs.noalias() += rows.transpose() * targets.head(3 * c);
   }
   normal.triangularView<Eigen::StrictlyUpper>() = normal.transpose();
-  const VecX x = solve_regularised_normal_equations(normal, rhs, design.regularization_weights(), n);
+  VecX x = VecX::Zero(design.num_unknowns());
+  x.head(u) = solve_regularised_normal_equations(normal, rhs, design.regularization_weights().head(u), n);
   RbfFitResult result { design.correction(x), x, 0, 0, static_cast<int>(n) };
   double residual = 0, target = 0;
   for (Eigen::Index j = 0; j < n; ++j) {

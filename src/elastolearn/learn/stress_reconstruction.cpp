@@ -38,8 +38,8 @@ void element_states_range(const ReconstructionMesh& mesh, const VecX& x, const V
     const Eigen::Vector4i tet = mesh.tets.row(e).transpose();
     ElementState& s = states[e];
     s.frame = material::principal_frame(fem::deformation_gradient(fem::gather_tet(x, tet), rest));
-    s.stretch_rates = material::stretch_rates(
-        s.frame, fem::deformation_gradient(fem::gather_tet(v, tet), rest));
+    s.deformation_rate = fem::deformation_gradient(fem::gather_tet(v, tet), rest);
+    s.stretch_rates = material::stretch_rates(s.frame, s.deformation_rate);
   }
 }
 
@@ -58,8 +58,9 @@ std::vector<std::array<int, 12>> element_free_rows(
 struct AssemblyScratch {
   std::vector<ElementState> states;
   MatX jt; ///< Jᵀ of one frame: unknowns × free dofs
-  RbfDesign::OutputMatrix outputs;             ///< A_e: 3 × unknowns
-  Eigen::Matrix<double, 12, Eigen::Dynamic> element_rows; ///< G_e A_e
+  RbfDesign::OutputMatrix outputs;             ///< A_e: 3 × elastic unknowns
+  Eigen::RowVectorXd damping_row;              ///< d_e: damping unknowns
+  Eigen::Matrix<double, 12, Eigen::Dynamic> element_rows; ///< [G_e A_e, (−K_e v_e) d_e]
   VecX target;
 };
 
@@ -73,16 +74,18 @@ constexpr int k_frame_blocks = 16;
 
 } // namespace
 
-ReconstructionMesh::ReconstructionMesh(const mesh::TetMesh& mesh)
+ReconstructionMesh::ReconstructionMesh(const mesh::TetMesh& mesh, fem::MaterialModel nominal_model)
     : rest(fem::precompute_rest_data(mesh))
     , tets(mesh.tets())
-    , num_vertices(mesh.num_vertices()) { }
+    , num_vertices(mesh.num_vertices())
+    , nominal(std::move(nominal_model)) { }
 
-ReconstructionMesh::ReconstructionMesh(
-    std::vector<fem::TetRestData> rest_data, Tets tet_indices, int n)
+ReconstructionMesh::ReconstructionMesh(std::vector<fem::TetRestData> rest_data, Tets tet_indices,
+    int n, fem::MaterialModel nominal_model)
     : rest(std::move(rest_data))
     , tets(std::move(tet_indices))
-    , num_vertices(n) {
+    , num_vertices(n)
+    , nominal(std::move(nominal_model)) {
   if (rest.size() != static_cast<size_t>(tets.rows()))
     fail("mesh", str(rest.size()) + " rest data for " + str(tets.rows()) + " tets");
   if (tets.size() > 0 && (tets.minCoeff() < 0 || tets.maxCoeff() >= n))
@@ -109,17 +112,45 @@ Eigen::Matrix<double, 12, 3> element_force_operator(
   return G;
 }
 
+Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
+    const material::ElasticModel& elastic) {
+  const Vec3& s = state.frame.stretches;
+  const material::PrincipalTangent tangent = material::principal_tangent(
+      state.frame, elastic.principal_stress(s), elastic.principal_stress_derivative(s), true);
+  const Mat3 stress_rate = material::first_piola_differential(state.frame, tangent, state.deformation_rate);
+  Vec12 f;
+  Eigen::Map<Eigen::Matrix<double, 3, 4>>(f.data()).noalias() = -rest.volume * stress_rate * rest.gradients;
+  return f;
+}
+
+namespace {
+
+/// Nominal Rayleigh α₁ of an element (0 without a damping model).
+double nominal_alpha1(const ReconstructionMesh& mesh, const Vec3& stretches) {
+  return mesh.nominal.damping ? mesh.nominal.damping->coefficients(stretches[0]).alpha1 : 0.0;
+}
+
+} // namespace
+
 VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
     const VecX& x, const VecX& v) {
   const int m = mesh.num_tets();
   std::vector<ElementState> states;
   compute_element_states(mesh, x, v, states);
   std::vector<Vec12> element_forces(m);
+  const material::ElasticModel* elastic = mesh.nominal.elastic.get();
   tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
     for (int e = r.begin(); e < r.end(); ++e) {
       const ElementState& s = states[e];
       element_forces[e].noalias() = element_force_operator(mesh.rest[e], s.frame)
           * correction.correction(s.frame.stretches, s.stretch_rates);
+      if (elastic == nullptr)
+        continue;
+      // ElasticForce's damping with the correction minus without it (same clamp α₁ + Δα₁ ≥ 0).
+      const double alpha1 = nominal_alpha1(mesh, s.frame.stretches);
+      const double change = std::max(0.0, alpha1 + correction.stiffness_damping(s.frame.stretches)) - alpha1;
+      if (change != 0)
+        element_forces[e] += change * element_stiffness_damping_force(mesh.rest[e], s, *elastic);
     }
   });
   VecX f = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));
@@ -257,12 +288,16 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
   const int rows = dofs.num_free();
   if (rows == 0)
     fail("dofs", "no free degree of freedom");
+  const material::ElasticModel* elastic = mesh.nominal.elastic.get();
+  if (design.damping_unknowns() > 0 && elastic == nullptr)
+    fail("nominal", "fitting the damping correction needs the nominal elastic model");
   const auto start = std::chrono::steady_clock::now();
   const std::vector<int> frames
       = detail::selected_frames(int(positions.size()), options.frame_stride);
   const std::vector<std::array<int, 12>> free_rows = element_free_rows(mesh, dofs);
   const int m = mesh.num_tets();
   const int u = design.num_unknowns();
+  const int u_elastic = design.elastic_unknowns();
 
   // Frames in k_frame_blocks contiguous blocks; each block's sums are formed serially in frame
   // order on one thread, and the blocks are added in block order.
@@ -272,7 +307,8 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
     AssemblyScratch s;
     s.states.resize(m);
     s.jt.resize(u, rows);
-    s.outputs.resize(3, u);
+    s.outputs.resize(3, u_elastic);
+    s.damping_row.resize(design.damping_unknowns());
     s.element_rows.resize(12, u);
     return s;
   });
@@ -286,14 +322,19 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
       for (size_t i = first; i < last; ++i) {
         const int t = frames[i];
         element_states_range(mesh, positions[t], velocities[t], 0, m, s.states);
-        // Element e adds G_e A_e (12 × u) to the rows of its free dofs: its nodal forces are
-        // G_e N = G_e A_e x (A_e = design.output_matrix at the element's state).
+        // Element e adds [G_e A_e, (−K_e v_e) d_e] (12 × u) to the rows of its free dofs: its
+        // nodal forces are G_e N + Δα₁ (−K_e v_e) = G_e A_e x_e + (−K_e v_e) d_e x_d.
         s.jt.setZero();
         for (int e = 0; e < m; ++e) {
           const ElementState& st = s.states[e];
           const Eigen::Matrix<double, 12, 3> G = element_force_operator(mesh.rest[e], st.frame);
-          design.output_matrix(st.frame.stretches, st.stretch_rates, s.outputs);
-          s.element_rows.noalias() = G * s.outputs;
+          design.output_matrix(st.frame.stretches, s.outputs);
+          s.element_rows.leftCols(u_elastic).noalias() = G * s.outputs;
+          if (u > u_elastic) {
+            design.damping_row(st.frame.stretches, s.damping_row);
+            s.element_rows.rightCols(u - u_elastic).noalias()
+                = element_stiffness_damping_force(mesh.rest[e], st, *elastic) * s.damping_row;
+          }
           for (int l = 0; l < 12; ++l) {
             const int row = free_rows[e][l];
             if (row >= 0) s.jt.col(row) += s.element_rows.row(l).transpose();

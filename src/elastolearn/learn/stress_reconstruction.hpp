@@ -8,27 +8,33 @@
 /// F_t x of frame t. Formulation, damping representation and timings: docs/learning.md,
 /// "Stress reconstruction". The LSQR option (Fig. 4) is in stress_reconstruction_lsqr.hpp.
 #include <elastolearn/fem/dof_map.hpp>
+#include <elastolearn/fem/elastic_force.hpp>
 #include <elastolearn/fem/tet_element.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/mesh/tet_mesh.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace elastolearn::learn {
 
-/// The per-element rest data the reconstruction needs; precompute once per mesh.
+/// The per-element rest data the reconstruction needs (precompute once per mesh), and the nominal
+/// material whose Rayleigh damping the correction's Δα₁ adds to (Eq. 13). Its `elastic` may be
+/// null when no damping is fitted or evaluated (then corrections contribute their N term only).
 struct ReconstructionMesh {
   /// From a rest mesh (computes fem::precompute_rest_data).
-  explicit ReconstructionMesh(const mesh::TetMesh& mesh);
+  explicit ReconstructionMesh(const mesh::TetMesh& mesh, fem::MaterialModel nominal = {});
   /// From rest data already computed (e.g. fem::ElasticForce::rest_data() and tets()).
   /// Throws InputError if `rest` and `tets` differ in length or an index is outside [0, n).
-  ReconstructionMesh(std::vector<fem::TetRestData> rest, Tets tets, int num_vertices);
+  ReconstructionMesh(std::vector<fem::TetRestData> rest, Tets tets, int num_vertices,
+      fem::MaterialModel nominal = {});
 
   std::vector<fem::TetRestData> rest; ///< m
   Tets tets; ///< m × 4
   int num_vertices = 0; ///< n
+  fem::MaterialModel nominal; ///< elastic model and Rayleigh damping (its correction is ignored)
 
   int num_tets() const { return static_cast<int>(tets.rows()); }
 };
@@ -38,6 +44,7 @@ struct ReconstructionMesh {
 struct ElementState {
   material::PrincipalFrame frame;
   Vec3 stretch_rates = Vec3::Zero();
+  Mat3 deformation_rate = Mat3::Zero(); ///< Ḟ [1/s]
 };
 
 /// Element states of one frame: `x`, `v` flat 3n positions [m] and velocities [m/s]; `states` is
@@ -51,8 +58,15 @@ void compute_element_states(const ReconstructionMesh& mesh, const VecX& x, const
 Eigen::Matrix<double, 12, 3> element_force_operator(
     const fem::TetRestData& rest, const material::PrincipalFrame& frame);
 
-/// Nodal forces [N] (flat 3n) of a correction alone, f = Σ_e B_e N(σ_e, ḟ_e) (Eq. 1's N term):
-/// the same as fem::ElasticForce with the correction minus without it (no Rayleigh damping).
+/// The element's stiffness-damping force per unit α₁ [N·s]: −K_e v_e = −vol (dP/dF : Ḟ) g_a with
+/// dP/dF the PSD-projected tangent of the nominal model `elastic`, exactly as fem::ElasticForce
+/// applies α₁ + Δα₁. Local dofs ordered x0, y0, z0, x1, ….
+Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
+    const material::ElasticModel& elastic);
+
+/// Nodal forces [N] (flat 3n) of a correction: what fem::ElasticForce gives with it minus without
+/// it, f = Σ_e B_e N(σ_e, ḟ_e) + [(α₁ + Δα₁)⁺ − α₁] (−K_e v_e) (Eq. 1's N term and Eq. 13's
+/// damping term; α₁ from mesh.nominal.damping). Without mesh.nominal.elastic only the N term.
 /// Parallel over elements.
 VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
     const VecX& x, const VecX& v);
@@ -127,14 +141,16 @@ struct StressReconstructionResult {
 
 /// Find the unknowns x of `design` minimising (paper Eqs. 12–13)
 ///   Σ_t ‖restrict_free(F_t x) − restrict_free(g_t)‖²  + Tikhonov,
-/// F_t x = Σ_e B_e N_x(σ_e, ḟ_e) the nodal force of the correction with unknowns x at frame t,
-/// and g_t (target_forces[t], flat 3n, only free dofs used) the force the new correction must
-/// produce (current correction force + control force). Eq. 13's damping term Σ_j Δα₁ K_j ẋ is the
-/// Δα₁(σ) D ḟ term of material::RbfCorrection. Tikhonov: design.options().regularization on the
-/// Jacobi-scaled unknowns, as fit_rbf_correction. Method normal_equations: J_t (free dofs × q)
-/// is assembled per frame and JᵀJ accumulated by symmetric rank updates, in parallel over fixed
-/// blocks of frames summed in order (deterministic for any thread count); then dense Cholesky.
-/// Method lsqr: reconstruct_rbf_correction_via_lsqr.
+/// F_t x = Σ_e G_e A_e x_e + (−K_e v_e) d_e x_d the nodal force of the correction with unknowns x
+/// at frame t (= correction_force while α₁ + Δα₁ ≥ 0), and g_t (target_forces[t], flat 3n, only
+/// free dofs used) the force the new correction must produce (current correction force + control
+/// force). K_e is the nominal model's stiffness (element_stiffness_damping_force; needs
+/// `mesh.nominal.elastic` when the design fits damping). Tikhonov:
+/// design.options().regularization on the Jacobi-scaled unknowns, as fit_rbf_correction.
+/// Method normal_equations: J_t (free dofs × q) is assembled per frame and JᵀJ accumulated by
+/// symmetric rank updates, in parallel over fixed blocks of frames summed in order
+/// (deterministic for any thread count); then dense Cholesky. Method lsqr:
+/// reconstruct_rbf_correction_via_lsqr.
 /// Throws InputError if the frame lists differ in length or are empty, a vector is not 3n long
 /// or not finite, the DofMap has not 3n dofs or no free dof, the options are invalid, or the
 /// regularised normal matrix is singular.

@@ -39,7 +39,9 @@ ElementStressResult reconstruct_element_stresses(const ReconstructionMesh& mesh,
 /// → StressSamples (sorted stretches, stretch rates, p̂ as target) → fit_rbf_correction(design).
 /// Frames run in parallel (oneTBB); the samples are stored in frame order, so the result does
 /// not depend on the thread count. `misfit` is the nodal-force misfit of the fitted correction,
-/// as for the direct method. Same inputs and throws as reconstruct_rbf_correction.
+/// as for the direct method. Element stresses carry no stiffness-damping information, so this
+/// method fits the elastic part only (Δα₁ = 0). Same inputs and throws as
+/// reconstruct_rbf_correction.
 StressReconstructionResult reconstruct_rbf_correction_via_lsqr(const ReconstructionMesh& mesh,
     const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
     const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,

@@ -20,6 +20,11 @@ public:
   /// ∂N/∂F̂ (3×3, row = output) and ∂N/∂Ḟ̂ (3×3).
   virtual void correction_gradient(const Vec3& stretches, const Vec3& stretch_rates,
                                    Mat3& d_stretches, Mat3& d_stretch_rates) const = 0;
+  /// Δα₁(F̂) [s]: a correction of the element's Rayleigh stiffness-damping coefficient (paper
+  /// Eq. 13). The element's damping force becomes −(α₁ + Δα₁) K_e v_e with K_e the *nominal*
+  /// model's stiffness (fem::ElasticForce), so that the learned damping is linear in Δα₁ and
+  /// damps every deformation mode, not only the stretch rates. Default: none.
+  virtual double stiffness_damping(const Vec3& /*stretches*/) const { return 0; }
   virtual std::unique_ptr<Correction> clone() const = 0;
 };
 

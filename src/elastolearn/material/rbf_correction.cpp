@@ -1,6 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/material/rbf_correction.hpp>
 
+#include <algorithm>
 #include <array>
 #include <sstream>
 
@@ -35,6 +36,11 @@ Vec3 stretch_view(const Vec3& s, int k) {
   return {s[k], s[o[0]], s[o[1]]};
 }
 
+Eigen::Vector4d quadratic_tail_basis(const Vec3& y) {
+  const double e = y[0] - 1, s = y[1] + y[2] - 2;
+  return {e * e, e * s, s * s, (y[1] - 1) * (y[2] - 1)};
+}
+
 RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
   const Eigen::Index m = m_p.centres.rows();
   if (m_p.weights.size() != m)
@@ -51,10 +57,10 @@ RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
   finite("own_slope", std::isfinite(m_p.own_slope));
   finite("other_slope", std::isfinite(m_p.other_slope));
   finite("constant", std::isfinite(m_p.constant));
+  finite("quadratic", m_p.quadratic.allFinite());
   finite("damping_weights", m_p.damping_weights.allFinite());
   finite("damping_slope", std::isfinite(m_p.damping_slope));
   finite("damping_constant", std::isfinite(m_p.damping_constant));
-  finite("damping_tangent", m_p.damping_tangent.allFinite());
   if (std::isnan(m_p.damping_floor) || m_p.damping_floor == std::numeric_limits<double>::infinity())
     fail("damping_floor", "must be a number or −infinity");
   if (!std::isfinite(m_p.epsilon) || m_p.epsilon < 0) {
@@ -65,8 +71,13 @@ RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
 }
 
 double RbfCorrection::elastic_view(const Vec3& y, Vec3* d_y) const {
-  double h = m_p.own_slope * (y[0] - 1) + m_p.other_slope * (y[1] + y[2] - 2) + m_p.constant;
-  if (d_y) *d_y = Vec3(m_p.own_slope, m_p.other_slope, m_p.other_slope);
+  const double e = y[0] - 1, s = y[1] + y[2] - 2;
+  const Eigen::Vector4d& q = m_p.quadratic;
+  double h = m_p.own_slope * e + m_p.other_slope * s + m_p.constant + q.dot(quadratic_tail_basis(y));
+  if (d_y) {
+    const double d_other = m_p.other_slope + q[1] * e + 2 * q[2] * s;
+    *d_y = Vec3(m_p.own_slope + 2 * q[0] * e + q[1] * s, d_other + q[3] * (y[2] - 1), d_other + q[3] * (y[1] - 1));
+  }
   const double eps2 = m_p.epsilon * m_p.epsilon;
   for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i) {
     const Vec3 d = y - m_p.centres.row(i).transpose();
@@ -77,39 +88,23 @@ double RbfCorrection::elastic_view(const Vec3& y, Vec3* d_y) const {
   return h;
 }
 
-double RbfCorrection::damping(const Vec3& stretches, Vec3* d_s) const {
+double RbfCorrection::damping(const Vec3& stretches) const {
   double alpha = m_p.damping_slope * (stretches.sum() - 3) + m_p.damping_constant;
-  if (d_s) d_s->setConstant(m_p.damping_slope);
-  if (m_p.damping_weights.size() == 0) {
-    if (alpha >= m_p.damping_floor) return alpha;
-    if (d_s) d_s->setZero();
-    return m_p.damping_floor;
+  if (m_p.damping_weights.size() > 0) {
+    const auto p = descending_order(stretches);
+    const Vec3 s(stretches[p[0]], stretches[p[1]], stretches[p[2]]);
+    const double eps2 = m_p.epsilon * m_p.epsilon;
+    for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i)
+      alpha += m_p.damping_weights[i] * std::sqrt((s - m_p.centres.row(i).transpose()).squaredNorm() + eps2);
   }
-  const auto p = descending_order(stretches);
-  const Vec3 s(stretches[p[0]], stretches[p[1]], stretches[p[2]]);
-  const double eps2 = m_p.epsilon * m_p.epsilon;
-  for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i) {
-    const Vec3 d = s - m_p.centres.row(i).transpose();
-    const double phi = std::sqrt(d.squaredNorm() + eps2);
-    alpha += m_p.damping_weights[i] * phi;
-    if (d_s && phi > 0)
-      for (int j = 0; j < 3; ++j) (*d_s)[p[j]] += m_p.damping_weights[i] * d[j] / phi;
-  }
-  if (alpha < m_p.damping_floor) {
-    if (d_s) d_s->setZero();
-    return m_p.damping_floor;
-  }
-  return alpha;
+  return std::max(alpha, m_p.damping_floor);
 }
 
-Vec3 RbfCorrection::correction(const Vec3& stretches, const Vec3& stretch_rates) const {
-  Vec3 n = elastic_correction(stretches);
-  if (m_p.damping_weights.size() > 0 || m_p.damping_slope != 0 || m_p.damping_constant != 0)
-    n += damping(stretches, nullptr) * (m_p.damping_tangent * stretch_rates);
-  return n;
+Vec3 RbfCorrection::correction(const Vec3& stretches, const Vec3& /*stretch_rates*/) const {
+  return elastic_correction(stretches);
 }
 
-void RbfCorrection::correction_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
+void RbfCorrection::correction_gradient(const Vec3& stretches, const Vec3& /*stretch_rates*/, Mat3& d_stretches,
                                         Mat3& d_stretch_rates) const {
   d_stretches.setZero();
   for (int k = 0; k < 3; ++k) {
@@ -120,11 +115,7 @@ void RbfCorrection::correction_gradient(const Vec3& stretches, const Vec3& stret
     d_stretches(k, o[0]) += d_y[1];
     d_stretches(k, o[1]) += d_y[2];
   }
-  Vec3 d_alpha;
-  const double alpha = damping(stretches, &d_alpha);
-  const Vec3 rate_stress = m_p.damping_tangent * stretch_rates;
-  d_stretches.noalias() += rate_stress * d_alpha.transpose();
-  d_stretch_rates = alpha * m_p.damping_tangent;
+  d_stretch_rates.setZero();
 }
 
 std::unique_ptr<Correction> RbfCorrection::clone() const { return std::make_unique<RbfCorrection>(*this); }
@@ -135,8 +126,38 @@ Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
   return n;
 }
 
-double RbfCorrection::damping_correction(const Vec3& stretches) const { return damping(stretches, nullptr); }
+bool RbfCorrection::has_damping() const {
+  return m_p.damping_weights.size() > 0 || m_p.damping_slope != 0 || m_p.damping_constant != 0 ||
+         m_p.damping_floor > 0;
+}
 
-Mat3 rest_principal_tangent(const ElasticModel& model) { return model.principal_stress_derivative(Vec3::Ones()); }
+RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
+  RbfCorrection::Parameters p = a.parameters();
+  const RbfCorrection::Parameters zero{RbfCorrection::Centres(0, 3), VecX(0)};
+  const RbfCorrection::Parameters& q = b ? b->parameters() : zero;
+  if (b && q.epsilon != p.epsilon) fail("epsilon", "cannot blend corrections with different kernel smoothing");
+  const Eigen::Index m = p.centres.rows(), n = q.centres.rows();
+  const auto damping_weights = [](const RbfCorrection::Parameters& x) {
+    return x.damping_weights.size() > 0 ? x.damping_weights : VecX(VecX::Zero(x.centres.rows()));
+  };
+  const bool damped = p.damping_weights.size() > 0 || q.damping_weights.size() > 0;
+  if (damped) {
+    VecX v(m + n);
+    v << (1 - t) * damping_weights(p), t * damping_weights(q);
+    p.damping_weights = v;
+  }
+  p.centres.conservativeResize(m + n, 3);
+  p.centres.bottomRows(n) = q.centres;
+  VecX w(m + n);
+  w << (1 - t) * p.weights, t * q.weights;
+  p.weights = w;
+  p.own_slope = (1 - t) * p.own_slope + t * q.own_slope;
+  p.other_slope = (1 - t) * p.other_slope + t * q.other_slope;
+  p.constant = (1 - t) * p.constant + t * q.constant;
+  p.quadratic = (1 - t) * p.quadratic + t * q.quadratic;
+  p.damping_slope = (1 - t) * p.damping_slope + t * q.damping_slope;
+  p.damping_constant = (1 - t) * p.damping_constant + t * q.damping_constant;
+  return RbfCorrection(std::move(p));
+}
 
 } // namespace elastolearn::material

@@ -3,7 +3,6 @@
 /// an isotropic elastic RBF in the principal stretches plus a stretch-dependent correction Δα₁
 /// of the Rayleigh stiffness-damping coefficient. Rationale and conventions: docs/learning.md.
 #include <elastolearn/material/correction.hpp>
-#include <elastolearn/material/elastic_model.hpp>
 
 #include <cmath>
 #include <limits>
@@ -21,23 +20,34 @@ inline double rbf_kernel(double squared_distance, double epsilon) {
 /// min(σ_a, σ_b)) with a, b the other two directions. y_k is unchanged by swapping a and b.
 Vec3 stretch_view(const Vec3& stretches, int k);
 
-/// N(σ, ḟ) with, for centres c_i (i = 1..m) in the space of stretch views and φ_i(y) = φ(‖y − c_i‖):
-///   N_k(σ, ḟ) = h(y_k) + Δα₁(σ) (D ḟ)_k                                               [Pa]
-///   h(y)      = Σ_i w_i φ_i(y) + a (y₁ − 1) + b (y₂ + y₃ − 2) + c                      (Eq. 10)
-///   Δα₁(σ)    = max(f, Σ_i v_i φ_i(sort↓ σ) + a_d (σ₁ + σ₂ + σ₃ − 3) + a₀)          [s] (Eq. 13)
+/// The quadratic tail's basis at a stretch view y: t(y) = (e², e s, s², p) with e = y₁ − 1,
+/// s = y₂ + y₃ − 2 and p = (y₂ − 1)(y₃ − 1), which span the quadratics in y − 1 symmetric in
+/// y₂, y₃. Zero with zero gradient at rest.
+Eigen::Vector4d quadratic_tail_basis(const Vec3& y);
+
+/// The learned correction, for centres c_i (i = 1..m) in the space of stretch views and
+/// φ_i(y) = φ(‖y − c_i‖):
+///   N_k(σ)  = h(y_k)                                                                   [Pa]
+///   h(y)    = Σ_i w_i φ_i(y) + a (y₁ − 1) + b (y₂ + y₃ − 2) + c + qᵀ t(y)              (Eq. 10)
+///   Δα₁(σ)  = max(f, Σ_i v_i φ_i(sort↓ σ) + a_d (σ₁ + σ₂ + σ₃ − 3) + a₀)        [s]  (Eq. 13)
 /// One scalar function h serves all three principal directions, each seeing the stretches from
-/// its own side. This makes N isotropic by construction: N(Pσ, Pḟ) = P N(σ, ḟ) for every
-/// permutation P and, crucially, N_i = N_j whenever σ_i = σ_j, so that P = U diag(P̂ + N) Vᵀ is a
-/// continuous function of F even where the SVD's U, V are not unique (a general R³ → R³ map of
-/// sorted stretches is not, and its stress jumps at repeated stretches, e.g. at rest). The
-/// linear tail a, b, c spans exactly the isotropic linear corrections 2Δμ(σ−1) + Δλ tr(σ−1)
-/// (a = 2Δμ + Δλ, b = Δλ) plus a pressure c.
-/// D is the 3×3 principal damping tangent [Pa]: the Rayleigh stiffness-damping stress α₁ K ẋ of
-/// an element, restricted to the principal stretch rates, is α₁ (∂P̂/∂σ) ḟ; D is the nominal
-/// model's ∂P̂/∂σ at rest (rest_principal_tangent). A positive Δα₁ adds damping; the floor f
-/// (damping_floor) keeps α₁ + Δα₁ ≥ 0.
-/// `correction` and `correction_gradient` are exact (subgradients at ties of max/min and, for
-/// ε = 0, at a centre), allocation-free and thread-safe.
+/// its own side. This makes N isotropic by construction: N(Pσ) = P N(σ) for every permutation P
+/// and, crucially, N_i = N_j whenever σ_i = σ_j, so that P = U diag(P̂ + N) Vᵀ is a continuous
+/// function of F even where the SVD's U, V are not unique (a general R³ → R³ map of sorted
+/// stretches is not, and its stress jumps at repeated stretches, e.g. at rest). The linear tail
+/// a, b, c spans exactly the isotropic linear corrections 2Δμ(σ−1) + Δλ tr(σ−1)
+/// (a = 2Δμ + Δλ, b = Δλ) plus a pressure c. The optional quadratic tail qᵀ t(y)
+/// (quadratic_tail_basis) spans every isotropic quadratic correction: the leading difference
+/// between two hyperelastic models (e.g. StVK or neo-Hookean against corotated) at moderate
+/// strain, which it extrapolates beyond the stretches seen in training, where the kernels'
+/// linear growth cannot.
+/// Δα₁ is the stiffness-damping correction (Correction::stiffness_damping): the element's
+/// Rayleigh damping force becomes −(α₁ + Δα₁) K_e v_e, K_e the nominal model's stiffness, as
+/// in paper Eq. (13). A positive Δα₁ adds damping; the floor f (damping_floor) bounds how much
+/// it may remove (fem::ElasticForce also keeps α₁ + Δα₁ ≥ 0).
+/// N does not depend on the stretch rates. `correction`, `correction_gradient` and
+/// `stiffness_damping` are exact (subgradients at ties of max/min and, for ε = 0, at a centre),
+/// allocation-free and thread-safe.
 class RbfCorrection final : public Correction {
 public:
   using Centres = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
@@ -47,10 +57,10 @@ public:
     double own_slope = 0;         ///< a [Pa]
     double other_slope = 0;       ///< b [Pa]
     double constant = 0;          ///< c [Pa]
+    Eigen::Vector4d quadratic = Eigen::Vector4d::Zero(); ///< q [Pa] (see quadratic_tail_basis)
     VecX damping_weights;         ///< m damping weights v_i [s], or empty for no damping RBF
     double damping_slope = 0;     ///< a_d [s]
     double damping_constant = 0;  ///< a₀ [s]
-    Mat3 damping_tangent = Mat3::Zero(); ///< D [Pa]
     /// Δα₁ is clamped below at this value [s] when evaluated: set it to −α₁ of the nominal
     /// model so that the total stiffness damping never turns negative (energy would grow).
     double damping_floor = -std::numeric_limits<double>::infinity();
@@ -67,22 +77,27 @@ public:
                            Mat3& d_stretch_rates) const override;
   std::unique_ptr<Correction> clone() const override;
 
-  /// The elastic part (h(y_1), h(y_2), h(y_3)) [Pa] alone (the correction at zero stretch rate).
+  double stiffness_damping(const Vec3& stretches) const override { return damping(stretches); }
+
+  /// (h(y_1), h(y_2), h(y_3)) [Pa], the same as correction(stretches, ·).
   Vec3 elastic_correction(const Vec3& stretches) const;
-  /// Δα₁(σ) [s], the correction of the Rayleigh stiffness coefficient.
-  double damping_correction(const Vec3& stretches) const;
+  /// True if Δα₁ is not identically zero.
+  bool has_damping() const;
   int num_centres() const { return static_cast<int>(m_p.centres.rows()); }
   const Parameters& parameters() const { return m_p; }
 
 private:
   /// h(y) and, if d_y is non-null, ∂h/∂y.
   double elastic_view(const Vec3& y, Vec3* d_y) const;
-  /// Δα₁(σ) and, if d_s is non-null, ∂Δα₁/∂σ.
-  double damping(const Vec3& stretches, Vec3* d_s) const;
+  /// Δα₁(σ) (its gradient is not needed: the Jacobian treats α₁ as constant, as for Rayleigh).
+  double damping(const Vec3& stretches) const;
   Parameters m_p;
 };
 
-/// D for RbfCorrection::Parameters::damping_tangent: ∂P̂/∂σ of `model` at rest (σ = 1).
-Mat3 rest_principal_tangent(const ElasticModel& model);
+/// (1 − t) a + t b: one correction whose N and Δα₁ (above its floor) are that blend of a's and
+/// b's, with both sets of centres; b = null is the zero correction. For a damped update of a
+/// correction that overshoots. Throws InputError("rbf_correction.epsilon", ...) if a and b use
+/// different kernel smoothing; the floor is a's.
+RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t);
 
 } // namespace elastolearn::material
