@@ -172,13 +172,19 @@ void BM_SvdStressTangent(benchmark::State& state) {
 }
 BENCHMARK(BM_SvdStressTangent);
 
+/// Rest data of the unit right-angled tet (vertices 0, e_x, e_y, e_z).
+fem::TetRestData unit_tet_rest() {
+  fem::TetRestData rest;
+  rest.volume = 1.0 / 6.0;
+  rest.gradients << -1, 1, 0, 0, -1, 0, 1, 0, -1, 0, 0, 1;
+  return rest;
+}
+
 /// Projected element stiffness through the 9×9 dP/dF (first_piola_derivative, then
 /// element_matrix_from_tangent on its upper triangle).
 void BM_ElementMatrixFromTangent(benchmark::State& state) {
   const auto& in = prepared();
-  fem::TetRestData rest;
-  rest.volume = 1.0 / 6.0;
-  rest.gradients << -1, 1, 0, 0, -1, 0, 1, 0, -1, 0, 0, 1;
+  const fem::TetRestData rest = unit_tet_rest();
   int k = 0;
   for (auto _ : state) {
     const Mat9 H = material::first_piola_derivative(in[k].frame, in[k].stress.stress,
@@ -195,9 +201,7 @@ BENCHMARK(BM_ElementMatrixFromTangent);
 /// fem/elastic_force.cpp computes it.
 void BM_ElementStiffness(benchmark::State& state) {
   const auto& in = prepared();
-  fem::TetRestData rest;
-  rest.volume = 1.0 / 6.0;
-  rest.gradients << -1, 1, 0, 0, -1, 0, 1, 0, -1, 0, 0, 1;
+  const fem::TetRestData rest = unit_tet_rest();
   int k = 0;
   for (auto _ : state) {
     const auto tangent =
@@ -214,9 +218,7 @@ BENCHMARK(BM_ElementStiffness);
 void BM_Element(benchmark::State& state) {
   const auto& F = states();
   const auto& model = corotated();
-  fem::TetRestData rest;
-  rest.volume = 1.0 / 6.0;
-  rest.gradients << -1, 1, 0, 0, -1, 0, 1, 0, -1, 0, 0, 1;
+  const fem::TetRestData rest = unit_tet_rest();
   // Vertex positions realising each F on the unit corner tet: x_a = F X_a.
   std::vector<Eigen::Matrix<double, 3, 4>> x(kStates);
   Eigen::Matrix<double, 3, 4> X;

@@ -76,9 +76,7 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
         // or 12×12 (the eigen-form tangent is kept for the Jacobian). K_e is the nominal model's
         // stiffness: a correction changes the elastic stress; the damping is Rayleigh's on the
         // nominal stiffness, scaled by α₁ + Δα₁ (this keeps the learned damping linear in Δα₁).
-        c.tangent = correction ? material::principal_tangent(c.frame, elastic->principal_stress(c.frame.stretches),
-                                                             elastic->principal_stress_derivative(c.frame.stretches),
-                                                             m_project_tangent)
+        c.tangent = correction ? material::principal_tangent(*elastic, c.frame, m_project_tangent)
                                : material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches,
                                                              m_project_tangent);
         c.has_tangent = true;

@@ -114,9 +114,7 @@ Eigen::Matrix<double, 12, 3> element_force_operator(
 
 Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
     const material::ElasticModel& elastic) {
-  const Vec3& s = state.frame.stretches;
-  const material::PrincipalTangent tangent = material::principal_tangent(
-      state.frame, elastic.principal_stress(s), elastic.principal_stress_derivative(s), true);
+  const material::PrincipalTangent tangent = material::principal_tangent(elastic, state.frame, true);
   const Mat3 stress_rate = material::first_piola_differential(state.frame, tangent, state.deformation_rate);
   Vec12 f;
   Eigen::Map<Eigen::Matrix<double, 3, 4>>(f.data()).noalias() = -rest.volume * stress_rate * rest.gradients;

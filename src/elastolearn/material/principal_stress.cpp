@@ -180,6 +180,11 @@ Mat3 first_piola(const ElasticModel& model, const Mat3& F) {
     return first_piola(frame, model.principal_stress(frame.stretches));
 }
 
+PrincipalTangent principal_tangent(const ElasticModel& model, const PrincipalFrame& frame, bool project_psd) {
+    return principal_tangent(frame, model.principal_stress(frame.stretches),
+        model.principal_stress_derivative(frame.stretches), project_psd);
+}
+
 Mat9 first_piola_derivative(const ElasticModel& model, const Mat3& F, bool project_psd) {
     const PrincipalFrame frame = principal_frame(F);
     return first_piola_derivative(frame, model.principal_stress(frame.stretches),

@@ -36,6 +36,9 @@ struct PrincipalTangent {
 };
 PrincipalTangent principal_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,
                                    const Mat3& principal_stress_derivative, bool project_psd);
+/// The same for an uncorrected model at the frame's stretches (e.g. the nominal stiffness that
+/// Rayleigh damping scales).
+PrincipalTangent principal_tangent(const ElasticModel& model, const PrincipalFrame& frame, bool project_psd);
 /// The 9×9 dP/dF of an eigen-form tangent (symmetric if the tangent was projected).
 Mat9 first_piola_derivative(const PrincipalFrame& frame, const PrincipalTangent& tangent);
 /// dP = (dP/dF) : dF without forming the 9×9: dP = U dP̂ Vᵀ with, for dF̂ = Uᵀ dF V,
