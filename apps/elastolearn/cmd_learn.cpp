@@ -71,7 +71,7 @@ std::shared_ptr<const elastolearn::material::Correction> distil_network(const Le
                   {"teacher_rms_pa", r.target_rms},
                   {"seconds_sampling", seconds_sampling},
                   {"seconds_training", r.training.seconds}}}};
-  return std::make_shared<const material::NnCorrection>(r.correction);
+  return std::make_shared<const material::NnCorrection>(learn::with_teacher_damping(r.correction, teacher));
 }
 
 void write_report(const std::filesystem::path& dir, const elastolearn::learn::LearningState& state,

@@ -164,7 +164,11 @@ TEST(MaterialFile, NnRoundTripIsBitExact) {
   ScratchDir dir;
   MaterialFile f;
   f.material = k_nominal;
-  const auto original = std::make_shared<material::NnCorrection>(nn_parameters(9));
+  material::NnCorrection::Parameters parameters = nn_parameters(9);
+  parameters.damping = std::make_shared<const material::RbfCorrection>(
+      material::damping_part(material::RbfCorrection(rbf_parameters(4, 2))));
+  const auto original = std::make_shared<material::NnCorrection>(parameters);
+  ASSERT_NE(original->stiffness_damping(Vec3(1.1, 1, 0.9)), 0); // the damping travels too
   f.correction = original;
   write_material_file(dir / "nn.json", f);
   const MaterialFile g = read_material_file(dir / "nn.json");
@@ -182,7 +186,7 @@ TEST(MaterialFile, NnRoundTripIsBitExact) {
     EXPECT_EQ(p.layers[k].bias, q.layers[k].bias) << "layer " << k;
   }
   expect_same_function(*original, *back);
-  EXPECT_EQ(describe_correction(*back), "nn, 6-6-6-1");
+  EXPECT_EQ(describe_correction(*back), "nn, 6-6-6-1, with damping correction");
 }
 
 TEST(MaterialFile, NominalOnlyFileGivesTheSceneMaterialModel) {
@@ -290,6 +294,21 @@ TEST(MaterialFile, BadFilesNameTheFileAndField) {
       j["correction"]["layers"][2]["weight"][0], j["correction"]["layers"][2]["weight"][0] });
   j["correction"]["layers"][2]["bias"] = Json::array({ 0.0, 0.0, 0.0 });
   expect_bad(j, { "bad.json: correction.layers[2].weight", "expected 1" });
+  // The network's damping correction is an RBF without elastic part.
+  material::NnCorrection::Parameters damped = nn_parameters(1);
+  damped.damping = std::make_shared<const material::RbfCorrection>(
+      material::damping_part(material::RbfCorrection(rbf_parameters(4, 2))));
+  nn.correction = std::make_shared<material::NnCorrection>(damped);
+  j = material_file_to_json(nn);
+  EXPECT_NO_THROW(parse_material_file(j, "ok.json"));
+  j["correction"]["damping"]["weights"][1] = 100.0;
+  expect_bad(j, { "bad.json: correction.damping", "elastic part" });
+  j = material_file_to_json(nn);
+  j["correction"]["damping"]["damping_weights"].erase(0);
+  expect_bad(j, { "bad.json: correction.damping.damping_weights" });
+  j = material_file_to_json(nn);
+  j["correction"]["damping"]["type"] = "nn";
+  expect_bad(j, { "bad.json: correction.damping.type", "\"rbf\"" });
 }
 
 TEST(MaterialFile, BrokenJsonNamesTheLine) {

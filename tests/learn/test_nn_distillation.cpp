@@ -25,9 +25,8 @@ namespace {
 
 /// A teacher like the learning loop's: the isotropic linear tail of nominal Lamé parameters off
 /// by Δμ = 3 kPa, Δλ = 4 kPa (a = 2Δμ + Δλ, b = Δλ), 4 centres around rest with elastic weights
-/// ~1e3 Pa, and a damping RBF Δα₁ ~ 1e-3 s (its stress through the corotated tangent, E = 50 kPa,
-/// ν = 0.4, see nominal_model). Over the sampled box the linear, kernel and damping stresses are all ~1e3 Pa at
-/// stretch rates ~1/s.
+/// ~1e3 Pa (over the sampled box the linear and kernel stresses are both ~1e3 Pa), and a damping
+/// RBF Δα₁ ~ 1e-3 s, which distillation carries over instead of fitting.
 material::RbfCorrection smooth_teacher() {
   material::RbfCorrection::Parameters p;
   p.centres.resize(4, 3);
@@ -39,12 +38,6 @@ material::RbfCorrection smooth_teacher() {
   p.damping_constant = 1e-3;
   p.epsilon = 0.05;
   return material::RbfCorrection(std::move(p));
-}
-
-/// The nominal model of the teacher's damping stress (E = 50 kPa, ν = 0.4).
-const material::CorotatedModel& nominal_model() {
-  static const material::CorotatedModel model(material::Lame::from_young_poisson(5e4, 0.4));
-  return model;
 }
 
 /// n samples with stretches uniform in [0.85, 1.15]³ and rates N(0, 1/s²), targets from `teacher`.
@@ -60,10 +53,8 @@ StressSamples random_samples(const material::Correction& teacher, int n, unsigne
     const Vec3 sigma(u(rng), u(rng), u(rng)), rate(g(rng), g(rng), g(rng));
     s.stretches.row(j) = sigma.transpose();
     s.stretch_rates.row(j) = rate.transpose();
-    // As distillation_samples: the damping correction enters as Δα₁ (∂P̂/∂σ) ḟ of the nominal.
-    s.targets.row(j) = (teacher.correction(sigma, rate)
-        + teacher.stiffness_damping(sigma) * (nominal_model().principal_stress_derivative(sigma) * rate))
-                           .transpose();
+    // As distillation_samples: the elastic correction only (Δα₁ is carried over, not distilled).
+    s.targets.row(j) = teacher.correction(sigma, rate).transpose();
   }
   return s;
 }
@@ -317,4 +308,36 @@ TEST(DistillationSamples, DistilledNetworkFollowsTheTeacherOnSimulatedStates) {
   std::cout << "simulated: epochs " << r.training.epochs << " (best " << r.training.best_epoch << "), relative RMS train " << r.relative_training_rms() << " validation "
             << r.relative_validation_rms() << ", " << r.training.seconds << " s\n";
   EXPECT_LT(r.relative_validation_rms(), 0.05);
+}
+
+TEST(NnDistillation, TeacherDampingIsCarriedOverExactly) {
+  // The network fits N only; Δα₁ of an RBF teacher travels unchanged (damping_part), so the
+  // network correction's stiffness damping equals the teacher's bit for bit, and its N is the
+  // network's alone.
+  const auto teacher = smooth_teacher();
+  const NnDistillationResult r = distill_nn_correction(random_samples(teacher, 600, 3), {});
+  EXPECT_EQ(r.correction.stiffness_damping(Vec3(1.1, 1, 0.9)), 0);
+  const material::NnCorrection damped = with_teacher_damping(r.correction, teacher);
+  ASSERT_NE(damped.parameters().damping, nullptr);
+  EXPECT_FALSE(damped.parameters().damping->has_elastic_part());
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0.8, 1.2), g(-2, 2);
+  for (int i = 0; i < 20; ++i) {
+    const Vec3 sigma(u(rng), u(rng), u(rng)), rate(g(rng), g(rng), g(rng));
+    EXPECT_EQ(damped.stiffness_damping(sigma), teacher.stiffness_damping(sigma));
+    EXPECT_EQ(damped.correction(sigma, rate), r.correction.correction(sigma, rate));
+  }
+  EXPECT_NE(teacher.stiffness_damping(Vec3(1.1, 1, 0.9)), 0);
+  // A network teacher passes its damping on; a teacher without damping gives none.
+  EXPECT_EQ(with_teacher_damping(r.correction, damped).parameters().damping, damped.parameters().damping);
+  EXPECT_EQ(with_teacher_damping(damped, material::AnalyticCorrection({ 1e3, 0, 0 })).parameters().damping, nullptr);
+  // The network's damping must not carry an elastic part.
+  material::NnCorrection::Parameters bad = r.correction.parameters();
+  bad.damping = std::make_shared<const material::RbfCorrection>(teacher);
+  try {
+    const material::NnCorrection c(bad);
+    ADD_FAILURE() << "a damping RBF with an elastic part was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nn_correction.damping"), std::string::npos) << e.what();
+  }
 }

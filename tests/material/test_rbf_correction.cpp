@@ -121,9 +121,13 @@ TEST(RbfCorrection, EqualStretchesGiveEqualStresses) {
   for (const Vec3& s : { Vec3(1.1, 1.1, 0.9), Vec3(0.8, 1.2, 1.2), Vec3(1.05, 0.7, 1.05), Vec3::Ones().eval() }) {
     const Vec3 rates = Vec3(0.2, 0.2, 0.2);
     const Vec3 out = n.correction(s, rates);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        if (s[i] == s[j]) EXPECT_EQ(out[i], out[j]) << "stretches " << s.transpose();
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        if (s[i] == s[j]) {
+          EXPECT_EQ(out[i], out[j]) << "stretches " << s.transpose();
+        }
+      }
+    }
   }
   // And the outputs approach each other continuously as two stretches meet.
   const Vec3 near(1.1 + 1e-7, 1.1, 0.9);

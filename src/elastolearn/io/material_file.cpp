@@ -55,10 +55,13 @@ Json nn_to_json(const material::NnCorrection& c) {
   for (const auto& layer : p.layers)
     layers.push_back(
         Json { { "weight", rows_to_json(layer.weight) }, { "bias", vector_to_json(layer.bias) } });
-  return Json { { "type", "nn" }, { "input_mean", vector_to_json(p.input_mean) },
+  Json out { { "type", "nn" }, { "input_mean", vector_to_json(p.input_mean) },
     { "input_scale", vector_to_json(p.input_scale) },
     { "output_mean", p.output_mean }, { "output_scale", p.output_scale },
     { "layers", std::move(layers) } };
+  if (p.damping)
+    out["damping"] = rbf_to_json(*p.damping);
+  return out;
 }
 
 // ---- reading ---------------------------------------------------------------------------------
@@ -152,7 +155,7 @@ std::shared_ptr<const material::Correction> rbf_from_json(const JsonObject& o) {
 
 std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
   o.reject_unknown_keys(
-      { "type", "input_mean", "input_scale", "output_mean", "output_scale", "layers" });
+      { "type", "input_mean", "input_scale", "output_mean", "output_scale", "layers", "damping" });
   material::NnCorrection::Parameters p;
   p.input_mean = read_vector(o, "input_mean", 6);
   p.input_scale = read_vector(o, "input_scale", 6);
@@ -170,6 +173,12 @@ std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
     layer.bias = read_vector(l, "bias", layer.weight.rows());
     inputs = layer.weight.rows();
     p.layers.push_back(std::move(layer));
+  }
+  if (o.has("damping")) {
+    // The stiffness-damping correction Δα₁, an RBF with no elastic part (NnCorrection::damping).
+    const JsonObject d = o.object("damping");
+    if (d.choice("type", { "rbf" }) == "rbf")
+      p.damping = std::dynamic_pointer_cast<const material::RbfCorrection>(rbf_from_json(d));
   }
   return construct(o, [&] { return std::make_shared<const material::NnCorrection>(std::move(p)); });
 }
@@ -204,6 +213,8 @@ std::string describe_correction(const material::Correction& correction) {
       s += '-';
       s += std::to_string(layer.weight.rows());
     }
+    if (nn->parameters().damping)
+      s += ", with damping correction";
     return s;
   }
   return correction.name();

@@ -113,7 +113,6 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   std::mt19937_64 rng(o.seed);
   long seen = 0;
   const std::shared_ptr<const material::Correction> shared_teacher = teacher.clone();
-  const material::ElasticModel& nominal = *scenes.front().material.elastic;
 
   for (const sim::Scene& original : scenes) {
     sim::Scene scene = original;
@@ -178,18 +177,28 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
     sorted_sample(out, j, s, f, unused);
     out.stretches.row(j) = s.transpose();
     out.stretch_rates.row(j) = f.transpose();
-    Vec3 target = teacher.correction(s, f);
-    // The teacher's damping correction as a principal stress (paper §6.2): Δα₁ (∂P̂/∂σ) ḟ of the
-    // nominal model, the part of the force −Δα₁ K_e v_e that a function of (σ, ḟ) can carry.
-    if (const double delta_alpha1 = teacher.stiffness_damping(s); delta_alpha1 != 0)
-      target += delta_alpha1 * (nominal.principal_stress_derivative(s) * f);
-    out.targets.row(j) = target.transpose();
+    out.targets.row(j) = teacher.correction(s, f).transpose();
   }
   if (!out.targets.allFinite())
     fail("teacher", "the teacher correction returned a non-finite value");
   if (report_out)
     *report_out = std::move(report);
   return out;
+}
+
+material::NnCorrection with_teacher_damping(const material::NnCorrection& network,
+    const material::Correction& teacher) {
+  material::NnCorrection::Parameters p = network.parameters();
+  p.damping.reset();
+  if (const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&teacher)) {
+    if (rbf->has_damping())
+      p.damping = std::make_shared<const material::RbfCorrection>(material::damping_part(*rbf));
+  } else if (const auto* nn = dynamic_cast<const material::NnCorrection*>(&teacher)) {
+    p.damping = nn->parameters().damping;
+  } else if (teacher.stiffness_damping(Vec3::Ones()) != 0) {
+    fail("teacher", "a \"" + teacher.name() + "\" correction's damping cannot be carried over (only an RBF's)");
+  }
+  return material::NnCorrection(std::move(p));
 }
 
 StressSamples distillation_samples(const sim::Scene& scene, std::span<const double> motion_scales,

@@ -49,15 +49,23 @@ struct DistillationSampleReport {
 /// has), record each element's principal stretches and stretch rates (sorted descending, rates
 /// permuted alike) at every frame_stride-th frame, keep a uniform random subsample of
 /// `recorded_samples` states over all scenes, add `jitter_copies` Gaussian-jittered copies of each,
-/// and evaluate the teacher on all of them: targets = N_teacher(σ, ḟ) + Δα₁(σ) (∂P̂/∂σ) ḟ [Pa],
-/// the elastic correction plus the damping correction's principal stress with the first scene's
-/// nominal model (paper §6.2: the network carries both; it sees only the stretch-rate part of
-/// the damping, not the shear modes that −Δα₁ K_e v_e also damps).
+/// and evaluate the teacher on all of them: targets = N_teacher(σ, ḟ) [Pa], the elastic
+/// correction only. The teacher's damping correction Δα₁ is not distilled (paper §6.2 lets the
+/// network carry it through ḟ): as a function of (σ, ḟ) it misses the shear modes that
+/// −Δα₁ K_e v_e damps, and its large rate-driven targets cost the elastic part enough accuracy
+/// that the network's simulations diverged (docs/learning.md). with_teacher_damping carries it
+/// over exactly instead.
 /// A simulation that diverges contributes the frames before it (reported). Deterministic.
 /// Throws InputError for bad options, no scenes, or no recorded state at all.
 StressSamples distillation_samples(std::span<const sim::Scene> scenes,
     const material::Correction& teacher, const DistillationSampleOptions& options,
     DistillationSampleReport* report = nullptr);
+
+/// `network` with the teacher's damping correction Δα₁ attached unchanged (an RBF teacher's
+/// damping_part, a network teacher's damping; none if the teacher has none), replacing any it had.
+/// Throws InputError("distillation.teacher", ...) for another kind of teacher with damping.
+material::NnCorrection with_teacher_damping(const material::NnCorrection& network,
+    const material::Correction& teacher);
 
 /// Convenience: distillation_samples over scaled_motions(scene, motion_scales), i.e. the scene's
 /// motion at several amplitudes (e.g. {0.5, 1, 1.5}); an empty list means {1}.

@@ -96,6 +96,8 @@ NnCorrection::NnCorrection(Parameters p)
       fail(layer_field(k, "bias"), "contains a non-finite value");
     inputs = l.weight.rows();
   }
+  if (m_p.damping && m_p.damping->has_elastic_part())
+    fail("damping", "must carry only a damping correction (its elastic part must be zero)");
 }
 
 double NnCorrection::evaluate(const NnInput& x, NnInput* d_input) const {

@@ -4,7 +4,9 @@
 /// isotropic by construction like the RBF (one scalar network per principal direction's view).
 /// Rationale and measured numbers: docs/learning.md ("Neural-network correction").
 #include <elastolearn/material/correction.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
 
+#include <memory>
 #include <vector>
 
 namespace elastolearn::material {
@@ -61,11 +63,18 @@ class NnCorrection final : public Correction {
     /// each takes the previous layer's outputs, the last has 1 output; hidden widths
     /// 1 … max_width, at most max_hidden_layers hidden layers. At least one layer.
     std::vector<Layer> layers;
+    /// The stiffness-damping correction Δα₁(σ) of paper Eq. 13, kept as the teacher's damping
+    /// RBF (material::damping_part) instead of being distilled: a function of (σ, ḟ) cannot
+    /// carry −Δα₁ K_e v_e's shear modes, and a network fitted to both parts at once missed the
+    /// elastic part enough that its simulations diverged (docs/learning.md). Null = no damping
+    /// correction. Its elastic part must be zero.
+    std::shared_ptr<const RbfCorrection> damping;
   };
 
   /// Throws InputError("nn_correction.<field>", ...) — e.g. "nn_correction.layers[1].weight" —
   /// if the layers are missing, too many, or their sizes do not chain 6 → … → 1, a hidden width
-  /// exceeds max_width, a value is not finite, or a scale is not positive.
+  /// exceeds max_width, a value is not finite, a scale is not positive, or `damping` has an
+  /// elastic part.
   explicit NnCorrection(Parameters parameters);
 
   std::string name() const override { return "nn"; }
@@ -73,6 +82,10 @@ class NnCorrection final : public Correction {
   void correction_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
       Mat3& d_stretch_rates) const override;
   std::unique_ptr<Correction> clone() const override;
+  /// Δα₁(σ) of `damping` (0 without one).
+  double stiffness_damping(const Vec3& stretches) const override {
+    return m_p.damping ? m_p.damping->stiffness_damping(stretches) : 0;
+  }
 
   /// g(x) [Pa] at one network input x (e.g. nn_input(σ, ḟ, k)) and, if `d_input` is non-null,
   /// ∂g/∂x.

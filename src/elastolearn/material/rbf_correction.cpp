@@ -131,9 +131,15 @@ bool RbfCorrection::has_damping() const {
          m_p.damping_floor > 0;
 }
 
+bool RbfCorrection::has_elastic_part() const {
+  return !m_p.weights.isZero(0) || m_p.own_slope != 0 || m_p.other_slope != 0 || m_p.constant != 0 ||
+         !m_p.quadratic.isZero(0);
+}
+
 RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   RbfCorrection::Parameters p = a.parameters();
-  const RbfCorrection::Parameters zero{RbfCorrection::Centres(0, 3), VecX(0)};
+  RbfCorrection::Parameters zero;
+  zero.centres.resize(0, 3);
   const RbfCorrection::Parameters& q = b ? b->parameters() : zero;
   if (b && q.epsilon != p.epsilon) fail("epsilon", "cannot blend corrections with different kernel smoothing");
   const Eigen::Index m = p.centres.rows(), n = q.centres.rows();
@@ -157,6 +163,14 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   p.quadratic = (1 - t) * p.quadratic + t * q.quadratic;
   p.damping_slope = (1 - t) * p.damping_slope + t * q.damping_slope;
   p.damping_constant = (1 - t) * p.damping_constant + t * q.damping_constant;
+  return RbfCorrection(std::move(p));
+}
+
+RbfCorrection damping_part(const RbfCorrection& c) {
+  RbfCorrection::Parameters p = c.parameters();
+  p.weights.setZero();
+  p.own_slope = p.other_slope = p.constant = 0;
+  p.quadratic.setZero();
   return RbfCorrection(std::move(p));
 }
 

@@ -83,6 +83,8 @@ public:
   Vec3 elastic_correction(const Vec3& stretches) const;
   /// True if Δα₁ is not identically zero.
   bool has_damping() const;
+  /// True if N is not identically zero (a weight, slope, constant or quadratic term ≠ 0).
+  bool has_elastic_part() const;
   int num_centres() const { return static_cast<int>(m_p.centres.rows()); }
   const Parameters& parameters() const { return m_p; }
 
@@ -99,5 +101,8 @@ private:
 /// correction that overshoots. Throws InputError("rbf_correction.epsilon", ...) if a and b use
 /// different kernel smoothing; the floor is a's.
 RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t);
+
+/// c's damping correction Δα₁ alone (same centres, ε, damping terms and floor; N = 0).
+RbfCorrection damping_part(const RbfCorrection& c);
 
 } // namespace elastolearn::material
