@@ -156,10 +156,15 @@ inline LearningCase dragon(const fs::path& data, bool quick) {
   c.train.fixed_vertices = base_vertices(c.train.mesh, 0.08);
   c.test = c.train;
   c.test.initial.kind = sim::InitialCondition::Kind::Velocity;
-  c.test.initial.angular_velocity = Vec3(5.0, 0, 5.0);
+  // Test swing: deforms more than the training droop (7.3 % vs 5.4 % of the diagonal) but keeps
+  // the StVK truth's elements uninverted (smallest stretch 0.59). The former ω = (5, 0, 5)
+  // inverted some (smallest stretch −0.62), a regime where StVK itself collapses; there even the
+  // correction reconstructed from the *true* training trajectory diverged at frame 13, while
+  // at (3, 0, 3) it reaches 0.069 % (docs/benchmarks_learning.md).
+  c.test.initial.angular_velocity = Vec3(3.0, 0, 3.0);
   c.truth_label = "StVK E 1e5, ν 0.40";
   c.nominal_label = "corotated E 1.2e5, ν 0.40";
-  c.motion_label = "train: droop from rest under gravity; test: gravity + swing ω = (5, 0, 5) rad/s about the base";
+  c.motion_label = "train: droop from rest under gravity; test: gravity + swing ω = (3, 0, 3) rad/s about the base";
   c.target_err_l = 0.2;
   return c;
 }

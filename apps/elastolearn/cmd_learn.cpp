@@ -201,6 +201,8 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--modes", l.pod.max_modes, "POD modes r of the space-time optimisation")->capture_default_str();
   cmd->add_option("--pod-stride", l.pod.frame_stride, "use every k-th frame for POD")->capture_default_str();
   cmd->add_flag("--full-space", l.full_space, "no reduction (Φ = identity): small meshes only");
+  cmd->add_flag("!--pod-forward-only", l.pod_with_constrained,
+                "POD of the forward simulation only (default: also of the constrained one)");
   cmd->add_option("--kernels", l.centres, "RBF kernels (k-means centres)")->capture_default_str();
   cmd->add_option("--position-weight", l.space_time.position_weight, "λ of the position term (Eq. 4)")
       ->capture_default_str();

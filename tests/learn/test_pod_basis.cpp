@@ -119,6 +119,37 @@ TEST(PodBasis, SelectsFrames) {
   EXPECT_LE(max_projection_error(m, basis.modes, VecX::Ones(basis.modes.rows())), 1e-12);
 }
 
+TEST(PodBasis, SeveralTrajectoriesShareOneBasis) {
+  // A second trajectory moving along a 4th shape (as the constrained simulation adds the observed
+  // shapes to the forward one's): the joint basis has 4 modes and reproduces both trajectories
+  // exactly; the frame selection applies to each trajectory.
+  const LowRankMotion m = low_rank_motion();
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  VecX shape = VecX::Zero(3 * m.rest.rows());
+  for (Eigen::Index d = 6; d < shape.size(); ++d)
+    shape[d] = g(rng);
+  LowRankMotion other = m;
+  for (std::size_t t = 0; t < other.frames.size(); ++t)
+    other.frames[t] = unflatten(VecX(flatten(m.frames[t]) + 0.02 * std::cos(0.5 * double(t)) * shape));
+  PodOptions options;
+  options.max_modes = 10;
+  options.frame_stride = 2;
+  const std::vector<std::vector<Positions>> both{m.frames, other.frames};
+  const PodBasis basis = pod_basis(std::span<const std::vector<Positions>>(both), m.rest, m.free_vertices, options);
+  EXPECT_EQ(basis.num_modes(), 4);
+  EXPECT_EQ(basis.frames.size(), 30u);
+  const VecX ones = VecX::Ones(basis.modes.rows());
+  EXPECT_LE(max_projection_error(m, basis.modes, ones), 1e-12);
+  EXPECT_LE(max_projection_error(other, basis.modes, ones), 1e-12);
+  // The first trajectory's own basis misses the second one's extra shape.
+  const PodBasis first = pod_basis(m.frames, m.rest, m.free_vertices, options);
+  EXPECT_GT(max_projection_error(other, first.modes, ones), 1e-3);
+  // Trajectories of different lengths are refused.
+  const std::vector<std::vector<Positions>> uneven{m.frames, std::vector<Positions>(m.frames.begin(), m.frames.end() - 1)};
+  EXPECT_THROW(pod_basis(std::span<const std::vector<Positions>>(uneven), m.rest, m.free_vertices, options), InputError);
+}
+
 TEST(PodBasis, RejectsBadInput) {
   const LowRankMotion m = low_rank_motion(10, 5);
   PodOptions bad;

@@ -184,20 +184,24 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       record.damped_update = true;
     } else if (!next.finished) {
       if (interrupted()) return false;
-      // 2. POD basis of the forward simulation.
-      t0 = Clock::now();
-      const PodBasis basis = options.full_space
-                                 ? identity_basis(scene.mesh.num_vertices(), basis_vertices)
-                                 : pod_basis(as_positions(forward.positions), scene.mesh.rest_positions(),
-                                             basis_vertices, options.pod);
-      record.modes = basis.num_modes();
-      record.seconds_pod = seconds_since(t0);
-
       // 3. Constrained forward simulation: the starting trajectory (falls back to the forward one).
       t0 = Clock::now();
       const ForwardRun constrained =
           all_free_tracked ? with_tracked_data(forward, tracked_scene)
                            : simulate_positions(with_correction(tracked_scene, state.correction), callbacks.progress);
+      record.seconds_constrained = seconds_since(t0);
+
+      // 2. POD basis of the forward simulation (and of the constrained one).
+      t0 = Clock::now();
+      std::vector<std::vector<Positions>> snapshots{as_positions(forward.positions)};
+      if (options.pod_with_constrained && constrained.completed) snapshots.push_back(as_positions(constrained.positions));
+      const PodBasis basis =
+          options.full_space ? identity_basis(scene.mesh.num_vertices(), basis_vertices)
+                             : pod_basis(std::span<const std::vector<Positions>>(snapshots), scene.mesh.rest_positions(),
+                                         basis_vertices, options.pod);
+      record.modes = basis.num_modes();
+      record.seconds_pod = seconds_since(t0);
+      t0 = Clock::now();
       // The optimisation moves the forward trajectory within span Φ (x_i = forward_i + Φ z_i),
       // starting from the constrained simulation projected onto that span. The projection
       // keeps the start smooth: dragging a few observed vertices leaves sharp local dents
@@ -206,7 +210,7 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       if (constrained.completed)
         for (size_t i = 0; i < origin.size(); ++i)
           origin[i].noalias() += basis.modes * (basis.modes.transpose() * (constrained.positions[i] - forward.positions[i]));
-      record.seconds_constrained = seconds_since(t0);
+      record.seconds_constrained += seconds_since(t0);
       if (interrupted()) return false;
 
       // 4. Sparse reduced space-time optimisation.

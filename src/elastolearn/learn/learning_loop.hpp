@@ -37,6 +37,10 @@ struct LearningOptions {
   int max_iterations = 8; ///< corrections computed at most
   int patience = 2;       ///< stop after this many iterations without a better forward error
   PodOptions pod;         ///< reduced basis (max_modes, frame window and stride)
+  /// POD snapshots from the constrained simulation too, not only the forward one, so that span Φ
+  /// contains the observed shapes the current model does not reach (docs/learning_loop.md: a
+  /// sub-millimetre shape error outside span Φ leaves residual forces no material explains).
+  bool pod_with_constrained = true;
   /// The full-space variant: no reduction, Φ = identity on the free dofs (small meshes only:
   /// each Gauss–Newton step factors T dense blocks of that size).
   bool full_space = false;

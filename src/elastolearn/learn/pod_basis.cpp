@@ -40,13 +40,28 @@ void PodOptions::validate() const {
 
 PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> rest,
     const std::vector<int>& free_vertices, const PodOptions& options, ConstRef<VecX> dof_masses) {
+  return pod_basis(std::span<const std::vector<Positions>>(&frames, 1), rest, free_vertices, options, dof_masses);
+}
+
+PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRef<Positions> rest,
+    const std::vector<int>& free_vertices, const PodOptions& options, ConstRef<VecX> dof_masses) {
   options.validate();
   const Eigen::Index n = rest.rows();
-  for (std::size_t t = 0; t < frames.size(); ++t) {
-    if (frames[t].rows() != n) {
+  if (trajectories.empty())
+    fail("frames", "no trajectory");
+  const std::vector<Positions>& frames = trajectories.front();
+  for (std::size_t k = 0; k < trajectories.size(); ++k) {
+    if (trajectories[k].size() != frames.size()) {
       fail("frames",
-          "frame " + str(t) + " has " + str(frames[t].rows()) + " vertices, the rest "
-              + "shape has " + str(n));
+          "trajectory " + str(k) + " has " + str(trajectories[k].size()) + " frames, the first "
+              + "has " + str(frames.size()));
+    }
+    for (std::size_t t = 0; t < trajectories[k].size(); ++t) {
+      if (trajectories[k][t].rows() != n) {
+        fail("frames",
+            "frame " + str(t) + " has " + str(trajectories[k][t].rows()) + " vertices, the rest "
+                + "shape has " + str(n));
+      }
     }
   }
   for (int v : free_vertices) {
@@ -87,7 +102,8 @@ PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> res
 
   // Snapshot matrix: row 3j + c ↔ free vertex j, component c; column s ↔ frame basis.frames[s].
   const Eigen::Index m = 3 * Eigen::Index(free_vertices.size());
-  const Eigen::Index s_count = Eigen::Index(basis.frames.size());
+  const Eigen::Index per_trajectory = Eigen::Index(basis.frames.size());
+  const Eigen::Index s_count = per_trajectory * Eigen::Index(trajectories.size());
   VecX weight = VecX::Ones(m);
   if (options.mass_orthonormal) {
     for (std::size_t j = 0; j < free_vertices.size(); ++j) {
@@ -97,7 +113,7 @@ PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> res
   }
   MatX snapshots(m, s_count);
   for (Eigen::Index s = 0; s < s_count; ++s) {
-    const Positions& x = frames[basis.frames[s]];
+    const Positions& x = trajectories[s / per_trajectory][basis.frames[s % per_trajectory]];
     for (std::size_t j = 0; j < free_vertices.size(); ++j) {
       const int v = free_vertices[j];
       for (int c = 0; c < 3; ++c)

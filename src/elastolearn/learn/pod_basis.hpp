@@ -4,6 +4,7 @@
 /// simulation's free-vertex displacements (a fraction of its frames, a fraction of the modes).
 #include <elastolearn/core/types.hpp>
 
+#include <span>
 #include <vector>
 
 namespace elastolearn::learn {
@@ -51,6 +52,14 @@ struct PodBasis {
 /// Throws InputError for invalid options, inconsistent sizes, a vertex index out of range,
 /// missing masses, no selected frame, or snapshots that do not move at all (no mode to keep).
 PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> rest,
+    const std::vector<int>& free_vertices, const PodOptions& options,
+    ConstRef<VecX> dof_masses = VecX());
+
+/// The same over several trajectories of equal length (e.g. a simulation and the constrained
+/// simulation that follows the observations): the frame selection applies to each trajectory,
+/// and all their selected frames are the snapshots; `frames` lists the selection once.
+/// Throws InputError also if there is no trajectory or their lengths differ.
+PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRef<Positions> rest,
     const std::vector<int>& free_vertices, const PodOptions& options,
     ConstRef<VecX> dof_masses = VecX());
 
