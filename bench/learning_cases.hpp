@@ -236,10 +236,28 @@ inline LearningCase bar_damping(int variant, bool quick) {
   c.test = c.train;
   c.train.initial.static_loads = {{tip, Vec3(0, 1.0, 0)}};
   c.test.initial.static_loads = {{tip, Vec3(0, -2.5, 0.8)}};
+  if (variant == 2) {
+    // Training by an impulse (from rest with a bending velocity) instead of the release from a
+    // static load. Released from a load, the heavily damped bar (α₁ up to 0.65 s over the
+    // training stretches, damping ratio > 1 in its lowest mode) creeps back monotonically, so its
+    // velocity stays nearly proportional to its displacement, and extra stiffness damping
+    // −Δα₁ K v looks like an elastic softening +c K u: the first correction was N ≈ −0.89 P̂
+    // with Δα₁ ≈ −0.17 s (the truth: N = 0, Δα₁ > 0), and every later one diverged (test err_L
+    // 14.3 %, nothing learned, at λ = 1, 10, 30). Starting at rest with a velocity, the
+    // displacement passes through its maximum while the velocity changes sign, which separates
+    // the two: test err_L 0.42 % after the default 8 iterations (12 iterations fit the training
+    // motion better, 0.026 % max, but test at 0.74 %: the test's stretches lie beyond the
+    // training's, σ₁ ≤ 1.12 against ≤ 1.022).
+    c.train.initial.kind = sim::InitialCondition::Kind::Velocity;
+    c.train.initial.static_loads.clear();
+    c.train.initial.angular_velocity = Vec3(0, 0, 0.5);
+    c.train.initial.center = Vec3::Zero();
+  }
   c.truth_label = std::string("corotated E 4e4, ν 0.43, α₁(σ₁) through ") +
                   (variant == 1 ? "(1, 0.2) (1.05, 0.3) (1.1, 0.5)" : "(1, 0.2) (1.03, 0.6) (1.08, 1.2)");
   c.nominal_label = "corotated E 4e4, ν 0.43, α₁ 0.2";
-  c.motion_label = "no gravity; released from a static tip load: train (0, 1, 0) N, test (0, −2.5, 0.8) N";
+  c.motion_label = variant == 1 ? "no gravity; released from a static tip load: train (0, 1, 0) N, test (0, −2.5, 0.8) N"
+                                 : "no gravity; train: from rest with ω_z = 0.5 rad/s about the clamp; test: released from a static tip load (0, −2.5, 0.8) N";
   c.target_err_l = variant == 1 ? 0.1 : 0.4;
   // The truth differs from the nominal in damping only, a small part of the force of the
   // training motion: with the default λ = 1 the space-time optimum stays near the nominal motion
