@@ -69,7 +69,7 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
       Mat3 P = material::first_piola(c.frame, c.stress.stress);
       c.alpha = damping ? damping->coefficients(c.frame.stretches[0]) : material::RayleighCoefficients{};
       // A learned Δα₁ scales the same stiffness as α₁ (paper Eq. 13); the total never turns negative.
-      if (correction) c.alpha.alpha1 = std::max(0.0, c.alpha.alpha1 + correction->stiffness_damping(c.frame.stretches));
+      c.alpha.alpha1 = material::corrected_stiffness_damping(c.alpha.alpha1, correction, c.frame.stretches);
       c.has_tangent = false;
       if (c.alpha.alpha1 != 0) {
         // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 9×9

@@ -124,7 +124,7 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
   }
 }
 
-std::shared_ptr<const material::Correction> rbf_from_json(const JsonObject& o) {
+std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "epsilon", "centres", "weights", "own_slope", "other_slope",
       "constant", "quadratic", "damping_weights", "damping_slope", "damping_constant",
       "damping_floor" });
@@ -177,8 +177,8 @@ std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
   if (o.has("damping")) {
     // The stiffness-damping correction Δα₁, an RBF with no elastic part (NnCorrection::damping).
     const JsonObject d = o.object("damping");
-    if (d.choice("type", { "rbf" }) == "rbf")
-      p.damping = std::dynamic_pointer_cast<const material::RbfCorrection>(rbf_from_json(d));
+    d.choice("type", { "rbf" });
+    p.damping = rbf_from_json(d);
   }
   return construct(o, [&] { return std::make_shared<const material::NnCorrection>(std::move(p)); });
 }

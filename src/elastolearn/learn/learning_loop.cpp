@@ -184,14 +184,14 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       record.damped_update = true;
     } else if (!next.finished) {
       if (interrupted()) return false;
-      // 3. Constrained forward simulation: the starting trajectory (falls back to the forward one).
+      // 2. Constrained forward simulation: the starting trajectory (falls back to the forward one).
       t0 = Clock::now();
       const ForwardRun constrained =
           all_free_tracked ? with_tracked_data(forward, tracked_scene)
                            : simulate_positions(with_correction(tracked_scene, state.correction), callbacks.progress);
       record.seconds_constrained = seconds_since(t0);
 
-      // 2. POD basis of the forward simulation (and of the constrained one).
+      // 3. POD basis of the forward simulation (and of the constrained one).
       t0 = Clock::now();
       std::vector<std::vector<Positions>> snapshots{as_positions(forward.positions)};
       if (options.pod_with_constrained && constrained.completed) snapshots.push_back(as_positions(constrained.positions));

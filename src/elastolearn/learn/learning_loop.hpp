@@ -4,8 +4,8 @@
 /// forward simulation reproduces the observations. Each iteration k:
 ///   1. forward-simulate with the current correction C_k; its error against the observations is
 ///      the convergence signal (the best C_k so far is kept);
-///   2. POD basis Φ of that simulation (§5.1);
-///   3. constrained forward simulation: observed vertices follow their data (Eqs. 6–8);
+///   2. constrained forward simulation: observed vertices follow their data (Eqs. 6–8);
+///   3. POD basis Φ of both simulations (§5.1; the paper's uses the forward one only);
 ///   4. sparse reduced space-time optimisation from it (Eqs. 2–4, space_time.hpp);
 ///   5. control forces (Eq. 5) and stress reconstruction (Eqs. 10–13): the new correction's
 ///      nodal forces must equal the nominal model's residual along the optimised trajectory;

@@ -146,7 +146,7 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
         continue;
       // ElasticForce's damping with the correction minus without it (same clamp α₁ + Δα₁ ≥ 0).
       const double alpha1 = nominal_alpha1(mesh, s.frame.stretches);
-      const double change = std::max(0.0, alpha1 + correction.stiffness_damping(s.frame.stretches)) - alpha1;
+      const double change = material::corrected_stiffness_damping(alpha1, &correction, s.frame.stretches) - alpha1;
       if (change != 0)
         element_forces[e] += change * element_stiffness_damping_force(mesh.rest[e], s, *elastic);
     }

@@ -4,6 +4,7 @@
 /// with F̂ the principal stretches (sorted descending) and Ḟ̂ = diag(Uᵀ Ḟ V) the stretch rates.
 #include <elastolearn/core/types.hpp>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -27,5 +28,12 @@ public:
   virtual double stiffness_damping(const Vec3& /*stretches*/) const { return 0; }
   virtual std::unique_ptr<Correction> clone() const = 0;
 };
+
+/// An element's stiffness-damping coefficient with a correction: α₁ + Δα₁(F̂), kept ≥ 0 (a
+/// negative total would feed energy in); α₁ itself without a correction. The one rule that
+/// fem::ElasticForce and the learning's correction forces share.
+inline double corrected_stiffness_damping(double alpha1, const Correction* correction, const Vec3& stretches) {
+  return correction ? std::max(0.0, alpha1 + correction->stiffness_damping(stretches)) : alpha1;
+}
 
 } // namespace elastolearn::material

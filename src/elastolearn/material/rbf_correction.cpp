@@ -88,14 +88,13 @@ double RbfCorrection::elastic_view(const Vec3& y, Vec3* d_y) const {
   return h;
 }
 
-double RbfCorrection::damping(const Vec3& stretches) const {
+double RbfCorrection::stiffness_damping(const Vec3& stretches) const {
   double alpha = m_p.damping_slope * (stretches.sum() - 3) + m_p.damping_constant;
   if (m_p.damping_weights.size() > 0) {
     const auto p = descending_order(stretches);
     const Vec3 s(stretches[p[0]], stretches[p[1]], stretches[p[2]]);
-    const double eps2 = m_p.epsilon * m_p.epsilon;
     for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i)
-      alpha += m_p.damping_weights[i] * std::sqrt((s - m_p.centres.row(i).transpose()).squaredNorm() + eps2);
+      alpha += m_p.damping_weights[i] * rbf_kernel((s - m_p.centres.row(i).transpose()).squaredNorm(), m_p.epsilon);
   }
   return std::max(alpha, m_p.damping_floor);
 }

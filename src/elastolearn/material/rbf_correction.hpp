@@ -77,7 +77,8 @@ public:
                            Mat3& d_stretch_rates) const override;
   std::unique_ptr<Correction> clone() const override;
 
-  double stiffness_damping(const Vec3& stretches) const override { return damping(stretches); }
+  /// Δα₁(σ) (its gradient is not needed: the Jacobian treats α₁ as constant, as for Rayleigh).
+  double stiffness_damping(const Vec3& stretches) const override;
 
   /// (h(y_1), h(y_2), h(y_3)) [Pa], the same as correction(stretches, ·).
   Vec3 elastic_correction(const Vec3& stretches) const;
@@ -91,8 +92,6 @@ public:
 private:
   /// h(y) and, if d_y is non-null, ∂h/∂y.
   double elastic_view(const Vec3& y, Vec3* d_y) const;
-  /// Δα₁(σ) (its gradient is not needed: the Jacobian treats α₁ as constant, as for Rayleigh).
-  double damping(const Vec3& stretches) const;
   Parameters m_p;
 };
 
