@@ -6,6 +6,7 @@
 // thread: 12 / 95 / 380 ms per step (corotated), 75 / 500 / 1750 ms (StVK).
 //
 //   ./build/bench/bench_fem_step --benchmark_filter='corotated/.*'   (subset)
+//   ./build/bench/bench_fem_step --no-jacobian-reuse ...   (every Newton iteration assembles)
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
 #include <elastolearn/mesh/primitives.hpp>
@@ -14,6 +15,7 @@
 
 #include <benchmark/benchmark.h>
 #include <chrono>
+#include <string>
 #include <tbb/global_control.h>
 
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
@@ -21,6 +23,8 @@ extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 namespace {
 
 using namespace elastolearn;
+
+bool g_jacobian_reuse = true;
 
 constexpr std::array<std::array<int, 3>, 3> kResolutions = {{{16, 4, 4}, {32, 8, 8}, {52, 13, 13}}};
 
@@ -34,6 +38,7 @@ sim::Scene bar(material::ElasticModelType type, int resolution, sim::LinearSolve
   s.gravity = Vec3(0, -9.81, 0);
   s.dt = 1e-3;
   s.newton.relative_tolerance = 1e-6;
+  if (!g_jacobian_reuse) s.newton.jacobian_reuse_contraction = 0;
   s.linear_solver = solver;
   return s;
 }
@@ -46,7 +51,7 @@ void step_benchmark(benchmark::State& state, material::ElasticModelType type, si
   sim::Simulator simulator(bar(type, resolution, solver));
   // Warm up past the first steps (whose Newton solves start far from the answer) as Vega's would.
   for (int i = 0; i < 3; ++i) simulator.step();
-  long newton = 0, linear = 0, steps = 0;
+  long newton = 0, jacobians = 0, linear = 0, steps = 0;
   sim::SolverTimings timings;
   double seconds = 0;
   for (auto _ : state) {
@@ -55,6 +60,7 @@ void step_benchmark(benchmark::State& state, material::ElasticModelType type, si
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!report.converged) state.SkipWithError(report.message.c_str());
     newton += report.iterations;
+    jacobians += report.jacobians;
     linear += report.linear_iterations;
     timings += report.timings;
     ++steps;
@@ -62,6 +68,7 @@ void step_benchmark(benchmark::State& state, material::ElasticModelType type, si
   state.counters["tets"] = simulator.scene().mesh.num_tets();
   state.counters["ms/step"] = 1e3 * seconds / steps;
   state.counters["newton/step"] = double(newton) / steps;
+  state.counters["jacobians/step"] = double(jacobians) / steps;
   if (solver == sim::LinearSolverType::ConjugateGradient) state.counters["cg_it/step"] = double(linear) / steps;
   state.counters["assembly%"] = 100 * timings.assembly / seconds;
   state.counters["factor%"] = 100 * timings.factorization / seconds;
@@ -85,6 +92,13 @@ void register_all() {
 } // namespace
 
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--no-jacobian-reuse") {
+      g_jacobian_reuse = false;
+      for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
+      --argc;
+      break;
+    }
   register_all();
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();

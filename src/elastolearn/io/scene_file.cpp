@@ -169,10 +169,11 @@ SceneFile parse_scene(const nlohmann::json& json, const std::string& file, const
   if (s.frames < 1) time.fail("frames", "must be at least 1");
   if (root.has("solver")) {
     const JsonObject solver = root.object("solver");
-    solver.reject_unknown_keys({"linear", "newton_tolerance", "max_newton_iterations"});
+    solver.reject_unknown_keys({"linear", "newton_tolerance", "max_newton_iterations", "reuse_jacobian"});
     s.linear_solver = sim::linear_solver_type_from_string(solver.choice("linear", {"cholmod", "cg", "eigen-ldlt"}, "cholmod"));
     s.newton.relative_tolerance = solver.positive("newton_tolerance", s.newton.relative_tolerance);
     s.newton.max_iterations = solver.integer("max_newton_iterations", s.newton.max_iterations);
+    if (!solver.boolean("reuse_jacobian", true)) s.newton.jacobian_reuse_contraction = 0;
   }
   if (root.has("output")) {
     const JsonObject o = root.object("output");

@@ -13,6 +13,8 @@ void NewtonOptions::validate() const {
     throw InputError("newton.absolute_tolerance", "must be >= 0");
   if (max_iterations < 1) throw InputError("newton.max_iterations", "must be >= 1");
   if (max_line_search < 0) throw InputError("newton.max_line_search", "must be >= 0");
+  if (!(jacobian_reuse_contraction == 0 || jacobian_reuse_contraction > 1))
+    throw InputError("newton.jacobian_reuse_contraction", "must be 0 (off) or > 1");
 }
 
 SolverTimings& SolverTimings::operator+=(const SolverTimings& o) {
@@ -33,6 +35,11 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
                           LinearSolver& solver, const NewtonOptions& options) {
   NewtonReport report;
   VecX g(u.size()), du = VecX::Zero(u.size()), u_prev(u.size());
+  // Reuse the Jacobian only after a full step that contracted the residual enough.
+  auto reuse_after = [&](double step, double before, double after) {
+    const double c = options.jacobian_reuse_contraction;
+    return c > 0 && step == 1.0 && std::isfinite(after) && after * c <= before;
+  };
   auto evaluate = [&](const VecX& at) {
     const auto t0 = Clock::now();
     problem.residual(at, g);
@@ -41,6 +48,7 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
   };
   double norm = evaluate(u);
   report.initial_residual = norm;
+  bool reuse_jacobian = false; // the first iteration always assembles
   const double target =
       std::max(options.relative_tolerance * report.initial_residual, options.absolute_tolerance);
   for (;;) {
@@ -61,15 +69,18 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
     }
     ++report.iterations;
     auto t0 = Clock::now();
-    problem.jacobian(u, A);
-    report.timings.assembly += seconds_since(t0);
-    t0 = Clock::now();
-    if (!solver.factorize(A.matrix())) {
-      report.message = "system matrix is not positive definite";
-      return report;
+    if (!reuse_jacobian) {
+      problem.jacobian(u, A);
+      report.timings.assembly += seconds_since(t0);
+      ++report.jacobians;
+      t0 = Clock::now();
+      if (!solver.factorize(A.matrix())) {
+        report.message = "system matrix is not positive definite";
+        return report;
+      }
+      report.timings.factorization += seconds_since(t0);
+      t0 = Clock::now();
     }
-    report.timings.factorization += seconds_since(t0);
-    t0 = Clock::now();
     const bool first = report.iterations == 1 && problem.first_increment;
     if (first && problem.first_increment->size() == du.size()) du = *problem.first_increment;
     else du.setZero();
@@ -101,6 +112,7 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
       }
       report.timings.assembly += seconds_since(t0);
       norm = evaluate(u);
+      reuse_jacobian = reuse_after(alpha, norm_prev, norm);
       continue;
     }
     // No energy (dynamics with damping or a learned correction): take the full Newton step, which
@@ -116,6 +128,7 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
       u = u_prev + alpha * du;
       norm = evaluate(u);
     }
+    reuse_jacobian = reuse_after(2 * alpha, norm_prev, norm); // the step taken is 2α
   }
 }
 

@@ -3,7 +3,8 @@
 /// static equilibrium solve. The Jacobian is the projected (PSD) one. With an energy (statics of
 /// hyperelastic models) the step is an Armijo backtracking line search on it; without one
 /// (dynamics with damping or a correction) the full step is taken unless the state turns
-/// non-finite or the residual grows more than 1000-fold.
+/// non-finite or the residual grows more than 1000-fold. After a strongly contracting iteration
+/// the Jacobian may be reused (NewtonOptions::jacobian_reuse_contraction).
 #include <elastolearn/core/types.hpp>
 #include <elastolearn/fem/system_matrix.hpp>
 #include <elastolearn/sim/linear_solver.hpp>
@@ -18,6 +19,13 @@ struct NewtonOptions {
   double absolute_tolerance = 0;    ///< … or ‖g‖ ≤ this [N] (0: chosen by the caller's scale)
   int max_iterations = 50;
   int max_line_search = 12;         ///< step halvings
+  /// Jacobian reuse (a chord step): after an iteration that shrank ‖g‖ at least this many times,
+  /// the next one solves with the same Jacobian and factorisation instead of re-assembling at
+  /// the new iterate; an iteration that contracts less makes the next one assemble afresh.
+  /// Within a time step Newton's first full step usually leaves ~1e-3 of the residual, where
+  /// the Jacobian has barely changed: reuse saves an assembly and a factorisation per step at
+  /// the same convergence criterion. 0 turns reuse off (every iteration assembles).
+  double jacobian_reuse_contraction = 10;
   /// Throws InputError naming the offending option.
   void validate() const;
 };
@@ -33,6 +41,7 @@ struct SolverTimings {
 struct NewtonReport {
   bool converged = false;
   int iterations = 0;
+  int jacobians = 0;        ///< Jacobian assemblies (iterations minus reuses)
   int linear_iterations = 0;
   double initial_residual = 0;
   double residual = 0;

@@ -169,6 +169,7 @@ NewtonReport Simulator::solve_static(int load_steps) {
     m_loads->set_scale(double(k) / load_steps);
     NewtonReport r = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
     total.iterations += r.iterations;
+    total.jacobians += r.jacobians;
     total.linear_iterations += r.linear_iterations;
     total.timings += r.timings;
     total.residual = r.residual;
