@@ -17,7 +17,6 @@
 #include <elastolearn/mesh/vertex_selection.hpp>
 
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -179,11 +178,10 @@ inline LearningCase dragon(const fs::path& data, bool quick) {
 inline LearningCase sphere(bool compression, bool quick) {
   LearningCase c;
   c.name = compression ? "sphere-compression" : "sphere-tension";
-  auto env = [](const char* k, double d) { const char* v = std::getenv(k); return v ? std::atof(v) : d; }; // TUNING
-  const double radius = env("EL_R", 0.2);
+  const double radius = 0.2;
   auto mesh = mesh::make_sphere(radius, quick ? 2000 : 12712);
   c.mesh_label = "ball r 0.2 m → " + std::to_string(mesh.num_tets()) + " tets";
-  const auto lame = material::Lame::from_young_poisson(env("EL_E", 1e5), 0.43);
+  const auto lame = material::Lame::from_young_poisson(1e5, 0.43);
   auto spline = compression
                     ? material::CubicSpline({0.7, 0.85, 1.0}, {0.3, 0.6, 1.0}, "compression edit")
                     : material::CubicSpline({1.0, 1.1, 1.25}, {1.0, 1.8, 3.0}, "tension edit");
@@ -200,11 +198,11 @@ inline LearningCase sphere(bool compression, bool quick) {
   top.vertices = mesh::vertices_with_max_coordinate(c.train.mesh, 1, 0.15 * radius);
   top.kind = sim::KeyframeMotion::Kind::Sinusoid;
   c.test = c.train;
-  top.amplitude = Vec3(0, env("EL_A1", 0.2) * radius, 0);
-  top.frequency = env("EL_F1", 1.0);
+  top.amplitude = Vec3(0, 0.2 * radius, 0);
+  top.frequency = 1.0;
   c.train.keyframes = {top};
-  top.amplitude = Vec3(0, env("EL_A2", 0.3) * radius, 0);
-  top.frequency = env("EL_F2", 1.25);
+  top.amplitude = Vec3(0, 0.3 * radius, 0);
+  top.frequency = 1.25;
   c.test.keyframes = {top};
   c.truth_label = std::string("spline-edited neo-Hookean E 1e5, ν 0.43 (") +
                   (compression ? "compression: s(0.7, 0.85, 1) = 0.3, 0.6, 1" : "tension: s(1, 1.1, 1.25) = 1, 1.8, 3") +
