@@ -74,6 +74,21 @@ TEST(RbfCorrection, GradientMatchesFiniteDifference) {
   }
 }
 
+TEST(RbfCorrection, OnePassEvaluationEqualsTheSeparateCalls) {
+  // correction_with_gradient (the element loops' call) shares the kernel evaluations of N and
+  // ∂N: it must return exactly what correction and correction_gradient return.
+  const RbfCorrection n(test_parameters(1e-3));
+  for (const Vec3& s : { Vec3(1.15, 0.97, 0.88), Vec3(1.0, 1.0, 1.0), Vec3(1.1, 0.95, -0.2) }) {
+    const Vec3 r(0.3, -0.5, 0.1);
+    Mat3 ds, dr, ds1, dr1;
+    n.correction_gradient(s, r, ds, dr);
+    const Vec3 value = n.correction_with_gradient(s, r, ds1, dr1);
+    EXPECT_EQ(value, n.correction(s, r));
+    EXPECT_EQ(ds1, ds);
+    EXPECT_EQ(dr1, dr);
+  }
+}
+
 TEST(RbfCorrection, SmoothedKernelIsDifferentiableAtACentre) {
   // With ε = 0.05 the kernel √(r² + ε²) is smooth through a centre: FD agrees there too (curvature
   // scale ε ≫ FD step, truncation (h/ε)⁴ ≈ 2e-15).

@@ -21,6 +21,13 @@ public:
   /// ∂N/∂F̂ (3×3, row = output) and ∂N/∂Ḟ̂ (3×3).
   virtual void correction_gradient(const Vec3& stretches, const Vec3& stretch_rates,
                                    Mat3& d_stretches, Mat3& d_stretch_rates) const = 0;
+  /// N and both gradients in one call, what the element loops need; the default calls the two
+  /// above, an implementation may share their work (the RBF evaluates each kernel once).
+  virtual Vec3 correction_with_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
+                                        Mat3& d_stretch_rates) const {
+    correction_gradient(stretches, stretch_rates, d_stretches, d_stretch_rates);
+    return correction(stretches, stretch_rates);
+  }
   /// Δα₁(F̂) [s]: a correction of the element's Rayleigh stiffness-damping coefficient (paper
   /// Eq. 13). The element's damping force becomes −(α₁ + Δα₁) K_e v_e with K_e the *nominal*
   /// model's stiffness (fem::ElasticForce), so that the learned damping is linear in Δα₁ and

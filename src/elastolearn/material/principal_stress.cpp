@@ -167,8 +167,7 @@ CorrectedStress corrected_principal_stress(const ElasticModel& model, const Corr
         model.principal_stress_derivative(stretches), Mat3::Zero() };
     if (correction != nullptr) {
         Mat3 dn_ds, dn_dr;
-        correction->correction_gradient(stretches, stretch_rates, dn_ds, dn_dr);
-        out.stress += correction->correction(stretches, stretch_rates);
+        out.stress += correction->correction_with_gradient(stretches, stretch_rates, dn_ds, dn_dr);
         out.d_stretches += dn_ds;
         out.d_stretch_rates = dn_dr;
     }

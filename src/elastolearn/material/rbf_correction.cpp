@@ -103,18 +103,25 @@ Vec3 RbfCorrection::correction(const Vec3& stretches, const Vec3& /*stretch_rate
   return elastic_correction(stretches);
 }
 
-void RbfCorrection::correction_gradient(const Vec3& stretches, const Vec3& /*stretch_rates*/, Mat3& d_stretches,
-                                        Mat3& d_stretch_rates) const {
+Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& /*stretch_rates*/, Mat3& d_stretches,
+                                             Mat3& d_stretch_rates) const {
+  Vec3 n;
   d_stretches.setZero();
   for (int k = 0; k < 3; ++k) {
     const auto o = others_descending(stretches, k);
     Vec3 d_y;
-    elastic_view(Vec3(stretches[k], stretches[o[0]], stretches[o[1]]), &d_y);
+    n[k] = elastic_view(Vec3(stretches[k], stretches[o[0]], stretches[o[1]]), &d_y);
     d_stretches(k, k) += d_y[0];
     d_stretches(k, o[0]) += d_y[1];
     d_stretches(k, o[1]) += d_y[2];
   }
   d_stretch_rates.setZero();
+  return n;
+}
+
+void RbfCorrection::correction_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
+                                        Mat3& d_stretch_rates) const {
+  correction_with_gradient(stretches, stretch_rates, d_stretches, d_stretch_rates);
 }
 
 std::unique_ptr<Correction> RbfCorrection::clone() const { return std::make_unique<RbfCorrection>(*this); }

@@ -73,6 +73,8 @@ public:
 
   std::string name() const override { return "rbf"; }
   Vec3 correction(const Vec3& stretches, const Vec3& stretch_rates) const override;
+  Vec3 correction_with_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
+                                Mat3& d_stretch_rates) const override;
   void correction_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
                            Mat3& d_stretch_rates) const override;
   std::unique_ptr<Correction> clone() const override;
