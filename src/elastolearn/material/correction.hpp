@@ -11,7 +11,8 @@
 namespace elastolearn::material {
 
 /// A correction to the principal stress: 6 inputs (stretches, stretch rates), 3 outputs [Pa].
-/// Implementations must be thread-safe and allocation-free in `correction`/`correction_gradient`.
+/// Implementations must be thread-safe and allocation-free in `correction`, `correction_gradient`
+/// and `correction_with_gradient`.
 class Correction {
 public:
   virtual ~Correction() = default;
