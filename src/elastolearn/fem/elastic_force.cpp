@@ -2,7 +2,6 @@
 #include <elastolearn/fem/elastic_force.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 
-#include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -10,15 +9,6 @@
 namespace elastolearn::fem {
 
 namespace {
-
-/// Symmetric part of a 3×3 matrix with negative eigenvalues clamped to zero.
-Mat3 symmetric_psd(const Mat3& a) {
-  const Mat3 s = 0.5 * (a + a.transpose());
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(s);
-  if (eig.eigenvalues().minCoeff() >= 0) return s;
-  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
-         eig.eigenvectors().transpose();
-}
 
 /// a·A + b·B of two eigen-form tangents (the eigen-form is linear in dP/dF).
 material::PrincipalTangent weighted_sum(double a, const material::PrincipalTangent& A, double b,
@@ -68,19 +58,25 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
       c.stress = material::corrected_principal_stress(*elastic, correction, c.frame.stretches, rates);
       Mat3 P = material::first_piola(c.frame, c.stress.stress);
       c.alpha = damping ? damping->coefficients(c.frame.stretches[0]) : material::RayleighCoefficients{};
-      // A learned Δα₁ scales the same stiffness as α₁ (paper Eq. 13); the total never turns negative.
-      c.alpha.alpha1 = material::corrected_stiffness_damping(c.alpha.alpha1, correction, c.frame.stretches);
+      // A learned Δα₁ scales the nominal stiffness (paper Eq. 13); the total never turns negative.
+      c.alpha1_change =
+          material::corrected_stiffness_damping(c.alpha.alpha1, correction, c.frame.stretches) - c.alpha.alpha1;
       c.has_tangent = false;
-      if (c.alpha.alpha1 != 0) {
+      if (c.alpha.alpha1 != 0 || c.alpha1_change != 0) {
         // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 9×9
-        // or 12×12 (the eigen-form tangent is kept for the Jacobian). K_e is the nominal model's
-        // stiffness: a correction changes the elastic stress; the damping is Rayleigh's on the
-        // nominal stiffness, scaled by α₁ + Δα₁ (this keeps the learned damping linear in Δα₁).
-        c.tangent = correction ? material::principal_tangent(*elastic, c.frame, m_project_tangent)
-                               : material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches,
-                                                             m_project_tangent);
+        // or 12×12. K_e is the corrected model's exact stiffness, the learned Δα₁ acts on the
+        // nominal one (see the class comment). Unprojected: the PSD projection is Newton's device
+        // (add_jacobian), and the damping force must stay linear in the correction.
+        material::CorrectedStress scratch;
+        const material::CorrectedStress& elastic_stress =
+            material::elastic_part(*elastic, correction, c.frame.stretches, c.stress, scratch);
+        c.tangent = material::damping_tangent(c.frame, elastic_stress.stress, elastic_stress.d_stretches);
         c.has_tangent = true;
-        P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
+        if (c.alpha.alpha1 != 0) P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
+        if (c.alpha1_change != 0) {
+          c.nominal_tangent = material::damping_tangent(*elastic, c.frame);
+          P += c.alpha1_change * material::first_piola_differential(c.frame, c.nominal_tangent, F_rate);
+        }
       }
       Eigen::Map<Eigen::Matrix<double, 3, 4>> force(m_force_buffer.data() + 12 * e);
       force.noalias() = -rest.volume * P * rest.gradients;
@@ -108,25 +104,28 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
   A.add_elements([&](int e, Mat12& J) {
     const TetRestData& rest = m_rest[e];
     const ElementCache& c = m_cache[e];
-    // c_x K_e + c_v α₁ K_e^nominal as one eigen-form tangent (both PSD when projected, so their
-    // sum is too); without a correction the two stiffnesses are the same.
-    material::PrincipalTangent tangent =
-        c.has_tangent && !correction
-            ? c.tangent
-            : material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
-    double scale = c_x + c_v * c.alpha.alpha1;
-    if (correction && c.has_tangent) {
-      tangent = weighted_sum(c_x, tangent, c_v * c.alpha.alpha1, c.tangent);
-      scale = 1;
+    // c_x K_e + c_v (α₁ K_e^damp + Δα₁ K_e^nom,damp) as one eigen-form tangent (the eigen-form is
+    // linear in dP/dF), projected once as a whole.
+    material::PrincipalTangent tangent;
+    if (!c.has_tangent) {
+      tangent = material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
+    } else {
+      tangent = weighted_sum(c_x, material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, false),
+                             c_v * c.alpha.alpha1, c.tangent);
+      if (c.alpha1_change != 0) tangent = weighted_sum(1.0, tangent, c_v * c.alpha1_change, c.nominal_tangent);
+      if (m_project_tangent) tangent = material::projected(tangent);
     }
-    J = element_stiffness(c.frame, tangent, rest, scale);
+    J = element_stiffness(c.frame, tangent, rest, c.has_tangent ? 1.0 : c_x);
     if (c.alpha.alpha0 != 0) J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
     if (correction && c_v != 0 && !c.stress.d_stretch_rates.isZero(0)) {
       // Project the damping tangent as a whole: the Rayleigh part α₁·block plus the correction's
       // rate part may be PSD together even where the rate part alone is not; projecting them
       // separately would overstate the damping and stall Newton.
-      const Mat3 rayleigh = c.has_tangent ? Mat3(c.alpha.alpha1 * c.tangent.block) : Mat3::Zero();
-      const Mat3 d_rates = m_project_tangent ? Mat3(symmetric_psd(rayleigh + c.stress.d_stretch_rates) - rayleigh)
+      Mat3 rayleigh = Mat3::Zero();
+      if (c.has_tangent) rayleigh = c.alpha.alpha1 * c.tangent.block;
+      if (c.alpha1_change != 0) rayleigh += c.alpha1_change * c.nominal_tangent.block;
+      if (m_project_tangent) rayleigh = material::symmetric_psd(rayleigh);
+      const Mat3 d_rates = m_project_tangent ? Mat3(material::symmetric_psd(rayleigh + c.stress.d_stretch_rates) - rayleigh)
                                              : c.stress.d_stretch_rates;
       if (!d_rates.isZero(0))
         J += c_v * element_matrix_from_tangent(material::first_piola_rate_derivative(c.frame, d_rates), rest);

@@ -65,6 +65,37 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
   }
 }
 
+void RbfDesign::output_matrix(
+    const Vec3& stretches, Eigen::Ref<OutputMatrix> out, Eigen::Ref<OutputGradient> gradient) const {
+  output_matrix(stretches, out);
+  gradient.setZero();
+  const Eigen::Index m = m_centres.rows();
+  for (int k = 0; k < 3; ++k) {
+    const auto idx = material::stretch_view_indices(stretches, k);
+    const Vec3 y(stretches[idx[0]], stretches[idx[1]], stretches[idx[2]]);
+    // ∂/∂σ_idx[c] of the view's entry c; collect into row 3 idx[c] + k.
+    const auto add = [&](Eigen::Index column, const Vec3& d_y) {
+      for (int c = 0; c < 3; ++c) gradient(3 * idx[c] + k, column) += d_y[c];
+    };
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const Vec3 d = y - m_centres.row(i).transpose();
+      const double phi = out(k, i);
+      if (phi > 0) add(i, d / phi);
+    }
+    if (m_options.elastic_polynomial) {
+      add(m, Vec3(1, 0, 0));
+      add(m + 1, Vec3(0, 1, 1));
+      if (m_options.quadratic_tail) {
+        const double e = y[0] - 1, s = y[1] + y[2] - 2;
+        add(m + 3, Vec3(2 * e, 0, 0));
+        add(m + 4, Vec3(s, e, e));
+        add(m + 5, Vec3(0, 2 * s, 2 * s));
+        add(m + 6, Vec3(0, y[2] - 1, y[1] - 1));
+      }
+    }
+  }
+}
+
 void RbfDesign::damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd> out) const {
   if (m_damping == 0) return;
   const Eigen::Index m = m_centres.rows();

@@ -48,8 +48,13 @@ public:
   int damping_unknowns() const { return m_damping; } ///< 0, or m (+ 2 with the tail)
   int num_unknowns() const { return m_elastic + m_damping; }
   const RbfFitOptions& options() const { return m_options; }
+  using OutputGradient = Eigen::Matrix<double, 9, Eigen::Dynamic>;
   /// A(σ) into `out` (3 × elastic_unknowns()), for stretches in any order. No allocation.
   void output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const;
+  /// A(σ) and its stretch derivative: row 3j + k of `gradient` (9 × elastic_unknowns()) is
+  /// ∂A(k, ·)/∂σ_j, i.e. column i reshaped (column-major) is ∂N/∂σ of unknown i alone. Exact
+  /// (subgradients at ties, and at a centre for ε = 0). No allocation.
+  void output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out, Eigen::Ref<OutputGradient> gradient) const;
   /// d(σ) into `out` (damping_unknowns() entries), for stretches in any order. No allocation.
   void damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd> out) const;
   /// Tikhonov weight of each unknown (regularization, or damping_regularization).

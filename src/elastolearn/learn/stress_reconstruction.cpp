@@ -59,6 +59,7 @@ struct AssemblyScratch {
   std::vector<ElementState> states;
   MatX jt; ///< Jᵀ of one frame: unknowns × free dofs
   RbfDesign::OutputMatrix outputs;             ///< A_e: 3 × elastic unknowns
+  RbfDesign::OutputGradient gradients;         ///< ∂A_e/∂σ: 9 × elastic unknowns
   Eigen::RowVectorXd damping_row;              ///< d_e: damping unknowns
   Eigen::Matrix<double, 12, Eigen::Dynamic> element_rows; ///< [G_e A_e, (−K_e v_e) d_e]
   VecX target;
@@ -112,13 +113,38 @@ Eigen::Matrix<double, 12, 3> element_force_operator(
   return G;
 }
 
-Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
-    const material::ElasticModel& elastic) {
-  const material::PrincipalTangent tangent = material::principal_tangent(elastic, state.frame, true);
+namespace {
+
+/// −vol (dP/dF : Ḟ) g_a for an eigen-form tangent (local dofs x0, y0, z0, x1, …).
+Vec12 stiffness_damping_force(
+    const fem::TetRestData& rest, const ElementState& state, const material::PrincipalTangent& tangent) {
   const Mat3 stress_rate = material::first_piola_differential(state.frame, tangent, state.deformation_rate);
   Vec12 f;
   Eigen::Map<Eigen::Matrix<double, 3, 4>>(f.data()).noalias() = -rest.volume * stress_rate * rest.gradients;
   return f;
+}
+
+} // namespace
+
+Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
+    const material::ElasticModel& elastic) {
+  return stiffness_damping_force(rest, state, material::damping_tangent(elastic, state.frame));
+}
+
+Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
+    const fem::TetRestData& rest, const ElementState& state) {
+  // The exact eigen-form tangent is linear in (p̂, ∂p̂/∂σ), and so is the force: its columns are
+  // the forces of the 12 unit inputs.
+  Eigen::Matrix<double, 12, 12> op;
+  for (int c = 0; c < 12; ++c) {
+    Vec3 stress = Vec3::Zero();
+    Mat3 derivative = Mat3::Zero();
+    if (c < 3) stress[c] = 1;
+    else derivative((c - 3) % 3, (c - 3) / 3) = 1;
+    op.col(c) = stiffness_damping_force(
+        rest, state, material::damping_tangent(state.frame, stress, derivative));
+  }
+  return op;
 }
 
 namespace {
@@ -140,15 +166,31 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
   tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
     for (int e = r.begin(); e < r.end(); ++e) {
       const ElementState& s = states[e];
-      element_forces[e].noalias() = element_force_operator(mesh.rest[e], s.frame)
-          * correction.correction(s.frame.stretches, s.stretch_rates);
-      if (elastic == nullptr)
+      if (elastic == nullptr) {
+        element_forces[e].noalias() = element_force_operator(mesh.rest[e], s.frame)
+            * correction.correction(s.frame.stretches, s.stretch_rates);
         continue;
-      // ElasticForce's damping with the correction minus without it (same clamp α₁ + Δα₁ ≥ 0).
+      }
+      const material::CorrectedStress total = material::corrected_principal_stress(
+          *elastic, &correction, s.frame.stretches, s.stretch_rates);
+      const Vec3 nominal_stress = elastic->principal_stress(s.frame.stretches);
+      element_forces[e].noalias() = element_force_operator(mesh.rest[e], s.frame) * (total.stress - nominal_stress);
+      // ElasticForce's damping with the correction minus without it: α₁ on the corrected minus
+      // the nominal stiffness, and the learned Δα₁ on the nominal one (same clamp α₁ + Δα₁ ≥ 0).
       const double alpha1 = nominal_alpha1(mesh, s.frame.stretches);
       const double change = material::corrected_stiffness_damping(alpha1, &correction, s.frame.stretches) - alpha1;
+      if (alpha1 == 0 && change == 0)
+        continue;
+      const Vec12 nominal_damping = element_stiffness_damping_force(mesh.rest[e], s, *elastic);
+      if (alpha1 != 0) {
+        material::CorrectedStress scratch;
+        const material::CorrectedStress& elastic_stress
+            = material::elastic_part(*elastic, &correction, s.frame.stretches, total, scratch);
+        element_forces[e] += alpha1 * (stiffness_damping_force(mesh.rest[e], s,
+            material::damping_tangent(s.frame, elastic_stress.stress, elastic_stress.d_stretches)) - nominal_damping);
+      }
       if (change != 0)
-        element_forces[e] += change * element_stiffness_damping_force(mesh.rest[e], s, *elastic);
+        element_forces[e] += change * nominal_damping;
     }
   });
   VecX f = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));
@@ -306,6 +348,7 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
     s.states.resize(m);
     s.jt.resize(u, rows);
     s.outputs.resize(3, u_elastic);
+    s.gradients.resize(9, u_elastic);
     s.damping_row.resize(design.damping_unknowns());
     s.element_rows.resize(12, u);
     return s;
@@ -320,14 +363,22 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
       for (size_t i = first; i < last; ++i) {
         const int t = frames[i];
         element_states_range(mesh, positions[t], velocities[t], 0, m, s.states);
-        // Element e adds [G_e A_e, (−K_e v_e) d_e] (12 × u) to the rows of its free dofs: its
-        // nodal forces are G_e N + Δα₁ (−K_e v_e) = G_e A_e x_e + (−K_e v_e) d_e x_d.
+        // Element e adds [G_e A_e + α₁ D_e [A_e; ∂A_e/∂σ], (−K_e v_e) d_e] (12 × u) to the rows of
+        // its free dofs: its nodal forces are G_e N + α₁ (−K_e^N v_e) + Δα₁ (−K_e v_e), linear in x.
         s.jt.setZero();
         for (int e = 0; e < m; ++e) {
           const ElementState& st = s.states[e];
           const Eigen::Matrix<double, 12, 3> G = element_force_operator(mesh.rest[e], st.frame);
-          design.output_matrix(st.frame.stretches, s.outputs);
-          s.element_rows.leftCols(u_elastic).noalias() = G * s.outputs;
+          const double alpha1 = elastic != nullptr ? nominal_alpha1(mesh, st.frame.stretches) : 0.0;
+          if (alpha1 != 0) {
+            design.output_matrix(st.frame.stretches, s.outputs, s.gradients);
+            const Eigen::Matrix<double, 12, 12> D = alpha1 * element_stiffness_damping_operator(mesh.rest[e], st);
+            s.element_rows.leftCols(u_elastic).noalias() = (G + D.leftCols<3>()) * s.outputs;
+            s.element_rows.leftCols(u_elastic).noalias() += D.rightCols<9>() * s.gradients;
+          } else {
+            design.output_matrix(st.frame.stretches, s.outputs);
+            s.element_rows.leftCols(u_elastic).noalias() = G * s.outputs;
+          }
           if (u > u_elastic) {
             design.damping_row(st.frame.stretches, s.damping_row);
             s.element_rows.rightCols(u - u_elastic).noalias()

@@ -59,15 +59,24 @@ Eigen::Matrix<double, 12, 3> element_force_operator(
     const fem::TetRestData& rest, const material::PrincipalFrame& frame);
 
 /// The element's stiffness-damping force per unit α₁ [N·s]: −K_e v_e = −vol (dP/dF : Ḟ) g_a with
-/// dP/dF the PSD-projected tangent of the nominal model `elastic`, exactly as fem::ElasticForce
-/// applies α₁ + Δα₁. Local dofs ordered x0, y0, z0, x1, ….
+/// dP/dF the exact tangent of the nominal model `elastic`, exactly as fem::ElasticForce applies
+/// Δα₁. Local dofs ordered x0, y0, z0, x1, ….
 Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
     const material::ElasticModel& elastic);
 
+/// The element's stiffness-damping force per unit α₁ as a linear function of a principal stress
+/// and its stretch derivative: column c maps entry c of [p̂; vec(∂p̂/∂σ)] (3 + 9, column-major)
+/// to the nodal forces −vol (dP/dF : Ḟ) g_a of the exact tangent of p̂ [N·s per Pa]. Applied to
+/// an RBF unknown's output and gradient (RbfDesign::output_matrix) it gives that unknown's share
+/// of the nominal α₁'s action on the corrected stiffness (fem::ElasticForce).
+Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
+    const fem::TetRestData& rest, const ElementState& state);
+
 /// Nodal forces [N] (flat 3n) of a correction: what fem::ElasticForce gives with it minus without
-/// it, f = Σ_e B_e N(σ_e, ḟ_e) + [(α₁ + Δα₁)⁺ − α₁] (−K_e v_e) (Eq. 1's N term and Eq. 13's
-/// damping term; α₁ from mesh.nominal.damping). Without mesh.nominal.elastic only the N term.
-/// Parallel over elements.
+/// it, f = Σ_e B_e N(σ_e, ḟ_e) + α₁ (−(K_e − K_e^nom) v_e) + [(α₁ + Δα₁)⁺ − α₁] (−K_e^nom v_e)
+/// with K_e the corrected and K_e^nom the nominal stiffness (Eq. 1's N term, the nominal
+/// Rayleigh term on the corrected stiffness, and Eq. 13's damping term; α₁ from
+/// mesh.nominal.damping). Without mesh.nominal.elastic only the N term. Parallel over elements.
 VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
     const VecX& x, const VecX& v);
 
@@ -141,11 +150,12 @@ struct StressReconstructionResult {
 
 /// Find the unknowns x of `design` minimising (paper Eqs. 12–13)
 ///   Σ_t ‖restrict_free(F_t x) − restrict_free(g_t)‖²  + Tikhonov,
-/// F_t x = Σ_e G_e A_e x_e + (−K_e v_e) d_e x_d the nodal force of the correction with unknowns x
-/// at frame t (= correction_force while α₁ + Δα₁ ≥ 0), and g_t (target_forces[t], flat 3n, only
+/// F_t x = Σ_e (G_e A_e + α₁ D_e [A_e; ∂A_e/∂σ]) x_e + (−K_e v_e) d_e x_d the nodal force of the
+/// correction with unknowns x at frame t (= correction_force while α₁ + Δα₁ ≥ 0), and g_t (target_forces[t], flat 3n, only
 /// free dofs used) the force the new correction must produce (current correction force + control
-/// force). K_e is the nominal model's stiffness (element_stiffness_damping_force; needs
-/// `mesh.nominal.elastic` when the design fits damping). Tikhonov:
+/// force). D_e is element_stiffness_damping_operator, K_e the nominal model's stiffness
+/// (element_stiffness_damping_force); both need `mesh.nominal.elastic` (required when the design
+/// fits damping; without it the α₁ term is left out). Tikhonov:
 /// design.options().regularization on the Jacobi-scaled unknowns, as fit_rbf_correction.
 /// Method normal_equations: J_t (free dofs × q) is assembled per frame and JᵀJ accumulated by
 /// symmetric rank updates, in parallel over fixed blocks of frames summed in order

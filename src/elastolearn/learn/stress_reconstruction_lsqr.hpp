@@ -40,7 +40,8 @@ ElementStressResult reconstruct_element_stresses(const ReconstructionMesh& mesh,
 /// Frames run in parallel (oneTBB); the samples are stored in frame order, so the result does
 /// not depend on the thread count. `misfit` is the nodal-force misfit of the fitted correction,
 /// as for the direct method. Element stresses carry no stiffness-damping information, so this
-/// method fits the elastic part only (Δα₁ = 0). Same inputs and throws as
+/// method fits the elastic part only (Δα₁ = 0) and leaves out the nominal α₁'s action on the
+/// correction's stiffness. Same inputs and throws as
 /// reconstruct_rbf_correction.
 StressReconstructionResult reconstruct_rbf_correction_via_lsqr(const ReconstructionMesh& mesh,
     const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,

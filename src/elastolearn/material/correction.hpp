@@ -29,10 +29,14 @@ public:
     correction_gradient(stretches, stretch_rates, d_stretches, d_stretch_rates);
     return correction(stretches, stretch_rates);
   }
+  /// Whether N depends on the stretch rates at all (false lets the element loops reuse N(F̂, Ḟ̂)
+  /// as the elastic part N(F̂, 0)). Default: true.
+  virtual bool depends_on_rates() const { return true; }
   /// Δα₁(F̂) [s]: a correction of the element's Rayleigh stiffness-damping coefficient (paper
-  /// Eq. 13). The element's damping force becomes −(α₁ + Δα₁) K_e v_e with K_e the *nominal*
-  /// model's stiffness (fem::ElasticForce), so that the learned damping is linear in Δα₁ and
-  /// damps every deformation mode, not only the stretch rates. Default: none.
+  /// Eq. 13). The element's damping force becomes −α₁ K_e v_e − Δα₁ K_e^nom v_e with K_e the
+  /// corrected and K_e^nom the *nominal* model's stiffness (fem::ElasticForce), so that the
+  /// learned damping is linear in Δα₁ and damps every deformation mode, not only the stretch
+  /// rates. Default: none.
   virtual double stiffness_damping(const Vec3& /*stretches*/) const { return 0; }
   virtual std::unique_ptr<Correction> clone() const = 0;
 };

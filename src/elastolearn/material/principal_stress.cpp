@@ -17,19 +17,6 @@ namespace {
 /// both well below 1e-9 relative.
 constexpr double quotient_gap = 1e-5;
 
-/// Symmetrise a 3×3 matrix and clamp its negative eigenvalues to zero. A positive-definite
-/// matrix (all leading minors > 0, Sylvester) is its own projection: only the symmetric part is
-/// returned, skipping the eigensolver in the common case.
-Mat3 project_psd_3x3(const Mat3& A) {
-    const Mat3 S = 0.5 * (A + A.transpose());
-    const double minor2 = S(0, 0) * S(1, 1) - S(0, 1) * S(0, 1);
-    if (S(0, 0) > 0 && minor2 > 0 && S.determinant() > 0)
-        return S;
-    Eigen::SelfAdjointEigenSolver<Mat3> eig(S);
-    const Vec3 lambda = eig.eigenvalues().cwiseMax(0.0);
-    return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
-}
-
 /// Rows 0..C of column C of H = Y Mᵀ (fixed-size segments, so the loop vectorises).
 template <int C> inline void upper_column_of_product(const Mat9& Y, const Mat9& M, Mat9& H) {
     Eigen::Matrix<double, C + 1, 1> h = Y.col(0).template head<C + 1>() * M(C, 0);
@@ -39,6 +26,22 @@ template <int C> inline void upper_column_of_product(const Mat9& Y, const Mat9& 
 }
 
 } // namespace
+
+// A positive-definite matrix (all leading minors > 0, Sylvester) is its own projection: only the
+// symmetric part is returned, skipping the eigensolver in the common case.
+Mat3 symmetric_psd(const Mat3& A) {
+    const Mat3 S = 0.5 * (A + A.transpose());
+    const double minor2 = S(0, 0) * S(1, 1) - S(0, 1) * S(0, 1);
+    if (S(0, 0) > 0 && minor2 > 0 && S.determinant() > 0)
+        return S;
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(S);
+    const Vec3 lambda = eig.eigenvalues().cwiseMax(0.0);
+    return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+PrincipalTangent projected(const PrincipalTangent& t) {
+    return { symmetric_psd(t.block), t.twist.cwiseMax(0.0), t.flip.cwiseMax(0.0) };
+}
 
 PrincipalFrame principal_frame(const Mat3& F) { return svd3(F); }
 
@@ -57,7 +60,7 @@ PrincipalTangent principal_tangent(
     const PrincipalFrame& frame, const Vec3& P, const Mat3& dP, bool project_psd) {
     const Vec3& s = frame.stretches;
     PrincipalTangent t;
-    t.block = project_psd ? project_psd_3x3(dP) : dP;
+    t.block = project_psd ? symmetric_psd(dP) : dP;
     static constexpr int pairs[3][2] = { { 0, 1 }, { 0, 2 }, { 1, 2 } };
     for (int m = 0; m < 3; ++m) {
         const int i = pairs[m][0], j = pairs[m][1];
@@ -83,6 +86,16 @@ PrincipalTangent principal_tangent(
         t.flip[m] = flip;
     }
     return t;
+}
+
+PrincipalTangent damping_tangent(const PrincipalFrame& frame, const Vec3& P, const Mat3& dP) {
+    PrincipalTangent t = principal_tangent(frame, P, dP, false);
+    t.flip.setZero();
+    return t;
+}
+
+PrincipalTangent damping_tangent(const ElasticModel& model, const PrincipalFrame& frame) {
+    return damping_tangent(frame, model.principal_stress(frame.stretches), model.principal_stress_derivative(frame.stretches));
 }
 
 Mat9 first_piola_derivative(const PrincipalFrame& frame, const PrincipalTangent& t) {
@@ -172,6 +185,14 @@ CorrectedStress corrected_principal_stress(const ElasticModel& model, const Corr
         out.d_stretch_rates = dn_dr;
     }
     return out;
+}
+
+const CorrectedStress& elastic_part(const ElasticModel& model, const Correction* correction, const Vec3& stretches,
+                                    const CorrectedStress& at_rates, CorrectedStress& scratch) {
+    if (correction == nullptr || !correction->depends_on_rates())
+        return at_rates;
+    scratch = corrected_principal_stress(model, correction, stretches, Vec3::Zero());
+    return scratch;
 }
 
 Mat3 first_piola(const ElasticModel& model, const Mat3& F) {

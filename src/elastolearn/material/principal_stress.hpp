@@ -36,9 +36,20 @@ struct PrincipalTangent {
 };
 PrincipalTangent principal_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,
                                    const Mat3& principal_stress_derivative, bool project_psd);
+/// The tangent with its block made symmetric PSD and its twist and flip eigenvalues ≥ 0 (what
+/// `project_psd` does, for a tangent formed otherwise, e.g. as a weighted sum).
+PrincipalTangent projected(const PrincipalTangent& tangent);
+/// Symmetric part of a 3×3 matrix with its negative eigenvalues clamped to zero.
+Mat3 symmetric_psd(const Mat3& a);
 /// The same for an uncorrected model at the frame's stretches (e.g. the nominal stiffness that
 /// Rayleigh damping scales).
 PrincipalTangent principal_tangent(const ElasticModel& model, const PrincipalFrame& frame, bool project_psd);
+/// The stiffness that Rayleigh damping scales (fem::ElasticForce): the exact tangent of P̂ without
+/// its flip eigenvalues. Linear in (P̂, ∂P̂/∂σ).
+PrincipalTangent damping_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,
+                                 const Mat3& principal_stress_derivative);
+/// The same for an uncorrected model at the frame's stretches.
+PrincipalTangent damping_tangent(const ElasticModel& model, const PrincipalFrame& frame);
 /// The 9×9 dP/dF of an eigen-form tangent (symmetric if the tangent was projected).
 Mat9 first_piola_derivative(const PrincipalFrame& frame, const PrincipalTangent& tangent);
 /// dP = (dP/dF) : dF without forming the 9×9: dP = U dP̂ Vᵀ with, for dF̂ = Uᵀ dF V,
@@ -68,6 +79,12 @@ struct CorrectedStress {
 /// Evaluate P̂ + N at (σ, Ḟ̂). `correction` may be null.
 CorrectedStress corrected_principal_stress(const ElasticModel& model, const Correction* correction,
                                            const Vec3& stretches, const Vec3& stretch_rates);
+
+/// The elastic part P̂ + N(σ, 0) of a corrected stress evaluated at (σ, Ḟ̂): `at_rates` itself
+/// when N does not depend on the rates (Correction::depends_on_rates), else re-evaluated into
+/// `scratch`. The stress whose stiffness Rayleigh damping scales (fem::ElasticForce).
+const CorrectedStress& elastic_part(const ElasticModel& model, const Correction* correction, const Vec3& stretches,
+                                    const CorrectedStress& at_rates, CorrectedStress& scratch);
 
 /// Convenience for tests and tools: P(F) of a model (no correction).
 Mat3 first_piola(const ElasticModel& model, const Mat3& F);

@@ -36,6 +36,11 @@ Vec3 stretch_view(const Vec3& s, int k) {
   return {s[k], s[o[0]], s[o[1]]};
 }
 
+std::array<int, 3> stretch_view_indices(const Vec3& s, int k) {
+  const auto o = others_descending(s, k);
+  return {k, o[0], o[1]};
+}
+
 Eigen::Vector4d quadratic_tail_basis(const Vec3& y) {
   const double e = y[0] - 1, s = y[1] + y[2] - 2;
   return {e * e, e * s, s * s, (y[1] - 1) * (y[2] - 1)};

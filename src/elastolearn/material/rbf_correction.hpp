@@ -4,6 +4,7 @@
 /// of the Rayleigh stiffness-damping coefficient. Rationale and conventions: docs/learning.md.
 #include <elastolearn/material/correction.hpp>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -19,6 +20,8 @@ inline double rbf_kernel(double squared_distance, double epsilon) {
 /// The view of the stretches seen by principal direction k: y_k = (σ_k, max(σ_a, σ_b),
 /// min(σ_a, σ_b)) with a, b the other two directions. y_k is unchanged by swapping a and b.
 Vec3 stretch_view(const Vec3& stretches, int k);
+/// The stretch indices of stretch_view: y_k = (σ[i₀], σ[i₁], σ[i₂]) for i = stretch_view_indices(σ, k).
+std::array<int, 3> stretch_view_indices(const Vec3& stretches, int k);
 
 /// The quadratic tail's basis at a stretch view y: t(y) = (e², e s, s², p) with e = y₁ − 1,
 /// s = y₂ + y₃ − 2 and p = (y₂ − 1)(y₃ − 1), which span the quadratics in y − 1 symmetric in
@@ -81,6 +84,7 @@ public:
 
   /// Δα₁(σ) (its gradient is not needed: the Jacobian treats α₁ as constant, as for Rayleigh).
   double stiffness_damping(const Vec3& stretches) const override;
+  bool depends_on_rates() const override { return false; }
 
   /// (h(y_1), h(y_2), h(y_3)) [Pa], the same as correction(stretches, ·).
   Vec3 elastic_correction(const Vec3& stretches) const;
