@@ -95,3 +95,24 @@ TEST(FirstPiolaDerivative, UsesColumnMajorVecOnBothSides) {
     EXPECT_NEAR(cubic(i01, i01), s[0] * s[0] + s[1] * s[1], 1e-13);
     EXPECT_NEAR(cubic(0, 0), 3 * s[0] * s[0], 1e-13);
 }
+
+TEST(DampingTangent, IsTheExactTangentWithoutItsFlipPart) {
+    // Rayleigh damping's stiffness (fem::ElasticForce): exact block and twist, no flip, and no
+    // projection, so that it is linear in the stress (the stress reconstruction relies on that).
+    const PrincipalFrame frame = principal_frame(rotated_stretch(Vec3(1.2, 0.9, 0.75), 7));
+    const Vec3 p1(3e3, -1e3, -4e3), p2(-2e3, 5e2, 1e3);
+    Mat3 d1, d2;
+    d1 << 5e4, 1e4, -2e4, 3e3, 4e4, 1e4, -1e4, 2e4, 6e4; // not symmetric (as an RBF's ∂N/∂σ)
+    d2 << -3e4, 2e3, 1e3, 5e3, -2e4, 0, 1e3, 4e3, -1e4;
+    const PrincipalTangent exact = principal_tangent(frame, p1, d1, false);
+    const PrincipalTangent t1 = damping_tangent(frame, p1, d1);
+    EXPECT_EQ(t1.block, exact.block);
+    EXPECT_EQ(t1.twist, exact.twist);
+    EXPECT_EQ(t1.flip, Vec3::Zero());
+    // Linear: T(a p1 + b p2) = a T(p1) + b T(p2), including the negative (unprojected) parts.
+    const PrincipalTangent t2 = damping_tangent(frame, p2, d2);
+    const PrincipalTangent sum = damping_tangent(frame, 2 * p1 - 3 * p2, 2 * d1 - 3 * d2);
+    EXPECT_LE((sum.block - (2 * t1.block - 3 * t2.block)).norm(), 1e-9 * sum.block.norm());
+    EXPECT_LE((sum.twist - (2 * t1.twist - 3 * t2.twist)).norm(), 1e-9 * sum.twist.norm());
+    EXPECT_LT(t2.block.minCoeff(), 0.0); // the test does exercise an indefinite tangent
+}
