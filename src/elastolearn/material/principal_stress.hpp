@@ -41,8 +41,7 @@ PrincipalTangent principal_tangent(const PrincipalFrame& frame, const Vec3& prin
 PrincipalTangent projected(const PrincipalTangent& tangent);
 /// Symmetric part of a 3×3 matrix with its negative eigenvalues clamped to zero.
 Mat3 symmetric_psd(const Mat3& a);
-/// The same for an uncorrected model at the frame's stretches (e.g. the nominal stiffness that
-/// Rayleigh damping scales).
+/// The same for an uncorrected model at the frame's stretches.
 PrincipalTangent principal_tangent(const ElasticModel& model, const PrincipalFrame& frame, bool project_psd);
 /// The stiffness that Rayleigh damping scales (fem::ElasticForce): the exact tangent of P̂ without
 /// its flip eigenvalues. Linear in (P̂, ∂P̂/∂σ).

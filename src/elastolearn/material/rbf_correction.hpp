@@ -45,8 +45,8 @@ Eigen::Vector4d quadratic_tail_basis(const Vec3& y);
 /// strain, which it extrapolates beyond the stretches seen in training, where the kernels'
 /// linear growth cannot.
 /// Δα₁ is the stiffness-damping correction (Correction::stiffness_damping): the element's
-/// Rayleigh damping force becomes −(α₁ + Δα₁) K_e v_e, K_e the nominal model's stiffness, as
-/// in paper Eq. (13). A positive Δα₁ adds damping; the floor f (damping_floor) bounds how much
+/// Rayleigh damping force becomes −α₁ K_e v_e − Δα₁ K_e^nom v_e, K_e the corrected and K_e^nom
+/// the nominal model's stiffness, as in paper Eq. (13) (fem::ElasticForce). A positive Δα₁ adds damping; the floor f (damping_floor) bounds how much
 /// it may remove (fem::ElasticForce also keeps α₁ + Δα₁ ≥ 0).
 /// N does not depend on the stretch rates. `correction`, `correction_gradient` and
 /// `stiffness_damping` are exact (subgradients at ties of max/min and, for ε = 0, at a centre),
