@@ -74,7 +74,7 @@ bool g_no_fit = false;     ///< --no-fit: skip the parameter-fit baseline (for t
 /// Overrides of the learning options for every case (−1: keep the case's).
 int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1;
 long g_seed = -1;
-double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1;
+double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1, g_kernel_smoothing = -1;
 bool g_linear_tail = false, g_full_space = false, g_no_damping = false, g_pod_forward_only = false;
 
 void apply_overrides(learn::LearningOptions& o) {
@@ -84,6 +84,7 @@ void apply_overrides(learn::LearningOptions& o) {
   if (g_patience > 0) o.patience = g_patience;
   if (g_seed >= 0) o.seed = static_cast<std::uint64_t>(g_seed);
   if (g_regularization >= 0) o.rbf.regularization = g_regularization;
+  if (g_kernel_smoothing >= 0) o.rbf.epsilon = g_kernel_smoothing;
   if (g_damping_regularization >= 0) o.rbf.damping_regularization = g_damping_regularization;
   if (g_linear_tail) o.rbf.quadratic_tail = false;
   if (g_full_space) o.full_space = true;
@@ -251,6 +252,7 @@ int main(int argc, char** argv) {
     else if (a == "--patience" && i + 1 < argc) g_patience = std::stoi(argv[++i]);
     else if (a == "--seed" && i + 1 < argc) g_seed = std::stol(argv[++i]);
     else if (a == "--regularization" && i + 1 < argc) g_regularization = std::stod(argv[++i]);
+    else if (a == "--kernel-smoothing" && i + 1 < argc) g_kernel_smoothing = std::stod(argv[++i]);
     else if (a == "--damping-regularization" && i + 1 < argc) g_damping_regularization = std::stod(argv[++i]);
     else if (a == "--linear-tail") g_linear_tail = true;
     else if (a == "--full-space") g_full_space = true;
@@ -259,7 +261,7 @@ int main(int argc, char** argv) {
     else if (a == "--position-weight" && i + 1 < argc) g_position_weight = std::stod(argv[++i]);
     else if (a == "--data" && i + 1 < argc) data = argv[++i];
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--seed S] [--regularization L] [--damping-regularization L] [--linear-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [CASE ...]\ncases:");
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [CASE ...]\ncases:");
       for (const auto& n : kCases) std::printf(" %s", n.c_str());
       std::printf(" (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
                   "data/meshes are (extracted there if missing)\n");

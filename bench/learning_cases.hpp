@@ -175,12 +175,16 @@ inline LearningCase dragon(const fs::path& data, bool quick) {
 
 /// Sphere with its top cap keyframed up and down (sinusoid), its bottom cap fixed; the truth is a
 /// spline-edited neo-Hookean (tension or compression edited), α₁ 0.2 as in paper 000 Table 1.
+/// Radius 1.5 m: at 0.2 m the keyframes prescribe the shape and any stiffness gives nearly the
+/// same motion (nominal test err_L 0.63 / 0.37 %, under the target without learning); at 1.5 m
+/// gravity and inertia let the stiffness show (quick mesh: 3.73 / 2.25 %). At 2 m the
+/// compression case learned nothing (its first correction overshot). docs/benchmarks_learning.md.
 inline LearningCase sphere(bool compression, bool quick) {
   LearningCase c;
   c.name = compression ? "sphere-compression" : "sphere-tension";
-  const double radius = 0.2;
+  const double radius = 1.5;
   auto mesh = mesh::make_sphere(radius, quick ? 2000 : 12712);
-  c.mesh_label = "ball r 0.2 m → " + std::to_string(mesh.num_tets()) + " tets";
+  c.mesh_label = "ball r 1.5 m → " + std::to_string(mesh.num_tets()) + " tets";
   const auto lame = material::Lame::from_young_poisson(1e5, 0.43);
   auto spline = compression
                     ? material::CubicSpline({0.7, 0.85, 1.0}, {0.3, 0.6, 1.0}, "compression edit")
