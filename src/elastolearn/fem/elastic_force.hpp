@@ -25,18 +25,18 @@ struct MaterialModel {
 /// Elastic (+correction) and Rayleigh damping forces of all tets, with their Jacobians.
 ///
 /// Per element: F = Σ x_a g_aᵀ, SVD F = U F̂ Vᵀ, P = U (P̂ + N) Vᵀ, f_a = −vol P g_a;
-/// K_e = vol Bᵀ (dP/dF) B of the corrected model (exact in the damping force, clamped PSD in the
-/// Jacobian); damping force
+/// K_e = vol Bᵀ (dP/dF) B of the corrected model (clamped PSD in the Jacobian); damping force
 ///   −α₁ K_e v_e − Δα₁ K_e^nom v_e − α₀ (ρ vol/4) v_e
 /// with (α₀, α₁) the damping model's, from the element's largest stretch: the nominal Rayleigh
 /// term acts on the *corrected* stiffness (a material whose elasticity is learned right is damped
 /// as its own Rayleigh damping would), while the learned Δα₁ = Correction::stiffness_damping(F̂)
 /// (paper Eq. 13; α₁ + Δα₁ kept ≥ 0) scales the nominal stiffness K_e^nom, so that the damping
-/// force stays linear in the correction's unknowns (learn::reconstruct_rbf_correction). Without
-/// a correction both stiffnesses are the model's. The damping force uses the exact tangent; the
-/// PSD projection is applied to the Jacobian only (a projected tangent in the force would
-/// make it nonlinear in the correction, and the learned correction diverged with it: measured in
-/// docs/learning.md). The correction's rate dependence adds
+/// force stays linear in the correction's unknowns (learn::reconstruct_rbf_correction). α₁'s
+/// K_e is material::damping_tangent of P̂ + N(σ, 0): exact, without its flip part, unprojected
+/// (a projected one would make the force nonlinear in the correction, and the learned correction
+/// diverged with it; measured in docs/learning.md, "Damping part"). Δα₁'s K_e^nom is the
+/// nominal's PSD-projected tangent (independent of the unknowns). The correction's rate
+/// dependence adds
 /// D_e = vol Bᵀ ∂P/∂Ḟ B
 /// (symmetrised, clamped PSD). The Jacobian drops ∂K/∂x·v (Rayleigh) and the variation of
 /// Ḟ̂ through U, V (correction): standard, and the residual is still exact.
@@ -71,7 +71,7 @@ private:
     /// A correction's Δα₁ as applied: (α₁ + Δα₁)⁺ − α₁ ≥ −α₁ (0 without a correction).
     double alpha1_change = 0;
     material::PrincipalTangent tangent; ///< material::damping_tangent of P̂ + N; valid if has_tangent
-    material::PrincipalTangent nominal_tangent; ///< material::damping_tangent of P̂; valid if alpha1_change ≠ 0
+    material::PrincipalTangent nominal_tangent; ///< dP/dF of P̂ (projected unless disabled); valid if alpha1_change ≠ 0
     bool has_tangent = false;
   };
   bool cache_matches(const ForceState& state) const;

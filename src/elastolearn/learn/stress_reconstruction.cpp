@@ -128,7 +128,7 @@ Vec12 stiffness_damping_force(
 
 Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
     const material::ElasticModel& elastic) {
-  return stiffness_damping_force(rest, state, material::damping_tangent(elastic, state.frame));
+  return stiffness_damping_force(rest, state, material::principal_tangent(elastic, state.frame, true));
 }
 
 Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
@@ -181,16 +181,16 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
       const double change = material::corrected_stiffness_damping(alpha1, &correction, s.frame.stretches) - alpha1;
       if (alpha1 == 0 && change == 0)
         continue;
-      const Vec12 nominal_damping = element_stiffness_damping_force(mesh.rest[e], s, *elastic);
       if (alpha1 != 0) {
         material::CorrectedStress scratch;
         const material::CorrectedStress& elastic_stress
             = material::elastic_part(*elastic, &correction, s.frame.stretches, total, scratch);
         element_forces[e] += alpha1 * (stiffness_damping_force(mesh.rest[e], s,
-            material::damping_tangent(s.frame, elastic_stress.stress, elastic_stress.d_stretches)) - nominal_damping);
+            material::damping_tangent(s.frame, elastic_stress.stress, elastic_stress.d_stretches))
+            - stiffness_damping_force(mesh.rest[e], s, material::damping_tangent(*elastic, s.frame)));
       }
       if (change != 0)
-        element_forces[e] += change * nominal_damping;
+        element_forces[e] += change * element_stiffness_damping_force(mesh.rest[e], s, *elastic);
     }
   });
   VecX f = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));
