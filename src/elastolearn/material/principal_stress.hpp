@@ -36,13 +36,13 @@ struct PrincipalTangent {
 };
 PrincipalTangent principal_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,
                                    const Mat3& principal_stress_derivative, bool project_psd);
+/// The same for an uncorrected model at the frame's stretches.
+PrincipalTangent principal_tangent(const ElasticModel& model, const PrincipalFrame& frame, bool project_psd);
 /// The tangent with its block made symmetric PSD and its twist and flip eigenvalues ≥ 0 (what
 /// `project_psd` does, for a tangent formed otherwise, e.g. as a weighted sum).
 PrincipalTangent projected(const PrincipalTangent& tangent);
 /// Symmetric part of a 3×3 matrix with its negative eigenvalues clamped to zero.
 Mat3 symmetric_psd(const Mat3& a);
-/// The same for an uncorrected model at the frame's stretches.
-PrincipalTangent principal_tangent(const ElasticModel& model, const PrincipalFrame& frame, bool project_psd);
 /// The stiffness that Rayleigh damping scales (fem::ElasticForce): the exact tangent of P̂ without
 /// its flip eigenvalues. Linear in (P̂, ∂P̂/∂σ).
 PrincipalTangent damping_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,

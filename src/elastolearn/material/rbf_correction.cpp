@@ -31,14 +31,14 @@ std::array<int, 2> others_descending(const Vec3& s, int k) {
 
 } // namespace
 
-Vec3 stretch_view(const Vec3& s, int k) {
-  const auto o = others_descending(s, k);
-  return {s[k], s[o[0]], s[o[1]]};
-}
-
 std::array<int, 3> stretch_view_indices(const Vec3& s, int k) {
   const auto o = others_descending(s, k);
   return {k, o[0], o[1]};
+}
+
+Vec3 stretch_view(const Vec3& s, int k) {
+  const auto i = stretch_view_indices(s, k);
+  return {s[i[0]], s[i[1]], s[i[2]]};
 }
 
 Eigen::Vector4d quadratic_tail_basis(const Vec3& y) {
@@ -113,12 +113,10 @@ Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& 
   Vec3 n;
   d_stretches.setZero();
   for (int k = 0; k < 3; ++k) {
-    const auto o = others_descending(stretches, k);
+    const auto i = stretch_view_indices(stretches, k);
     Vec3 d_y;
-    n[k] = elastic_view(Vec3(stretches[k], stretches[o[0]], stretches[o[1]]), &d_y);
-    d_stretches(k, k) += d_y[0];
-    d_stretches(k, o[0]) += d_y[1];
-    d_stretches(k, o[1]) += d_y[2];
+    n[k] = elastic_view(Vec3(stretches[i[0]], stretches[i[1]], stretches[i[2]]), &d_y);
+    for (int c = 0; c < 3; ++c) d_stretches(k, i[c]) += d_y[c];
   }
   d_stretch_rates.setZero();
   return n;
