@@ -74,8 +74,9 @@ bool g_no_fit = false;     ///< --no-fit: skip the parameter-fit baseline (for t
 /// Overrides of the learning options for every case (−1: keep the case's).
 int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1;
 long g_seed = -1;
-double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1, g_kernel_smoothing = -1;
-bool g_linear_tail = false, g_full_space = false, g_no_damping = false, g_pod_forward_only = false;
+double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1, g_kernel_smoothing = -1,
+       g_full_space_weight = -1;
+bool g_linear_tail = false, g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false;
 
 void apply_overrides(learn::LearningOptions& o) {
   if (g_modes > 0) o.pod.max_modes = g_modes;
@@ -91,6 +92,8 @@ void apply_overrides(learn::LearningOptions& o) {
   if (g_pod_forward_only) o.pod_with_constrained = false;
   if (g_no_damping) o.rbf.fit_damping = false;
   if (g_position_weight > 0) o.space_time.position_weight = g_position_weight;
+  if (g_unprojected) o.projected_reconstruction = false;
+  if (g_full_space_weight >= 0) o.reconstruction.full_space_weight = g_full_space_weight;
 }
 
 Row run_case(const LearningCase& c) {
@@ -259,9 +262,11 @@ int main(int argc, char** argv) {
     else if (a == "--pod-forward-only") g_pod_forward_only = true;
     else if (a == "--no-damping") g_no_damping = true;
     else if (a == "--position-weight" && i + 1 < argc) g_position_weight = std::stod(argv[++i]);
+    else if (a == "--unprojected-reconstruction") g_unprojected = true;
+    else if (a == "--full-space-weight" && i + 1 < argc) g_full_space_weight = std::stod(argv[++i]);
     else if (a == "--data" && i + 1 < argc) data = argv[++i];
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [CASE ...]\ncases:");
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
       for (const auto& n : kCases) std::printf(" %s", n.c_str());
       std::printf(" (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
                   "data/meshes are (extracted there if missing)\n");

@@ -213,6 +213,11 @@ void add_learn_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--frame-stride", l.reconstruction.frame_stride, "use every k-th frame in the reconstruction")
       ->capture_default_str();
+  cmd->add_flag("!--unprojected-reconstruction", l.projected_reconstruction,
+                "fit the control forces at every free dof alike (default: mainly within the POD basis)");
+  cmd->add_option("--full-space-weight", l.reconstruction.full_space_weight,
+                  "weight of the misfit outside the POD basis in the projected reconstruction")
+      ->capture_default_str();
   cmd->add_flag("--no-damping", o->no_damping, "do not learn the damping correction");
   cmd->add_flag("--linear-tail", o->linear_tail, "RBF with a linear polynomial tail only (default: quadratic)");
   cmd->add_option("--damping-regularization", l.rbf.damping_regularization,

@@ -103,7 +103,9 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
                    {"regularization", o.rbf.regularization},
                    {"damping_regularization", o.rbf.damping_regularization}}},
           {"reconstruction", {{"method", learn::reconstruction_method_name(o.reconstruction.method)},
-                              {"frame_stride", o.reconstruction.frame_stride}}},
+                              {"frame_stride", o.reconstruction.frame_stride},
+                              {"projected", o.projected_reconstruction},
+                              {"full_space_weight", o.reconstruction.full_space_weight}}},
           {"stretch_samples", {{"frame_stride", o.stretch_samples.frame_stride},
                                {"max_samples", o.stretch_samples.max_samples}}},
           {"seed", o.seed}};

@@ -49,6 +49,14 @@ struct LearningOptions {
   int centres = 40;       ///< RBF kernels m (k-means clusters)
   RbfFitOptions rbf;      ///< ε, polynomial tails, damping part, regularisation
   StressReconstructionOptions reconstruction;
+  /// Fit the correction's nodal forces to the control forces mainly within span Φ (the POD basis),
+  /// where the reduced space-time optimisation controls the residual, instead of at every free
+  /// dof (reconstruction.full_space_weight weighs the rest). The residual outside span Φ is
+  /// left by the reduced trajectory's small strain errors, which grow as the mesh is refined,
+  /// and fitting it made the first correction overshoot (docs/learning.md, "Projected
+  /// reconstruction"). Not used by the full-space variant (there span Φ is everything) nor by
+  /// the lsqr reconstruction method.
+  bool projected_reconstruction = true;
   /// Use at most this many frames in the reconstruction (a larger frame stride when there are
   /// more; 0 = all). Consecutive frames are nearly the same equations: 150 keep the fit's
   /// information at a fraction of the cost on long, finely stepped runs.

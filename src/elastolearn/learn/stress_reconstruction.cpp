@@ -63,6 +63,8 @@ struct AssemblyScratch {
   Eigen::RowVectorXd damping_row;              ///< d_e: damping unknowns
   Eigen::Matrix<double, 12, Eigen::Dynamic> element_rows; ///< [G_e A_e, (−K_e v_e) d_e]
   VecX target;
+  MatX projected_jt; ///< Jᵀ P: unknowns × r (with a projection)
+  VecX projected_target; ///< Pᵀ g (with a projection)
 };
 
 /// Per-block sums (a block is a fixed range of frames, so the result is thread-count independent).
@@ -254,6 +256,8 @@ void StressReconstructionOptions::validate() const {
     fail("lsqr_tolerance", "must be finite and > 0, got " + str(lsqr_tolerance));
   if (lsqr_max_iterations < 0)
     fail("lsqr_max_iterations", "must be ≥ 0, got " + str(lsqr_max_iterations));
+  if (!std::isfinite(full_space_weight) || full_space_weight < 0)
+    fail("full_space_weight", "must be finite and ≥ 0, got " + str(full_space_weight));
 }
 
 namespace detail {
@@ -319,8 +323,11 @@ ForceMisfit correction_force_misfit(const ReconstructionMesh& mesh, const fem::D
 StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& mesh,
     const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
     const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
-    const StressReconstructionOptions& options) {
+    const StressReconstructionOptions& options, ConstRef<MatX> projection) {
   options.validate();
+  const bool projected = projection.size() > 0;
+  if (projected && options.method == ReconstructionMethod::lsqr)
+    fail("method", "the lsqr method has no force projection: use normal_equations");
   if (options.method == ReconstructionMethod::lsqr)
     return reconstruct_rbf_correction_via_lsqr(
         mesh, dofs, design, positions, velocities, target_forces, options);
@@ -328,6 +335,9 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
   const int rows = dofs.num_free();
   if (rows == 0)
     fail("dofs", "no free degree of freedom");
+  if (projected && (projection.rows() != rows || !projection.allFinite()))
+    fail("projection", "must have one finite row per free dof (" + str(rows) + "), got "
+        + str(projection.rows()));
   const material::ElasticModel* elastic = mesh.nominal.elastic.get();
   if (design.damping_unknowns() > 0 && elastic == nullptr)
     fail("nominal", "fitting the damping correction needs the nominal elastic model");
@@ -351,6 +361,8 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
     s.gradients.resize(9, u_elastic);
     s.damping_row.resize(design.damping_unknowns());
     s.element_rows.resize(12, u);
+    s.projected_jt.resize(u, projection.cols());
+    s.projected_target.resize(projection.cols());
     return s;
   });
   tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
@@ -390,8 +402,19 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
           }
         }
         dofs.restrict_into(target_forces[t], s.target);
-        sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.jt);
-        sum.rhs.noalias() += s.jt * s.target;
+        if (projected) {
+          s.projected_jt.noalias() = s.jt * projection;
+          s.projected_target.noalias() = projection.transpose() * s.target;
+          sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.projected_jt);
+          sum.rhs.noalias() += s.projected_jt * s.projected_target;
+          if (options.full_space_weight > 0) {
+            sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.jt, options.full_space_weight);
+            sum.rhs.noalias() += options.full_space_weight * (s.jt * s.target);
+          }
+        } else {
+          sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.jt);
+          sum.rhs.noalias() += s.jt * s.target;
+        }
       }
     }
   });

@@ -115,6 +115,11 @@ struct StressReconstructionOptions {
   double lsqr_tolerance = 1e-8;
   /// … or after this many iterations (≥ 0; 0 = 2 × the number of element stresses).
   int lsqr_max_iterations = 0;
+  /// With a force projection P (reconstruct_rbf_correction's `projection`): the weight μ ≥ 0 of
+  /// the unprojected misfit next to the projected one. μ = 0 leaves the correction's forces
+  /// outside span P unconstrained, and learned corrections then blew up on larger test motions
+  /// (quick sphere-tension: test simulation diverged at μ = 0.01, 0.535 % err_L at μ = 0.1).
+  double full_space_weight = 0.1;
   /// Throws InputError("stress_reconstruction.<field>", ...) for an out-of-range field.
   void validate() const;
 };
@@ -151,6 +156,11 @@ struct StressReconstructionResult {
 
 /// Find the unknowns x of `design` minimising (paper Eqs. 12–13)
 ///   Σ_t ‖restrict_free(F_t x) − restrict_free(g_t)‖²  + Tikhonov,
+/// or, with a force projection P (`projection`: free dofs × r, orthonormal columns, e.g. the
+/// space-time optimisation's POD basis on the free dofs; empty = none),
+///   Σ_t ‖Pᵀ r_t‖² + μ Σ_t ‖r_t‖²  + Tikhonov,   r_t = restrict_free(F_t x − g_t),
+/// with μ = options.full_space_weight: the misfit is measured mainly where the reduced
+/// space-time optimisation controls the residual (docs/learning.md, "Projected reconstruction"),
 /// F_t x = Σ_e (G_e A_e + α₁ D_e [A_e; ∂A_e/∂σ]) x_e + (−K_e v_e) d_e x_d the nodal force of the
 /// correction with unknowns x at frame t (= correction_force while α₁ + Δα₁ ≥ 0), and g_t (target_forces[t], flat 3n, only
 /// free dofs used) the force the new correction must produce (current correction force + control
@@ -163,12 +173,13 @@ struct StressReconstructionResult {
 /// (deterministic for any thread count); then dense Cholesky. Method lsqr:
 /// reconstruct_rbf_correction_via_lsqr.
 /// Throws InputError if the frame lists differ in length or are empty, a vector is not 3n long
-/// or not finite, the DofMap has not 3n dofs or no free dof, the options are invalid, or the
-/// regularised normal matrix is singular.
+/// or not finite, the DofMap has not 3n dofs or no free dof, the options are invalid, the
+/// projection has not one row per free dof (or is combined with the lsqr method), or the
+/// regularised normal matrix is singular. The reported misfit is always the unprojected one.
 StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& mesh,
     const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
     const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
-    const StressReconstructionOptions& options = {});
+    const StressReconstructionOptions& options = {}, ConstRef<MatX> projection = MatX());
 
 namespace detail {
 /// Input checks shared by the reconstruction entry points (throws InputError).
