@@ -266,6 +266,9 @@ TEST(StressReconstruction, ProjectedFitIgnoresTargetForcesOutsideTheProjection) 
   EXPECT_THROW(reconstruct_rbf_correction(k.geometry, k.dofs, k.design, k.frames.positions,
                    k.frames.velocities, k.targets, o, projection),
       InputError);
+  StressReconstructionOptions negative;
+  negative.full_space_weight = -0.1;
+  EXPECT_THROW(negative.validate(), InputError);
 }
 
 TEST(StressReconstruction, RejectsInconsistentFrames) {
