@@ -244,10 +244,8 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
                      (scene.frames + options.max_reconstruction_frames - 1) / options.max_reconstruction_frames);
       MatX projection; // Φ on the free dofs
       if (options.projected_reconstruction && !options.full_space &&
-          options.reconstruction.method == ReconstructionMethod::normal_equations) {
-        projection.resize(physics.dofs().num_free(), basis.num_modes());
-        for (int k = 0; k < basis.num_modes(); ++k) projection.col(k) = physics.dofs().restrict(basis.modes.col(k));
-      }
+          options.reconstruction.method == ReconstructionMethod::normal_equations)
+        projection = basis.modes(physics.dofs().free_dofs(), Eigen::all);
       const StressReconstructionResult reconstructed = reconstruct_rbf_correction(
           reconstruction_mesh, physics.dofs(), design, without_first(optimized.positions), without_first(velocities),
           without_first(targets), reconstruction_options, projection);

@@ -326,6 +326,7 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
     const StressReconstructionOptions& options, ConstRef<MatX> projection) {
   options.validate();
   const bool projected = projection.size() > 0;
+  const double full_weight = projected ? options.full_space_weight : 1.0; // of the unprojected misfit
   if (projected && options.method == ReconstructionMethod::lsqr)
     fail("method", "the lsqr method has no force projection: use normal_equations");
   if (options.method == ReconstructionMethod::lsqr)
@@ -407,13 +408,10 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
           s.projected_target.noalias() = projection.transpose() * s.target;
           sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.projected_jt);
           sum.rhs.noalias() += s.projected_jt * s.projected_target;
-          if (options.full_space_weight > 0) {
-            sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.jt, options.full_space_weight);
-            sum.rhs.noalias() += options.full_space_weight * (s.jt * s.target);
-          }
-        } else {
-          sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.jt);
-          sum.rhs.noalias() += s.jt * s.target;
+        }
+        if (full_weight > 0) {
+          sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.jt, full_weight);
+          sum.rhs.noalias() += full_weight * (s.jt * s.target);
         }
       }
     }
