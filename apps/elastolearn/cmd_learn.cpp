@@ -198,6 +198,9 @@ void add_learn_command(CLI::App& root) {
   auto& l = o->learning;
   cmd->add_option("--max-iterations", l.max_iterations, "corrections computed at most")->capture_default_str();
   cmd->add_option("--patience", l.patience, "stop after this many iterations without improvement")->capture_default_str();
+  cmd->add_option("--free-halvings", l.free_halvings,
+                  "diverging corrections in a row halved towards the best one before patience counts them")
+      ->capture_default_str();
   cmd->add_option("--modes", l.pod.max_modes, "POD modes r of the space-time optimisation")->capture_default_str();
   cmd->add_option("--pod-stride", l.pod.frame_stride, "use every k-th frame for POD")->capture_default_str();
   cmd->add_flag("--full-space", l.full_space, "no reduction (Φ = identity): small meshes only");

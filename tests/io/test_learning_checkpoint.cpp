@@ -88,8 +88,11 @@ TEST(LearningCheckpoint, RefusesACheckpointOfOtherInputs) {
   Fixture f;
   learn::LearningState state;
   state.next_iteration = 3;
+  state.divergences_in_a_row = 2;
   write_learning_checkpoint(f.file, f.inputs, state);
-  EXPECT_EQ(read_learning_checkpoint(f.file, f.inputs).next_iteration, 3);
+  const learn::LearningState read = read_learning_checkpoint(f.file, f.inputs);
+  EXPECT_EQ(read.next_iteration, 3);
+  EXPECT_EQ(read.divergences_in_a_row, 2);
   auto other = f.inputs;
   other.scene = "other.json";
   EXPECT_THROW(read_learning_checkpoint(f.file, other), InputError);

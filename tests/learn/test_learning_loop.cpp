@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 
 namespace elastolearn::learn {
@@ -140,6 +141,39 @@ TEST(LearningLoop, FullSpaceVariantLearnsOnASmallMesh) {
   options.max_full_space_dofs = 50;
   LearningState refused;
   EXPECT_THROW(run_learning(small(nominal, false), observed, options, refused), InputError);
+}
+
+TEST(LearningLoop, DivergingCorrectionsAreHalvedBeforePatienceCountsThem) {
+  // Resume at iteration 1 with a correction whose simulation diverges: a uniaxial softening of
+  // 40× the nominal's stiffness (E = 1e6 Pa), so that ½ and ¼ of it diverge as well. The first
+  // `free_halvings` divergences in a row are halved without counting against patience (1 here).
+  const auto material = make_material(material::ElasticModelType::Corotated, 1e6);
+  auto scene = bar_scene(material, false);
+  scene.frames = 20;
+  const auto observed = observe_surface(scene);
+  material::RbfCorrection::Parameters p;
+  p.centres.resize(0, 3);
+  p.own_slope = -40e6;
+  const auto unstable = std::make_shared<material::RbfCorrection>(p);
+  for (const int free_halvings : {0, 2}) {
+    LearningOptions options = small_options();
+    options.patience = 1;
+    options.free_halvings = free_halvings;
+    LearningState state;
+    state.next_iteration = 1;
+    state.correction = unstable;
+    state.best_error = 1.0; // the nominal's, say; nothing below will beat it
+    state.best_iteration = 0;
+    ASSERT_TRUE(run_learning(scene, observed, options, state));
+    ASSERT_EQ(state.history.size(), static_cast<size_t>(free_halvings + 1)) << "free_halvings " << free_halvings;
+    for (const IterationRecord& r : state.history) EXPECT_FALSE(r.forward_completed);
+    EXPECT_EQ(state.divergences_in_a_row, free_halvings + 1);
+    EXPECT_EQ(state.iterations_without_improvement, 1);
+    EXPECT_TRUE(state.finished);
+    // The last correction tried is 2^-free_halvings of the first (the best is the nominal).
+    const double scale = std::ldexp(1.0, -free_halvings);
+    EXPECT_NEAR(state.correction->parameters().own_slope, scale * p.own_slope, 1e-9 * std::abs(p.own_slope));
+  }
 }
 
 TEST(LearningLoop, TruthEqualToNominalLearnsAlmostNothing) {

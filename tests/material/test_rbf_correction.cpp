@@ -262,3 +262,19 @@ TEST(RbfCorrection, BlendIsTheWeightedSumOfTwoCorrections) {
   const RbfCorrection smoother(pb);
   EXPECT_THROW(blend(a, &smoother, 0.5), InputError);
 }
+
+TEST(RbfCorrection, RepeatedBlendsWithTheSameCorrectionKeepSharedCentresOnce) {
+  // The loop's damped updates: C' = ½ (C + best), then ½ (C' + best) = ¼ C + ¾ best, ...
+  RbfCorrection::Parameters pc = test_parameters(1e-3), pbest = test_parameters(1e-3);
+  pbest.centres.array() += 0.03;
+  pbest.weights *= 0.4;
+  pbest.damping_weights *= -2;
+  const RbfCorrection c(pc), best(pbest);
+  const RbfCorrection quarter = blend(blend(c, &best, 0.5), &best, 0.5);
+  EXPECT_EQ(quarter.num_centres(), c.num_centres() + best.num_centres());
+  for (const Vec3& s : { Vec3(1.2, 1.0, 0.9), Vec3(0.95, 0.9, 0.8), Vec3(1.1, 1.1, 1.0) }) {
+    const Vec3 want = 0.25 * c.correction(s, Vec3::Zero()) + 0.75 * best.correction(s, Vec3::Zero());
+    EXPECT_LE((quarter.correction(s, Vec3::Zero()) - want).norm(), 1e-12 * want.norm());
+    EXPECT_NEAR(quarter.stiffness_damping(s), 0.25 * c.stiffness_damping(s) + 0.75 * best.stiffness_damping(s), 1e-14);
+  }
+}

@@ -87,6 +87,7 @@ nlohmann::json iteration_record_to_json(const learn::IterationRecord& r) {
 nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
   return {{"max_iterations", o.max_iterations},
           {"patience", o.patience},
+          {"free_halvings", o.free_halvings},
           {"pod", {{"max_modes", o.pod.max_modes}, {"energy_fraction", o.pod.energy_fraction},
                    {"first_frame", o.pod.first_frame}, {"frame_count", o.pod.frame_count},
                    {"frame_stride", o.pod.frame_stride}, {"mass_orthonormal", o.pod.mass_orthonormal},
@@ -125,6 +126,7 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
         {"best_error", state.best_error},
         {"best_iteration", state.best_iteration},
         {"iterations_without_improvement", state.iterations_without_improvement},
+        {"divergences_in_a_row", state.divergences_in_a_row},
         {"finished", state.finished},
         {"history", history}}}};
   write_json_file(path, j);
@@ -150,6 +152,7 @@ learn::LearningState read_learning_checkpoint(const std::filesystem::path& path,
   state.best_error = s.number("best_error");
   state.best_iteration = s.integer("best_iteration");
   state.iterations_without_improvement = s.integer("iterations_without_improvement");
+  state.divergences_in_a_row = s.integer("divergences_in_a_row", 0); // absent in older checkpoints
   state.finished = s.boolean("finished", false);
   for (const auto& r : s.objects("history")) state.history.push_back(read_record(r));
   return state;

@@ -91,6 +91,7 @@ template <typename T> std::vector<T> without_first(const std::vector<T>& v) { re
 void LearningOptions::validate() const {
   if (max_iterations < 0) throw InputError("learn.max_iterations", "must be ≥ 0");
   if (patience < 1) throw InputError("learn.patience", "must be ≥ 1");
+  if (free_halvings < 0) throw InputError("learn.free_halvings", "must be ≥ 0");
   if (centres < 1) throw InputError("learn.centres", "must be ≥ 1");
   pod.validate();
   space_time.validate();
@@ -170,9 +171,10 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       next.best_error = error;
       next.best_iteration = record.iteration;
     }
+    next.divergences_in_a_row = forward.completed ? 0 : state.divergences_in_a_row + 1;
     if (better_forward || (forward.completed && control_forces_still_shrinking(state.history)))
       next.iterations_without_improvement = 0;
-    else
+    else if (next.divergences_in_a_row == 0 || next.divergences_in_a_row > options.free_halvings)
       ++next.iterations_without_improvement;
     if (next.iterations_without_improvement >= options.patience || record.iteration >= options.max_iterations)
       next.finished = true;

@@ -12,8 +12,8 @@
 ///   6. RBF centres re-clustered (k-means) over the trajectory's stretches each iteration.
 /// The loop stops when neither the forward error nor the control forces (by 5 %) improved for
 /// `patience` iterations, or after `max_iterations` corrections. A correction whose forward
-/// simulation diverges counts as no improvement and is replaced by ½ (C_k + best) (a damped
-/// update, no trajectory stages) while patience lasts. Every stage is deterministic, and an iteration depends only on
+/// simulation diverges is replaced by ½ (C_k + best) (a damped update, no trajectory stages);
+/// the first `free_halvings` divergences in a row do not count against patience, later ones do. Every stage is deterministic, and an iteration depends only on
 /// the current correction, so a run resumed from a checkpoint reaches the same result.
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/kmeans.hpp>
@@ -36,6 +36,11 @@ namespace elastolearn::learn {
 struct LearningOptions {
   int max_iterations = 8; ///< corrections computed at most
   int patience = 2;       ///< stop after this many iterations without a better forward error
+  /// Divergences in a row that are halved towards the best correction without counting against
+  /// patience: a step that overshoots is shortened to ½, ¼, … of itself before the loop gives up
+  /// on its direction (full-size sphere-tension: C_1 and ½ C_1 diverged, ¼ C_1 learned;
+  /// docs/benchmarks_learning.md, "Update 6"). Each halving still counts as an iteration.
+  int free_halvings = 2;
   PodOptions pod;         ///< reduced basis (max_modes, frame window and stride)
   /// POD snapshots from the constrained simulation too, not only the forward one, so that span Φ
   /// contains the observed shapes the current model does not reach (docs/learning_loop.md: a
@@ -98,6 +103,7 @@ struct LearningState {
   double best_error = -1;                                     ///< its RMS forward error [m] (−1: none yet)
   int best_iteration = -1;
   int iterations_without_improvement = 0;
+  int divergences_in_a_row = 0;                               ///< forward simulations diverged in a row
   bool finished = false;
   std::vector<IterationRecord> history;
 };

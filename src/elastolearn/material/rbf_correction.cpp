@@ -151,21 +151,29 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   zero.centres.resize(0, 3);
   const RbfCorrection::Parameters& q = b ? b->parameters() : zero;
   if (b && q.epsilon != p.epsilon) fail("epsilon", "cannot blend corrections with different kernel smoothing");
-  const Eigen::Index m = p.centres.rows(), n = q.centres.rows();
   const auto damping_weights = [](const RbfCorrection::Parameters& x) {
     return x.damping_weights.size() > 0 ? x.damping_weights : VecX(VecX::Zero(x.centres.rows()));
   };
   const bool damped = p.damping_weights.size() > 0 || q.damping_weights.size() > 0;
-  if (damped) {
-    VecX v(m + n);
-    v << (1 - t) * damping_weights(p), t * damping_weights(q);
-    p.damping_weights = v;
+  VecX v = (1 - t) * damping_weights(p);
+  p.weights *= 1 - t;
+  // b's centres join a's; a centre both share (repeated damped updates blend with the same best
+  // correction) is kept once with the summed weights, so the centre count does not grow.
+  for (Eigen::Index j = 0; j < q.centres.rows(); ++j) {
+    Eigen::Index i = 0;
+    while (i < p.centres.rows() && p.centres.row(i) != q.centres.row(j)) ++i;
+    if (i == p.centres.rows()) {
+      p.centres.conservativeResize(i + 1, 3);
+      p.centres.row(i) = q.centres.row(j);
+      p.weights.conservativeResize(i + 1);
+      p.weights[i] = 0;
+      v.conservativeResize(i + 1);
+      v[i] = 0;
+    }
+    p.weights[i] += t * q.weights[j];
+    if (q.damping_weights.size() > 0) v[i] += t * q.damping_weights[j];
   }
-  p.centres.conservativeResize(m + n, 3);
-  p.centres.bottomRows(n) = q.centres;
-  VecX w(m + n);
-  w << (1 - t) * p.weights, t * q.weights;
-  p.weights = w;
+  if (damped) p.damping_weights = v;
   p.own_slope = (1 - t) * p.own_slope + t * q.own_slope;
   p.other_slope = (1 - t) * p.other_slope + t * q.other_slope;
   p.constant = (1 - t) * p.constant + t * q.constant;
