@@ -38,7 +38,7 @@ struct LearningOptions {
   int patience = 2;       ///< stop after this many iterations without a better forward error
   /// Divergences in a row that are halved towards the best correction without counting against
   /// patience: a step that overshoots is shortened to ½, ¼, … of itself before the loop gives up
-  /// on its direction (full-size sphere-tension: C_1 and ½ C_1 diverged, ¼ C_1 learned;
+  /// on its direction (full-size sphere-tension: C_3 and ½ C_3 diverged, ¼ C_3 learned;
   /// docs/benchmarks_learning.md, "Update 6"). Each halving still counts as an iteration.
   int free_halvings = 2;
   PodOptions pod;         ///< reduced basis (max_modes, frame window and stride)
