@@ -13,8 +13,9 @@
 /// The loop stops when neither the forward error nor the control forces (by 5 %) improved for
 /// `patience` iterations, or after `max_iterations` corrections. A correction whose forward
 /// simulation diverges is replaced by ½ (C_k + best) (a damped update, no trajectory stages);
-/// the first `free_halvings` divergences in a row do not count against patience, later ones do. Every stage is deterministic, and an iteration depends only on
-/// the current correction, so a run resumed from a checkpoint reaches the same result.
+/// the first `free_halvings` divergences in a row do not count against patience, later ones do.
+/// Every stage is deterministic, and an iteration depends only on the current correction (and
+/// the counters in LearningState), so a run resumed from a checkpoint reaches the same result.
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/kmeans.hpp>
 #include <elastolearn/learn/pod_basis.hpp>
