@@ -85,9 +85,10 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   // stiffness, then 0.138 %, 0.0938 % since the POD basis also spans the constrained simulation
   // (nominal 4.304 %), 0.0680 % since Rayleigh's α₁ acts on the corrected stiffness without its
   // flip part (which also changed the truth's damping, hence the new nominal figure), 0.0457 %
-  // since the reconstruction fits the forces mainly within span Φ (0.0588 % with μ = 0.3). The issue asks for ≥ 5× below the nominal; we assert that and that we
-  // have not regressed by more than 2× from the stored learned figure (a compiler's different
-  // rounding moves it a little; a broken stage moves it by orders of magnitude).
+  // since the reconstruction fits the forces mainly within span Φ (0.0588 % with μ = 0.3). The
+  // issue asks for ≥ 5× below the nominal; we assert that and that we have not regressed by more
+  // than 2× from the stored learned figure (a compiler's different rounding moves it a little; a
+  // broken stage moves it by orders of magnitude).
   std::printf("[ measured ] err_L nominal %.4f %%, learned %.4f %% (best iteration %d)\n", nominal_error,
               learned_error, state.best_iteration);
   EXPECT_NEAR(nominal_error, 4.450, 0.01);
@@ -98,8 +99,8 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   // three amplitudes, Δα₁ carried over. It must simulate the unseen swing stably and stay well
   // below the nominal error (its fit is ~1.5 % of the teacher's output; stored figure 0.112 %,
   // same 2× regression margin; 0.123 % before Rayleigh's α₁ acted on the corrected stiffness,
-  // 0.109 % before the projected reconstruction). Before Δα₁ was carried
-  // over instead of distilled, the network's simulation of the demo's test motion diverged.
+  // 0.109 % before the projected reconstruction). Before Δα₁ was carried over instead of
+  // distilled, the network's simulation of the demo's test motion diverged.
   DistillationSampleOptions so;
   so.recorded_samples = 10000;
   const std::vector<double> scales{0.5, 1.0, 2.0};

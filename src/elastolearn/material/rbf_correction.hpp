@@ -103,9 +103,9 @@ private:
 
 /// (1 − t) a + t b: one correction whose N and Δα₁ (above its floor) are that blend of a's and
 /// b's, with both sets of centres (a centre in both kept once, with the summed weights); b = null
-/// is the zero correction. For a damped update of a
-/// correction that overshoots. Throws InputError("rbf_correction.epsilon", ...) if a and b use
-/// different kernel smoothing; the floor is a's.
+/// is the zero correction. For a damped update of a correction that overshoots. Throws
+/// InputError("rbf_correction.epsilon", ...) if a and b use different kernel smoothing; the
+/// floor is a's.
 RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t);
 
 /// c's damping correction Δα₁ alone (same centres, ε, damping terms and floor; N = 0).
