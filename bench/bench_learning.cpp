@@ -72,7 +72,7 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
 bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and the nominal test, then stop (for tuning scenes)
 bool g_no_fit = false;     ///< --no-fit: skip the parameter-fit baseline (for tuning the learning)
 /// Overrides of the learning options for every case (−1: keep the case's).
-int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_halvings = -1;
+int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_halvings = -1, g_forward_fit = -1;
 long g_seed = -1;
 double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1, g_kernel_smoothing = -1,
        g_full_space_weight = -1;
@@ -84,6 +84,7 @@ void apply_overrides(learn::LearningOptions& o) {
   if (g_iterations >= 0) o.max_iterations = g_iterations;
   if (g_patience > 0) o.patience = g_patience;
   if (g_free_halvings >= 0) o.free_halvings = g_free_halvings;
+  if (g_forward_fit >= 0) o.forward_fit.max_iterations = g_forward_fit;
   if (g_seed >= 0) o.seed = static_cast<std::uint64_t>(g_seed);
   if (g_regularization >= 0) o.rbf.regularization = g_regularization;
   if (g_kernel_smoothing >= 0) o.rbf.epsilon = g_kernel_smoothing;
@@ -143,7 +144,11 @@ Row run_case(const LearningCase& c) {
                   100 * r.forward_error.max / size);
     else
       std::printf("   iteration %d:", r.iteration);
-    if (r.modes > 0)
+    if (r.forward_fit)
+      std::printf(" (forward fit: %s, %d kernels, %.1f s)\n",
+                  !r.forward_completed ? "trial DIVERGED, rejected" : r.forward_fit_accepted ? "accepted" : "rejected",
+                  r.centres, r.seconds_forward);
+    else if (r.modes > 0)
       std::printf("; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N; "
                   "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
                   r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target, r.seconds_forward,
@@ -255,6 +260,7 @@ int main(int argc, char** argv) {
     else if (a == "--iterations" && i + 1 < argc) g_iterations = std::stoi(argv[++i]);
     else if (a == "--patience" && i + 1 < argc) g_patience = std::stoi(argv[++i]);
     else if (a == "--free-halvings" && i + 1 < argc) g_free_halvings = std::stoi(argv[++i]);
+    else if (a == "--forward-fit" && i + 1 < argc) g_forward_fit = std::stoi(argv[++i]);
     else if (a == "--seed" && i + 1 < argc) g_seed = std::stol(argv[++i]);
     else if (a == "--regularization" && i + 1 < argc) g_regularization = std::stod(argv[++i]);
     else if (a == "--kernel-smoothing" && i + 1 < argc) g_kernel_smoothing = std::stod(argv[++i]);
@@ -268,7 +274,7 @@ int main(int argc, char** argv) {
     else if (a == "--full-space-weight" && i + 1 < argc) g_full_space_weight = std::stod(argv[++i]);
     else if (a == "--data" && i + 1 < argc) data = argv[++i];
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] [--forward-fit F] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
       for (const auto& n : kCases) std::printf(" %s", n.c_str());
       std::printf(" (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
                   "data/meshes are (extracted there if missing)\n");

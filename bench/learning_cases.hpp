@@ -214,6 +214,15 @@ inline LearningCase sphere(bool compression, bool quick) {
   c.nominal_label = "corotated E 1.2e5, ν 0.43, α₁ 0.2";
   c.motion_label = "top cap keyframed y = A sin 2πft; train A 0.2 r, f 1 Hz; test A 0.3 r, f 1.25 Hz";
   c.target_err_l = 2.0;
+  // Learned by the forward fit alone: at 12.7k tets the space-time loop's corrections are wrong
+  // near the keyframed cap's rim (its interior is held at the current model's equilibrium) and
+  // stall at a training RMS of 0.75 % after 8 iterations, 540 s; three Levenberg–Marquardt
+  // steps on the forward error reach 0.03 %. Kernel smoothing ε = 0.03: with 10⁻³ the fitted
+  // correction's test simulation stalls Newton where the larger test stretches cross centres.
+  // docs/benchmarks_learning.md, "Update 7".
+  c.options.max_iterations = 0;
+  c.options.forward_fit.max_iterations = 3;
+  c.options.rbf.epsilon = 0.03;
   // The 12.7k-tet sphere: fit E and ν only (α₁ is right) and with fewer iterations, to keep the
   // baseline within minutes (the first 100 of the 200 frames).
   c.fit.parameters = {learn::FitParameter::Young, learn::FitParameter::Poisson};

@@ -127,6 +127,16 @@ void run_learn(const LearnOptions& o) {
   if (!o.quiet) callbacks.progress = terminal_progress("learn");
   callbacks.interrupted = [] { return interrupt_requested(); };
   callbacks.iteration = [&](const learn::IterationRecord& r) {
+    if (r.forward_fit) {
+      if (r.forward_completed)
+        std::printf("%4d %12.4f %12.4f %14s %6s %6d %9.2f   (forward fit: %s)\n", r.iteration,
+                    100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal, "-", "-", r.centres,
+                    r.seconds_total(), r.forward_fit_accepted ? "step accepted" : "step rejected, μ × 10");
+      else
+        std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10)\n", r.iteration);
+      std::fflush(stdout);
+      return;
+    }
     if (!r.forward_completed) {
       std::printf(r.damped_update ? "%4d  forward simulation diverged: trying half of this correction's step\n"
                                   : "%4d  forward simulation diverged: stopping (the best correction so far is kept)\n",
@@ -226,6 +236,12 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--damping-regularization", l.rbf.damping_regularization,
                   "Tikhonov weight of the damping correction's unknowns")->capture_default_str();
   cmd->add_option("--seed", l.seed, "k-means seed")->capture_default_str();
+  cmd->add_option("--forward-fit", l.forward_fit.max_iterations,
+                  "Levenberg-Marquardt steps on the forward simulation's error after the loop (0 = none)")
+      ->capture_default_str();
+  cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")->capture_default_str();
+  cmd->add_flag("!--allow-rest-stress", l.rbf.stress_free_rest,
+                "let the correction carry a stress at rest (default: N(1, 1, 1) = 0)");
   cmd->add_flag("--network", o->network,
                 "distil the learned RBF into the network correction and save that (the RBF goes to training.teacher)");
   cmd->add_option("--network-motion-scales", o->network_motion_scales,

@@ -176,6 +176,7 @@ TEST(RbfFit, ElasticOnlyFitIgnoresRatesAndSortsSamples) {
   }
   RbfFitOptions options;
   options.fit_damping = false;
+  options.stress_free_rest = false; // the truth has a pressure at rest: the tail's c carries it
   const RbfDesign design(centres_for(train, 20), options);
   EXPECT_EQ(design.num_unknowns(), 20 + 3 + 4); // kernels, linear and quadratic tails
   const RbfFitResult a = fit_rbf_correction(design, train),
@@ -250,5 +251,38 @@ TEST(RbfDesign, OutputGradientMatchesFiniteDifferences) {
           EXPECT_NEAR(gradient(3 * j + k, i), (plus(k, i) - minus(k, i)) / (2 * h), 1e-7)
               << "σ = " << s.transpose() << ", ∂/∂σ_" << j << " of output " << k << ", unknown " << i;
     }
+  }
+}
+
+TEST(RbfDesign, StressFreeRestKeepsTheRestShapeUnstressed) {
+  // Every hyperelastic model is stress-free at rest, and an unloaded object simulated with a
+  // learned material must stay at rest: under stress_free_rest any weights give N(1, 1, 1) = 0,
+  // with one unknown fewer (the pressure c). A x must equal the correction built from x either
+  // way (the reconstruction fits A x; the simulator evaluates the correction).
+  MatX centres(3, 3);
+  centres << 1.1, 1.0, 0.9, 1.0, 0.95, 0.9, 1.2, 1.1, 0.8;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g(0.0, 1e3);
+  for (const bool stress_free : { true, false }) {
+    RbfFitOptions options;
+    options.stress_free_rest = stress_free;
+    const RbfDesign design(centres, options);
+    RbfFitOptions other = options;
+    other.stress_free_rest = !stress_free;
+    EXPECT_EQ(design.elastic_unknowns(), RbfDesign(centres, other).elastic_unknowns() + (stress_free ? -1 : 1));
+    VecX x(design.num_unknowns());
+    for (auto& v : x) v = g(rng);
+    const material::RbfCorrection n = design.correction(x);
+    RbfDesign::OutputMatrix a(3, design.elastic_unknowns());
+    for (const Vec3& s : { Vec3(1.05, 0.93, 0.97), Vec3(0.8, 1.2, 1.0), Vec3(1, 1, 1) }) {
+      design.output_matrix(s, a);
+      const Vec3 fitted = a * x.head(design.elastic_unknowns());
+      EXPECT_LE((fitted - n.correction(s, Vec3::Zero())).norm(), 1e-9 * x.norm()) << "σ = " << s.transpose();
+    }
+    const double at_rest = n.correction(Vec3::Ones(), Vec3::Zero()).norm();
+    if (stress_free)
+      EXPECT_LE(at_rest, 1e-10 * x.norm()); // rounding of Σ w_i (φ_i(1) − φ_i(1))
+    else
+      EXPECT_GT(at_rest, 1.0); // random weights and pressure: a prestress of order 1e3 Pa
   }
 }

@@ -43,6 +43,8 @@ learn::IterationRecord read_record(const JsonObject& o) {
   r.forward_error = read_error(o.object("forward_error"));
   r.forward_completed = o.boolean("forward_completed", true);
   r.damped_update = o.boolean("damped_update", false);
+  r.forward_fit = o.boolean("forward_fit", false);
+  r.forward_fit_accepted = o.boolean("forward_fit_accepted", false);
   r.control_force_rms = o.number("control_force_rms");
   r.space_time_initial = o.number("space_time_initial");
   r.space_time_objective = o.number("space_time_objective");
@@ -67,6 +69,8 @@ nlohmann::json iteration_record_to_json(const learn::IterationRecord& r) {
           {"forward_error", error_json(r.forward_error)},
           {"forward_completed", r.forward_completed},
           {"damped_update", r.damped_update},
+          {"forward_fit", r.forward_fit},
+          {"forward_fit_accepted", r.forward_fit_accepted},
           {"control_force_rms", r.control_force_rms},
           {"space_time_initial", r.space_time_initial},
           {"space_time_objective", r.space_time_objective},
@@ -99,7 +103,7 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
           {"full_space", o.full_space},
           {"max_reconstruction_frames", o.max_reconstruction_frames},
           {"rbf", {{"epsilon", o.rbf.epsilon}, {"elastic_polynomial", o.rbf.elastic_polynomial},
-                   {"quadratic_tail", o.rbf.quadratic_tail},
+                   {"quadratic_tail", o.rbf.quadratic_tail}, {"stress_free_rest", o.rbf.stress_free_rest},
                    {"fit_damping", o.rbf.fit_damping}, {"damping_polynomial", o.rbf.damping_polynomial},
                    {"regularization", o.rbf.regularization},
                    {"damping_regularization", o.rbf.damping_regularization}}},
@@ -109,7 +113,8 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
                               {"full_space_weight", o.reconstruction.full_space_weight}}},
           {"stretch_samples", {{"frame_stride", o.stretch_samples.frame_stride},
                                {"max_samples", o.stretch_samples.max_samples}}},
-          {"seed", o.seed}};
+          {"seed", o.seed},
+          {"forward_fit", {{"max_iterations", o.forward_fit.max_iterations}, {"damping", o.forward_fit.damping}}}};
 }
 
 void write_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs,
@@ -128,6 +133,8 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
         {"iterations_without_improvement", state.iterations_without_improvement},
         {"divergences_in_a_row", state.divergences_in_a_row},
         {"finished", state.finished},
+        {"forward_fit_steps", state.forward_fit_steps},
+        {"forward_fit_damping", state.forward_fit_damping},
         {"history", history}}}};
   write_json_file(path, j);
 }
@@ -154,6 +161,8 @@ learn::LearningState read_learning_checkpoint(const std::filesystem::path& path,
   state.iterations_without_improvement = s.integer("iterations_without_improvement");
   state.divergences_in_a_row = s.integer("divergences_in_a_row", 0); // absent in older checkpoints
   state.finished = s.boolean("finished", false);
+  state.forward_fit_steps = s.integer("forward_fit_steps", 0);
+  state.forward_fit_damping = s.number("forward_fit_damping", -1.0);
   for (const auto& r : s.objects("history")) state.history.push_back(read_record(r));
   return state;
 }

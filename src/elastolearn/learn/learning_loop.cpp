@@ -98,6 +98,7 @@ void LearningOptions::validate() const {
   rbf.validate();
   reconstruction.validate();
   stretch_samples.validate();
+  forward_fit.validate();
   if (max_reconstruction_frames < 0) throw InputError("learn.max_reconstruction_frames", "must be ≥ 0");
   if (full_space && max_full_space_dofs < 1) throw InputError("learn.max_full_space_dofs", "must be ≥ 1");
 }
@@ -123,6 +124,64 @@ ForwardRun simulate_positions(const sim::Scene& scene, const ProgressCallback& p
   if (!run.completed) run.positions.clear();
   return run;
 }
+
+namespace {
+
+/// The stage after the loop: Levenberg–Marquardt on the forward error from the best correction
+/// (LearningOptions::forward_fit). Each step is one IterationRecord and one checkpoint; a resumed
+/// run restarts from the best correction with the saved μ, so it takes the same steps.
+bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observed, const LearningOptions& options,
+                     const ReconstructionMesh& mesh, LearningState& state, const LearningCallbacks& callbacks) {
+  const int remaining = options.forward_fit.max_iterations - state.forward_fit_steps;
+  if (remaining <= 0) return true;
+  if (callbacks.interrupted && callbacks.interrupted()) return false;
+  // Centres: the best correction's, or (nothing learned) k-means over the nominal motion's stretches.
+  MatX centres;
+  if (state.best) {
+    centres = state.best->parameters().centres;
+  } else {
+    const ForwardRun nominal = simulate_positions(scene, callbacks.progress);
+    KMeansOptions kmeans_options;
+    const MatX stretches = stretch_views(collect_stretches(mesh, nominal.positions, options.stretch_samples));
+    kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(stretches.rows()));
+    kmeans_options.seed = options.seed;
+    centres = kmeans(stretches, kmeans_options).centres;
+  }
+  const RbfDesign design(centres, options.rbf);
+  const VecX start = state.best ? design.unknowns(*state.best) : VecX(VecX::Zero(design.num_unknowns()));
+  ForwardFitOptions fit_options = options.forward_fit;
+  fit_options.max_iterations = remaining;
+  if (state.forward_fit_damping > 0) fit_options.damping = state.forward_fit_damping;
+  bool stopped = false;
+  fit_to_observations(scene, observed, mesh, design, start, fit_options, callbacks.progress,
+      [&](const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping) {
+        IterationRecord record;
+        record.iteration = state.next_iteration;
+        record.forward_fit = true;
+        record.forward_fit_accepted = accepted;
+        record.forward_completed = trial.completed;
+        if (trial.completed) record.forward_error = trial.error;
+        record.centres = design.num_centres();
+        record.seconds_forward = trial.seconds;
+        if (accepted) {
+          state.best = std::make_shared<material::RbfCorrection>(design.correction(kept));
+          state.best_error = trial.error.rms;
+          state.best_iteration = record.iteration;
+        }
+        state.correction = std::make_shared<material::RbfCorrection>(design.correction(kept));
+        ++state.forward_fit_steps;
+        state.forward_fit_damping = damping;
+        state.next_iteration = record.iteration + 1;
+        state.history.push_back(record);
+        if (callbacks.iteration) callbacks.iteration(record);
+        if (callbacks.checkpoint) callbacks.checkpoint(state);
+        stopped = callbacks.interrupted && callbacks.interrupted();
+        return !stopped;
+      });
+  return !stopped || state.forward_fit_steps >= options.forward_fit.max_iterations;
+}
+
+} // namespace
 
 bool run_learning(const sim::Scene& scene, const observe::Observation& observed, const LearningOptions& options,
                   LearningState& state, const LearningCallbacks& callbacks) {
@@ -264,7 +323,7 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
     if (callbacks.iteration) callbacks.iteration(record);
     if (callbacks.checkpoint) callbacks.checkpoint(state);
   }
-  return true;
+  return run_forward_fit(scene, observed, options, reconstruction_mesh, state, callbacks);
 }
 
 } // namespace elastolearn::learn

@@ -17,6 +17,7 @@
 /// Every stage is deterministic, and an iteration depends only on the current correction (and
 /// the counters in LearningState), so a run resumed from a checkpoint reaches the same result.
 #include <elastolearn/core/progress.hpp>
+#include <elastolearn/learn/forward_fit.hpp>
 #include <elastolearn/learn/kmeans.hpp>
 #include <elastolearn/learn/pod_basis.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
@@ -70,6 +71,12 @@ struct LearningOptions {
   /// Samples for k-means; capped so that clustering stays cheap on big meshes and long runs.
   StretchSampleOptions stretch_samples = {1, 100000};
   std::uint64_t seed = 1; ///< k-means seeding
+  /// After the loop: Levenberg–Marquardt steps on the forward simulation's error itself, from
+  /// the best correction over its centres (forward_fit.hpp; 0 = none). The space-time stages
+  /// hold the unobserved interior at the current model's equilibrium; this stage moves it with
+  /// the corrected material (full-size sphere: the loop stalls at a training RMS of 0.75 %,
+  /// four steps from the nominal model reach 0.015 %; docs/learning.md, "Forward fit").
+  ForwardFitOptions forward_fit;
   /// Throws InputError("learn.<field>", ...) for an out-of-range field.
   void validate() const;
 };
@@ -81,6 +88,10 @@ struct IterationRecord {
   bool forward_completed = true;    ///< false if C_k's forward simulation diverged
   /// C_k diverged and C_{k+1} = ½ (C_k + best) was tried instead (a damped update).
   bool damped_update = false;
+  /// A step of the forward fit after the loop (no trajectory stages): C_k is the trial, and
+  /// forward_fit_accepted says whether it lowered the error (and became the best).
+  bool forward_fit = false;
+  bool forward_fit_accepted = false;
   double control_force_rms = 0;     ///< √(mean r²) of the optimised trajectory [N]
   double space_time_initial = 0;    ///< E at the constrained simulation
   double space_time_objective = 0;  ///< E after optimisation
@@ -105,7 +116,9 @@ struct LearningState {
   int best_iteration = -1;
   int iterations_without_improvement = 0;
   int divergences_in_a_row = 0;                               ///< forward simulations diverged in a row
-  bool finished = false;
+  bool finished = false;                                      ///< the loop (its space-time iterations) ended
+  int forward_fit_steps = 0;                                  ///< forward-fit steps taken after it
+  double forward_fit_damping = -1;                            ///< its current μ (−1: not started)
   std::vector<IterationRecord> history;
 };
 

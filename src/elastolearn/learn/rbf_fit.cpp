@@ -45,7 +45,19 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_o
   if (!centres.allFinite()) fail("centres", "contains a non-finite value");
   m_centres = centres;
   const int m = static_cast<int>(centres.rows());
-  m_elastic = m + (options.elastic_polynomial ? 3 : 0) + (options.elastic_polynomial && options.quadratic_tail ? 4 : 0);
+  m_rest_kernels = VecX::Zero(m);
+  if (options.stress_free_rest)
+    for (int i = 0; i < m; ++i)
+      m_rest_kernels[i] = material::rbf_kernel((Vec3::Ones() - centres.row(i).transpose()).squaredNorm(), options.epsilon);
+  m_elastic = m;
+  if (options.elastic_polynomial) {
+    m_elastic += 2;
+    if (!options.stress_free_rest) m_constant = m_elastic++;
+    if (options.quadratic_tail) {
+      m_quadratic = m_elastic;
+      m_elastic += 4;
+    }
+  }
   m_damping = options.fit_damping ? m + (options.damping_polynomial ? 2 : 0) : 0;
 }
 
@@ -55,12 +67,12 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
   for (int k = 0; k < 3; ++k) {
     const Vec3 y = material::stretch_view(stretches, k);
     for (Eigen::Index i = 0; i < m; ++i)
-      out(k, i) = material::rbf_kernel((y - m_centres.row(i).transpose()).squaredNorm(), eps);
+      out(k, i) = material::rbf_kernel((y - m_centres.row(i).transpose()).squaredNorm(), eps) - m_rest_kernels[i];
     if (m_options.elastic_polynomial) {
       out(k, m) = y[0] - 1;
       out(k, m + 1) = y[1] + y[2] - 2;
-      out(k, m + 2) = 1;
-      if (m_options.quadratic_tail) out.block<1, 4>(k, m + 3) = material::quadratic_tail_basis(y).transpose();
+      if (m_constant >= 0) out(k, m_constant) = 1;
+      if (m_quadratic >= 0) out.block<1, 4>(k, m_quadratic) = material::quadratic_tail_basis(y).transpose();
     }
   }
 }
@@ -79,18 +91,18 @@ void RbfDesign::output_matrix(
     };
     for (Eigen::Index i = 0; i < m; ++i) {
       const Vec3 d = y - m_centres.row(i).transpose();
-      const double phi = out(k, i);
+      const double phi = out(k, i) + m_rest_kernels[i];
       if (phi > 0) add(i, d / phi);
     }
     if (m_options.elastic_polynomial) {
       add(m, Vec3(1, 0, 0));
       add(m + 1, Vec3(0, 1, 1));
-      if (m_options.quadratic_tail) {
+      if (m_quadratic >= 0) {
         const double e = y[0] - 1, s = y[1] + y[2] - 2;
-        add(m + 3, Vec3(2 * e, 0, 0));
-        add(m + 4, Vec3(s, e, e));
-        add(m + 5, Vec3(0, 2 * s, 2 * s));
-        add(m + 6, Vec3(0, y[2] - 1, y[1] - 1));
+        add(m_quadratic, Vec3(2 * e, 0, 0));
+        add(m_quadratic + 1, Vec3(s, e, e));
+        add(m_quadratic + 2, Vec3(0, 2 * s, 2 * s));
+        add(m_quadratic + 3, Vec3(0, y[2] - 1, y[1] - 1));
       }
     }
   }
@@ -116,11 +128,12 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
   p.centres = m_centres;
   p.epsilon = m_options.epsilon;
   p.weights = x.head(m);
+  p.constant = -p.weights.dot(m_rest_kernels); // N(1) = 0 under stress_free_rest
   if (m_options.elastic_polynomial) {
     p.own_slope = x[m];
     p.other_slope = x[m + 1];
-    p.constant = x[m + 2];
-    if (m_options.quadratic_tail) p.quadratic = x.segment<4>(m + 3);
+    if (m_constant >= 0) p.constant = x[m_constant];
+    if (m_quadratic >= 0) p.quadratic = x.segment<4>(m_quadratic);
   }
   if (m_damping > 0) {
     const auto v = x.tail(m_damping);
@@ -132,6 +145,38 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
     p.damping_floor = m_options.damping_floor;
   }
   return material::RbfCorrection(std::move(p));
+}
+
+VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
+  const auto& p = c.parameters();
+  const Eigen::Index m = m_centres.rows();
+  if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon)
+    fail("correction", "its centres or kernel smoothing differ from the design's");
+  const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();
+  const bool has_damping = p.damping_weights.size() > 0 || p.damping_slope != 0 || p.damping_constant != 0;
+  if ((has_tail && !m_options.elastic_polynomial) || (!p.quadratic.isZero() && m_quadratic < 0) ||
+      (has_damping && m_damping == 0))
+    fail("correction", "it has a term the design does not fit");
+  VecX x = VecX::Zero(num_unknowns());
+  x.head(m) = p.weights;
+  if (m_options.elastic_polynomial) {
+    x[m] = p.own_slope;
+    x[m + 1] = p.other_slope;
+    if (m_constant >= 0) x[m_constant] = p.constant;
+    if (m_quadratic >= 0) x.segment<4>(m_quadratic) = p.quadratic;
+  }
+  const double prestress = p.constant + p.weights.dot(m_rest_kernels);
+  if (m_constant < 0 && std::abs(prestress) > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels) + 1))
+    fail("correction", "it is not stress-free at rest (N(1) = " + str(prestress) + " Pa)");
+  if (m_damping > 0) {
+    if (p.damping_weights.size() == m) x.segment(m_elastic, m) = p.damping_weights;
+    if (m_options.damping_polynomial) {
+      x[m_elastic + m] = p.damping_slope;
+      x[m_elastic + m + 1] = p.damping_constant;
+    } else if (p.damping_slope != 0 || p.damping_constant != 0)
+      fail("correction", "it has a damping tail the design does not fit");
+  }
+  return x;
 }
 
 MatX stretch_views(ConstRef<MatX> stretches) {

@@ -12,7 +12,13 @@ namespace elastolearn::learn {
 
 struct RbfFitOptions {
   double epsilon = 1e-3; ///< kernel smoothing ε of material::rbf_kernel [-]
-  bool elastic_polynomial = true; ///< fit the linear tail a, b, c of the elastic part
+  bool elastic_polynomial = true; ///< fit the linear tail a, b (and c, see below) of the elastic part
+  /// Keep the rest shape stress-free: N(1, 1, 1) = 0, as for every hyperelastic model. The
+  /// kernels enter as φ_i(y) − φ_i(1) and the pressure c is not an unknown but follows from the
+  /// weights (c = −Σ w_i φ_i(1)). Without it the fit may explain residual forces by a prestress
+  /// at rest (the full-size sphere's first correction had N(1) = +1.07 kPa), and an unloaded
+  /// object simulated with the learned material would not stay at rest.
+  bool stress_free_rest = true;
   /// Also fit the quadratic tail q (material::quadratic_tail_basis; needs elastic_polynomial).
   bool quadratic_tail = true;
   /// Fit the stiffness-damping RBF Δα₁(σ) (only the stress reconstruction can: it needs the
@@ -33,18 +39,20 @@ struct RbfFitOptions {
 };
 
 /// The unknowns of an RBF correction with given centres, and the linear maps from them to N and
-/// Δα₁. Unknowns x = [x_e; x_d] with x_e = [w (m); a, b, c (with the elastic tail)] and
-/// x_d = [v (m); a_d, a₀ (with the damping tail)] (only when fit_damping), in the notation of
-/// material::RbfCorrection (before Δα₁'s floor):
-///   N(σ) = A(σ) x_e,   row k of A = [φ_i(y_k) …, y_k1 − 1, y_k2 + y_k3 − 2, 1, t(y_k)ᵀ],
-///   Δα₁(σ) = d(σ) x_d, d = [φ_i(sort↓ σ) …, Σσ − 3, 1].
+/// Δα₁. Unknowns x = [x_e; x_d] with x_e = [w (m); a, b, c, q (with the elastic tail; c only
+/// without stress_free_rest, q only with quadratic_tail)] and x_d = [v (m); a_d, a₀ (with the
+/// damping tail)] (only when fit_damping), in the notation of material::RbfCorrection (before
+/// Δα₁'s floor):
+///   N(σ) = A(σ) x_e,   row k of A = [φ_i(y_k) − r_i …, y_k1 − 1, y_k2 + y_k3 − 2, 1, t(y_k)ᵀ],
+///   Δα₁(σ) = d(σ) x_d, d = [φ_i(sort↓ σ) …, Σσ − 3, 1],
+/// with r_i = φ_i(1, 1, 1) under stress_free_rest (else 0).
 class RbfDesign {
 public:
   using OutputMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic>;
   /// `centres` m × 3 (m ≥ 1, finite). Throws InputError for invalid options or centres.
   RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options);
   int num_centres() const { return static_cast<int>(m_centres.rows()); }
-  int elastic_unknowns() const { return m_elastic; } ///< m (+ 3 with the tail, + 4 quadratic)
+  int elastic_unknowns() const { return m_elastic; } ///< m (+ 2 or 3 with the tail, + 4 quadratic)
   int damping_unknowns() const { return m_damping; } ///< 0, or m (+ 2 with the tail)
   int num_unknowns() const { return m_elastic + m_damping; }
   const RbfFitOptions& options() const { return m_options; }
@@ -61,10 +69,18 @@ public:
   VecX regularization_weights() const;
   /// The correction whose unknowns are `x` (length num_unknowns()).
   material::RbfCorrection correction(ConstRef<VecX> x) const;
+  /// The unknowns of a correction over this design's centres (inverse of `correction`). Throws
+  /// InputError("rbf_fit.correction", ...) if its centres or ε differ, or it has a term this
+  /// design cannot express (a tail without elastic_polynomial, damping without fit_damping, a
+  /// prestress N(1) ≠ 0 under stress_free_rest).
+  VecX unknowns(const material::RbfCorrection& correction) const;
 
 private:
   material::RbfCorrection::Centres m_centres;
   RbfFitOptions m_options;
+  VecX m_rest_kernels; ///< r_i = φ_i(1, 1, 1) under stress_free_rest, else 0
+  int m_constant = -1; ///< column of the pressure c, or −1
+  int m_quadratic = -1; ///< first column of q, or −1
   int m_elastic = 0;
   int m_damping = 0;
 };

@@ -56,12 +56,7 @@ std::vector<std::array<int, 12>> element_free_rows(
 
 /// Per-thread work space of the normal-equation assembly.
 struct AssemblyScratch {
-  std::vector<ElementState> states;
-  MatX jt; ///< Jᵀ of one frame: unknowns × free dofs
-  RbfDesign::OutputMatrix outputs;             ///< A_e: 3 × elastic unknowns
-  RbfDesign::OutputGradient gradients;         ///< ∂A_e/∂σ: 9 × elastic unknowns
-  Eigen::RowVectorXd damping_row;              ///< d_e: damping unknowns
-  Eigen::Matrix<double, 12, Eigen::Dynamic> element_rows; ///< [G_e A_e, (−K_e v_e) d_e]
+  CorrectionForceJacobian jacobian;
   VecX target;
   MatX projected_jt; ///< Jᵀ P: unknowns × r (with a projection)
   VecX projected_target; ///< Pᵀ g (with a projection)
@@ -157,6 +152,68 @@ double nominal_alpha1(const ReconstructionMesh& mesh, const Vec3& stretches) {
 }
 
 } // namespace
+
+namespace {
+constexpr int k_jacobian_batch = 512; ///< elements per batch of CorrectionForceJacobian
+}
+
+CorrectionForceJacobian::CorrectionForceJacobian(
+    const ReconstructionMesh& mesh, const fem::DofMap& dofs, const RbfDesign& design)
+    : m_mesh(mesh)
+    , m_design(design)
+    , m_free_rows(element_free_rows(mesh, dofs))
+    , m_states(mesh.num_tets())
+    , m_jt(design.num_unknowns(), dofs.num_free())
+    , m_batch(12 * std::min(k_jacobian_batch, std::max(1, mesh.num_tets())), design.num_unknowns()) {
+  if (design.damping_unknowns() > 0 && mesh.nominal.elastic == nullptr)
+    fail("nominal", "fitting the damping correction needs the nominal elastic model");
+}
+
+void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows, RbfDesign::OutputMatrix& outputs,
+    RbfDesign::OutputGradient& gradients, Eigen::RowVectorXd& damping_row) const {
+  const material::ElasticModel* elastic = m_mesh.nominal.elastic.get();
+  const int u = m_design.num_unknowns(), u_elastic = m_design.elastic_unknowns();
+  const ElementState& st = m_states[e];
+  const Eigen::Matrix<double, 12, 3> G = element_force_operator(m_mesh.rest[e], st.frame);
+  const double alpha1 = elastic != nullptr ? nominal_alpha1(m_mesh, st.frame.stretches) : 0.0;
+  if (alpha1 != 0) {
+    m_design.output_matrix(st.frame.stretches, outputs, gradients);
+    const Eigen::Matrix<double, 12, 12> D = alpha1 * element_stiffness_damping_operator(m_mesh.rest[e], st);
+    rows.leftCols(u_elastic).noalias() = (G + D.leftCols<3>()) * outputs;
+    rows.leftCols(u_elastic).noalias() += D.rightCols<9>() * gradients;
+  } else {
+    m_design.output_matrix(st.frame.stretches, outputs);
+    rows.leftCols(u_elastic).noalias() = G * outputs;
+  }
+  if (u > u_elastic) {
+    m_design.damping_row(st.frame.stretches, damping_row);
+    rows.rightCols(u - u_elastic).noalias() = element_stiffness_damping_force(m_mesh.rest[e], st, *elastic) * damping_row;
+  }
+}
+
+const MatX& CorrectionForceJacobian::transposed(const VecX& x, const VecX& v) {
+  const int m = m_mesh.num_tets();
+  const int u = m_design.num_unknowns(), u_elastic = m_design.elastic_unknowns();
+  compute_element_states(m_mesh, x, v, m_states);
+  m_jt.setZero();
+  for (int first = 0; first < m; first += k_jacobian_batch) {
+    const int count = std::min(k_jacobian_batch, m - first);
+    tbb::parallel_for(tbb::blocked_range<int>(0, count, 32), [&](const tbb::blocked_range<int>& r) {
+      // Per-task work space: a few small buffers per 32 elements, next to their O(u) products.
+      RbfDesign::OutputMatrix outputs(3, u_elastic);
+      RbfDesign::OutputGradient gradients(9, u_elastic);
+      Eigen::RowVectorXd damping_row(u - u_elastic);
+      for (int i = r.begin(); i < r.end(); ++i)
+        element_rows(first + i, m_batch.middleRows(12 * i, 12), outputs, gradients, damping_row);
+    });
+    for (int i = 0; i < count; ++i)
+      for (int l = 0; l < 12; ++l) {
+        const int row = m_free_rows[first + i][l];
+        if (row >= 0) m_jt.col(row) += m_batch.row(12 * i + l).transpose();
+      }
+  }
+  return m_jt;
+}
 
 VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
     const VecX& x, const VecX& v) {
@@ -339,31 +396,20 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
   if (projected && (projection.rows() != rows || !projection.allFinite()))
     fail("projection", "must have one finite row per free dof (" + str(rows) + "), got "
         + str(projection.rows()));
-  const material::ElasticModel* elastic = mesh.nominal.elastic.get();
-  if (design.damping_unknowns() > 0 && elastic == nullptr)
+  if (design.damping_unknowns() > 0 && mesh.nominal.elastic == nullptr)
     fail("nominal", "fitting the damping correction needs the nominal elastic model");
   const auto start = std::chrono::steady_clock::now();
   const std::vector<int> frames
       = detail::selected_frames(int(positions.size()), options.frame_stride);
-  const std::vector<std::array<int, 12>> free_rows = element_free_rows(mesh, dofs);
-  const int m = mesh.num_tets();
   const int u = design.num_unknowns();
-  const int u_elastic = design.elastic_unknowns();
 
   // Frames in k_frame_blocks contiguous blocks; each block's sums are formed serially in frame
   // order on one thread, and the blocks are added in block order.
   const int blocks = std::min<int>(k_frame_blocks, int(frames.size()));
   std::vector<BlockSums> sums(blocks);
   tbb::enumerable_thread_specific<AssemblyScratch> scratch([&] {
-    AssemblyScratch s;
-    s.states.resize(m);
-    s.jt.resize(u, rows);
-    s.outputs.resize(3, u_elastic);
-    s.gradients.resize(9, u_elastic);
-    s.damping_row.resize(design.damping_unknowns());
-    s.element_rows.resize(12, u);
-    s.projected_jt.resize(u, projection.cols());
-    s.projected_target.resize(projection.cols());
+    AssemblyScratch s { CorrectionForceJacobian(mesh, dofs, design), VecX(), MatX(u, projection.cols()),
+        VecX(projection.cols()) };
     return s;
   });
   tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
@@ -375,43 +421,17 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
       const size_t first = frames.size() * b / blocks, last = frames.size() * (b + 1) / blocks;
       for (size_t i = first; i < last; ++i) {
         const int t = frames[i];
-        element_states_range(mesh, positions[t], velocities[t], 0, m, s.states);
-        // Element e adds [G_e A_e + α₁ D_e [A_e; ∂A_e/∂σ], (−K_e v_e) d_e] (12 × u) to the rows of
-        // its free dofs: its nodal forces are G_e N + α₁ (−K_e^N v_e) + Δα₁ (−K_e v_e), linear in x.
-        s.jt.setZero();
-        for (int e = 0; e < m; ++e) {
-          const ElementState& st = s.states[e];
-          const Eigen::Matrix<double, 12, 3> G = element_force_operator(mesh.rest[e], st.frame);
-          const double alpha1 = elastic != nullptr ? nominal_alpha1(mesh, st.frame.stretches) : 0.0;
-          if (alpha1 != 0) {
-            design.output_matrix(st.frame.stretches, s.outputs, s.gradients);
-            const Eigen::Matrix<double, 12, 12> D = alpha1 * element_stiffness_damping_operator(mesh.rest[e], st);
-            s.element_rows.leftCols(u_elastic).noalias() = (G + D.leftCols<3>()) * s.outputs;
-            s.element_rows.leftCols(u_elastic).noalias() += D.rightCols<9>() * s.gradients;
-          } else {
-            design.output_matrix(st.frame.stretches, s.outputs);
-            s.element_rows.leftCols(u_elastic).noalias() = G * s.outputs;
-          }
-          if (u > u_elastic) {
-            design.damping_row(st.frame.stretches, s.damping_row);
-            s.element_rows.rightCols(u - u_elastic).noalias()
-                = element_stiffness_damping_force(mesh.rest[e], st, *elastic) * s.damping_row;
-          }
-          for (int l = 0; l < 12; ++l) {
-            const int row = free_rows[e][l];
-            if (row >= 0) s.jt.col(row) += s.element_rows.row(l).transpose();
-          }
-        }
+        const MatX& jt = s.jacobian.transposed(positions[t], velocities[t]);
         dofs.restrict_into(target_forces[t], s.target);
         if (projected) {
-          s.projected_jt.noalias() = s.jt * projection;
+          s.projected_jt.noalias() = jt * projection;
           s.projected_target.noalias() = projection.transpose() * s.target;
           sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.projected_jt);
           sum.rhs.noalias() += s.projected_jt * s.projected_target;
         }
         if (full_weight > 0) {
-          sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(s.jt, full_weight);
-          sum.rhs.noalias() += full_weight * (s.jt * s.target);
+          sum.normal.selfadjointView<Eigen::Lower>().rankUpdate(jt, full_weight);
+          sum.rhs.noalias() += full_weight * (jt * s.target);
         }
       }
     }

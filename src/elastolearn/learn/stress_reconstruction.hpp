@@ -14,6 +14,7 @@
 #include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/mesh/tet_mesh.hpp>
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -80,6 +81,33 @@ Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
 /// mesh.nominal.damping). Without mesh.nominal.elastic only the N term. Parallel over elements.
 VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
     const VecX& x, const VecX& v);
+
+/// J of one frame: column i is the nodal force (free dofs) of RBF unknown i alone at a state
+/// (x, v), so that the correction's force there (correction_force, restricted) is J x: element e
+/// adds [B_e A_e + α₁ D_e [A_e; ∂A_e/∂σ], (−K_e^nom v_e) d_e] (RbfDesign's A, d; Eq. 13) to its
+/// free dofs' rows (exact up to Δα₁'s clamps). The element blocks are computed in parallel in
+/// batches and added in element order, so J does not depend on the thread count. Owns its work
+/// space (allocated once); one instance per concurrent caller. `mesh`, `dofs` and `design` must
+/// outlive it.
+class CorrectionForceJacobian {
+public:
+  /// Throws InputError if the design fits damping but mesh.nominal has no elastic model.
+  CorrectionForceJacobian(const ReconstructionMesh& mesh, const fem::DofMap& dofs, const RbfDesign& design);
+  /// Jᵀ (unknowns × free dofs) at flat 3n positions x [m] and velocities v [m/s].
+  const MatX& transposed(const VecX& x, const VecX& v);
+
+private:
+  /// Element e's 12 × u block into `rows`.
+  void element_rows(int e, Eigen::Ref<MatX> rows, RbfDesign::OutputMatrix& outputs,
+      RbfDesign::OutputGradient& gradients, Eigen::RowVectorXd& damping_row) const;
+
+  const ReconstructionMesh& m_mesh;
+  const RbfDesign& m_design;
+  std::vector<std::array<int, 12>> m_free_rows; ///< free index of each element's local dofs (−1: prescribed)
+  std::vector<ElementState> m_states;
+  MatX m_jt;
+  MatX m_batch; ///< 12 rows per element of one batch
+};
 
 /// Which principal stretches collect_stretches returns.
 struct StretchSampleOptions {

@@ -30,6 +30,17 @@ LinearSolverType linear_solver_type_from_string(const std::string& name) {
 // OpenBLAS's thread control, when CHOLMOD runs on OpenBLAS (weak: absent with other BLAS).
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
+bool LinearSolver::solve(const MatX& b, MatX& x, double relative_tolerance) {
+  x.setZero(b.rows(), b.cols());
+  VecX column;
+  for (Eigen::Index j = 0; j < b.cols(); ++j) {
+    column.setZero(b.rows());
+    if (!solve(VecX(b.col(j)), column, relative_tolerance)) return false;
+    x.col(j) = column;
+  }
+  return true;
+}
+
 namespace {
 
 /// Below this many unknowns CHOLMOD's supernodes are too small for threaded BLAS to pay; its
@@ -51,6 +62,10 @@ public:
     return m_factor.info() == Eigen::Success;
   }
   bool solve(const VecX& b, VecX& x, double) override {
+    x = m_factor.solve(b);
+    return m_factor.info() == Eigen::Success && x.allFinite();
+  }
+  bool solve(const MatX& b, MatX& x, double) override {
     x = m_factor.solve(b);
     return m_factor.info() == Eigen::Success && x.allFinite();
   }

@@ -29,6 +29,9 @@ public:
   /// Returns false on failure (breakdown, no convergence). `x` holds the initial guess on entry
   /// for iterative solvers.
   virtual bool solve(const VecX& b, VecX& x, double relative_tolerance) = 0;
+  /// Solve A X = B for every column of B (direct solvers: one pass over the factor for all of
+  /// them; iterative ones solve column by column from X = 0). Returns false on failure.
+  virtual bool solve(const MatX& b, MatX& x, double relative_tolerance);
   /// Iterations used by the last solve (1 for direct solvers).
   virtual int last_iterations() const { return 1; }
   virtual LinearSolverType type() const = 0;

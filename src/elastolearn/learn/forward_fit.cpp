@@ -1,0 +1,205 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/learn/forward_fit.hpp>
+#include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/trajectory_physics.hpp>
+#include <elastolearn/sim/simulator.hpp>
+
+#include <elastolearn/sim/linear_solver.hpp>
+
+#include <Eigen/Cholesky>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+namespace elastolearn::learn {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// The observed entries among the free dofs: (free dof, observation vertex slot, component).
+struct ObservedDof {
+  int free = 0;
+  int slot = 0;
+  int component = 0;
+};
+
+std::vector<ObservedDof> observed_free_dofs(const fem::DofMap& dofs, const observe::Observation& observed) {
+  std::vector<ObservedDof> out;
+  for (int j = 0; j < observed.num_observed(); ++j)
+    for (int c = 0; c < 3; ++c) {
+      const int free = dofs.free_index(3 * observed.vertex_ids[j] + c);
+      if (free >= 0) out.push_back({free, j, c});
+    }
+  return out;
+}
+
+} // namespace
+
+void ForwardFitOptions::validate() const {
+  if (max_iterations < 0)
+    throw InputError("forward_fit.max_iterations", "must be ≥ 0, got " + std::to_string(max_iterations));
+  if (!std::isfinite(damping) || damping <= 0)
+    throw InputError("forward_fit.damping", "must be finite and > 0");
+}
+
+ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, const observe::Observation& observed,
+    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& unknowns, bool sensitivities,
+    const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  ForwardSensitivityPass pass;
+  const sim::Scene corrected
+      = with_correction(scene, std::make_shared<material::RbfCorrection>(design.correction(unknowns)));
+  sim::Simulator simulator(corrected);
+  const auto initial = simulator.apply_initial_condition();
+  if (!initial.converged) {
+    pass.message = "initial condition: " + initial.message;
+    return pass;
+  }
+  TrajectoryPhysics physics(corrected);
+  const fem::DofMap& dofs = physics.dofs();
+  const int u = design.num_unknowns(), n_free = dofs.num_free();
+  const double h = scene.dt;
+  VecX masses;
+  dofs.restrict_into(physics.dof_masses(), masses);
+  const std::vector<ObservedDof> observed_dofs = observed_free_dofs(dofs, observed);
+  const int k = static_cast<int>(observed_dofs.size());
+
+  // Work space, allocated once: the system matrices share the pattern, CHOLMOD analyses it once.
+  fem::SystemMatrix system = physics.make_matrix(), damping = physics.make_matrix();
+  const std::unique_ptr<sim::LinearSolver> solver = sim::make_linear_solver(sim::LinearSolverType::Cholmod);
+  std::unique_ptr<CorrectionForceJacobian> jacobian;
+  MatX s_now, s_previous, s_before, rhs, observed_rows(k, u);
+  VecX residual, observed_error(k);
+  if (sensitivities) {
+    solver->analyze(system.matrix());
+    jacobian = std::make_unique<CorrectionForceJacobian>(mesh, dofs, design);
+    s_previous = MatX::Zero(n_free, u);
+    pass.normal = MatX::Zero(u, u);
+    pass.gradient = VecX::Zero(u);
+  }
+
+  std::vector<VecX> frames;
+  frames.reserve(static_cast<size_t>(scene.frames) + 1);
+  frames.push_back(simulator.positions());
+  const VecX x_start_before = simulator.positions() - h * simulator.velocities(); // x_{−1}
+  if (sensitivities && corrected.initial.kind == sim::InitialCondition::Kind::StaticLoad) {
+    // Static start f(x_0, 0; w) + loads = 0: K_0 S_0 = ∂f_0/∂w, and x_{−1} = x_0 moves with it.
+    physics.residual(frames[0], frames[0], frames[0], 0.0, residual);
+    physics.jacobians(system, damping); // K + D/h and D at v = 0 (PSD: the static solve's tangent)
+    const fem::SparseMatrix k0 = system.matrix() - damping.matrix() / h;
+    rhs = jacobian->transposed(frames[0], VecX::Zero(frames[0].size())).transpose();
+    if (!solver->factorize(k0) || !solver->solve(rhs, s_previous, 0.0)) {
+      pass.message = "the initial stiffness is not positive definite";
+      return pass;
+    }
+  }
+  if (sensitivities) s_before = s_previous;
+
+  const auto accumulate = [&](int t, const VecX& x) {
+    for (int i = 0; i < k; ++i) {
+      const ObservedDof& o = observed_dofs[i];
+      observed_error[i] = x[dofs.free_dofs()[o.free]] - observed.positions[t](o.slot, o.component);
+    }
+    if (!sensitivities) return;
+    for (int i = 0; i < k; ++i) observed_rows.row(i) = s_now.row(observed_dofs[i].free);
+    pass.normal.selfadjointView<Eigen::Lower>().rankUpdate(observed_rows.transpose());
+    pass.gradient.noalias() += observed_rows.transpose() * observed_error;
+  };
+  if (sensitivities) s_now = s_previous;
+  accumulate(0, frames[0]);
+
+  for (int t = 1; t <= scene.frames; ++t) {
+    const auto report = simulator.step();
+    if (!report.converged) {
+      pass.message = "frame " + std::to_string(t) + ": " + report.message;
+      return pass;
+    }
+    frames.push_back(simulator.positions());
+    if (sensitivities) {
+      const VecX& x_before = t >= 2 ? frames[t - 2] : x_start_before;
+      physics.residual(x_before, frames[t - 1], frames[t], simulator.time(), residual);
+      // The step's exact Jacobian (K + D/h and D at the converged state) gives the exact
+      // sensitivities; where it is not positive definite, the simulator's PSD projection.
+      physics.set_project_tangent(false);
+      physics.jacobians(system, damping);
+      system.add_diagonal(masses, 1.0 / (h * h));
+      bool factored = solver->factorize(system.matrix());
+      if (!factored) {
+        physics.set_project_tangent(true);
+        physics.jacobians(system, damping);
+        system.add_diagonal(masses, 1.0 / (h * h));
+        factored = solver->factorize(system.matrix());
+      }
+      if (!factored) {
+        pass.message = "frame " + std::to_string(t) + ": the step's Jacobian is not positive definite";
+        return pass;
+      }
+      const VecX velocity = (frames[t] - frames[t - 1]) / h;
+      rhs = jacobian->transposed(frames[t], velocity).transpose();
+      rhs.noalias() += (2.0 / (h * h)) * masses.asDiagonal() * s_previous;
+      rhs.noalias() += (damping.matrix() * s_previous) / h;
+      rhs.noalias() -= (1.0 / (h * h)) * masses.asDiagonal() * s_before;
+      if (!solver->solve(rhs, s_now, 0.0)) {
+        pass.message = "frame " + std::to_string(t) + ": the sensitivity solve failed";
+        return pass;
+      }
+      std::swap(s_before, s_previous);
+      s_previous = s_now;
+    }
+    accumulate(t, frames[t]);
+    if (progress) progress(t, scene.frames, sensitivities ? "forward simulation with sensitivities" : "forward simulation");
+  }
+  pass.completed = true;
+  pass.error = observation_error(frames, observed);
+  pass.squared_error = pass.error.rms * pass.error.rms * double(pass.error.samples);
+  if (sensitivities) pass.normal.triangularView<Eigen::StrictlyUpper>() = pass.normal.transpose();
+  pass.seconds = seconds_since(start);
+  return pass;
+}
+
+ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Observation& observed,
+    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start, const ForwardFitOptions& options,
+    const ProgressCallback& progress, const ForwardFitStepCallback& on_step) {
+  options.validate();
+  const auto started = std::chrono::steady_clock::now();
+  ForwardFitResult result;
+  result.unknowns = start;
+  ForwardSensitivityPass current = simulate_with_sensitivities(scene, observed, mesh, design, start, true, progress);
+  if (!current.completed)
+    throw InputError("forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
+  result.rms_history.push_back(current.error.rms);
+  double mu = options.damping;
+  const Eigen::Index u = start.size();
+  for (int it = 0; it < options.max_iterations; ++it) {
+    // Jacobi-scaled Levenberg–Marquardt step: (Ĥ + μ I) Δ̂ = −ĝ, Δ = Δ̂ / s, s = √diag(H).
+    VecX scale = current.normal.diagonal().cwiseSqrt();
+    for (Eigen::Index i = 0; i < u; ++i)
+      if (!(scale[i] > 0)) scale[i] = 1;
+    MatX a = scale.cwiseInverse().asDiagonal() * current.normal * scale.cwiseInverse().asDiagonal();
+    a.diagonal().array() += mu;
+    const VecX step = (a.llt().solve(-current.gradient.cwiseQuotient(scale))).cwiseQuotient(scale);
+    const VecX trial = result.unknowns + step;
+    ForwardSensitivityPass next = simulate_with_sensitivities(scene, observed, mesh, design, trial, true, progress);
+    result.rms_history.push_back(next.completed ? next.error.rms : -1.0);
+    const bool accepted = next.completed && next.squared_error < current.squared_error;
+    if (accepted) {
+      result.unknowns = trial;
+      ++result.accepted;
+      mu /= 3;
+    } else {
+      mu *= 10;
+    }
+    const bool go_on = !on_step || on_step(next, accepted, result.unknowns, mu);
+    if (accepted) current = std::move(next);
+    if (!go_on) break;
+  }
+  result.seconds = seconds_since(started);
+  return result;
+}
+
+} // namespace elastolearn::learn

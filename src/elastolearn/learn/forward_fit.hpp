@@ -1,0 +1,71 @@
+#pragma once
+/// \file Fitting a correction's unknowns to the observations through the forward simulation
+/// itself: Levenberg–Marquardt on E(w) = Σ_t Σ_{observed j} ‖x_t,j(w) − o_t,j‖², with the
+/// trajectory's sensitivities S_t = ∂x_t/∂w from differentiating the backward-Euler steps
+///   (M/h² + K_t + D_t/h) S_t = (2M/h² + D_t/h) S_{t−1} − (M/h²) S_{t−2} + ∂f_t/∂w
+/// (K = −∂f/∂x, D = −∂f/∂v at the converged step; ∂f/∂w is CorrectionForceJacobian, since the
+/// force is linear in the unknowns; a static initial state adds K_0 S_0 = ∂f_0/∂w).
+/// Unlike the space-time stages, the unobserved interior here always moves with the corrected
+/// material, so the fit cannot lock it at the current model's equilibrium (docs/learning.md,
+/// "Forward fit"). Each iteration costs one forward simulation plus, per frame, one extra
+/// factorisation and a solve with one right-hand side per unknown.
+#include <elastolearn/core/progress.hpp>
+#include <elastolearn/learn/rbf_fit.hpp>
+#include <elastolearn/learn/stress_reconstruction.hpp>
+#include <elastolearn/learn/trajectory_error.hpp>
+#include <elastolearn/observe/observation.hpp>
+#include <elastolearn/sim/scene.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace elastolearn::learn {
+
+/// One forward simulation with a correction, its error at the observed vertices and, if asked,
+/// the Gauss–Newton normal equations of E at its unknowns.
+struct ForwardSensitivityPass {
+  bool completed = false;
+  std::string message; ///< why the simulation stopped, if it did
+  ErrorSummary error; ///< at the observed vertices, all frames [m]
+  double squared_error = 0; ///< E [m²]
+  MatX normal; ///< Σ_t (P S_t)ᵀ (P S_t), P the observed free dofs
+  VecX gradient; ///< Σ_t (P S_t)ᵀ (P x_t − o_t) (½ ∇E)
+  double seconds = 0;
+};
+
+/// Simulate `scene` (the nominal model, no correction attached) with design.correction(unknowns)
+/// and compare with `observed` (T + 1 frames, validated by the caller). `mesh` is the
+/// reconstruction mesh of scene.mesh with the nominal material.
+ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, const observe::Observation& observed,
+    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& unknowns, bool sensitivities,
+    const ProgressCallback& progress = {});
+
+struct ForwardFitOptions {
+  int max_iterations = 0; ///< trial steps (one forward simulation each) after the start
+  /// Initial Levenberg–Marquardt damping μ on the Jacobi-scaled normal equations; ÷3 after an
+  /// accepted step, ×10 after a rejected one.
+  double damping = 1e-2;
+  /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
+  void validate() const;
+};
+
+struct ForwardFitResult {
+  VecX unknowns; ///< the best found (the start if no step improved)
+  std::vector<double> rms_history; ///< RMS error of each simulation, the start first (−1: diverged)
+  int accepted = 0; ///< steps that lowered the error
+  double seconds = 0;
+};
+
+/// Called after each trial step with its pass, whether it was accepted, the unknowns kept and
+/// the damping μ for the next step; returns false to stop the fit there.
+using ForwardFitStepCallback
+    = std::function<bool(const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping)>;
+
+/// Levenberg–Marquardt from `start` (unknowns in design's layout), with options.damping as the
+/// first μ. Throws InputError for invalid options or if the start's simulation diverges.
+ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Observation& observed,
+    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start, const ForwardFitOptions& options,
+    const ProgressCallback& progress = {}, const ForwardFitStepCallback& on_step = {});
+
+} // namespace elastolearn::learn
