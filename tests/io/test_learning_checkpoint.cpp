@@ -55,28 +55,31 @@ void expect_same(const material::RbfCorrection& a, const material::RbfCorrection
   EXPECT_EQ(a.parameters().damping_weights, b.parameters().damping_weights);
 }
 
-TEST(LearningCheckpoint, ResumedRunEqualsUninterruptedRun) {
-  Fixture f;
+/// Run f's learning whole, and interrupted after checkpoint `stop_after` then resumed from the
+/// file: both must reach the same history and the bit-identical correction.
+void expect_resume_equals_whole(Fixture& f, int stop_after) {
+  f.inputs.options = learning_options_to_json(f.options);
   learn::LearningState whole;
   ASSERT_TRUE(learn::run_learning(f.nominal, f.observed, f.options, whole));
   ASSERT_TRUE(whole.best);
+  EXPECT_EQ(whole.forward_fit_steps, f.options.forward_fit.max_iterations);
 
-  // Interrupt right after the first checkpoint, then resume from the file.
   learn::LearningState first;
-  bool saved = false;
+  int saved = 0;
   learn::LearningCallbacks callbacks;
   callbacks.checkpoint = [&](const learn::LearningState& s) {
     write_learning_checkpoint(f.file, f.inputs, s);
-    saved = true;
+    ++saved;
   };
-  callbacks.interrupted = [&] { return saved; };
+  callbacks.interrupted = [&] { return saved >= stop_after; };
   EXPECT_FALSE(learn::run_learning(f.nominal, f.observed, f.options, first, callbacks));
   learn::LearningState resumed = read_learning_checkpoint(f.file, f.inputs);
-  EXPECT_EQ(resumed.next_iteration, 1);
+  EXPECT_EQ(resumed.next_iteration, stop_after);
   ASSERT_TRUE(learn::run_learning(f.nominal, f.observed, f.options, resumed));
 
   EXPECT_EQ(resumed.best_iteration, whole.best_iteration);
   EXPECT_EQ(resumed.best_error, whole.best_error);
+  EXPECT_EQ(resumed.forward_fit_steps, whole.forward_fit_steps);
   ASSERT_EQ(resumed.history.size(), whole.history.size());
   for (size_t i = 0; i < whole.history.size(); ++i)
     EXPECT_EQ(resumed.history[i].forward_error.rms, whole.history[i].forward_error.rms) << "iteration " << i;
@@ -84,15 +87,32 @@ TEST(LearningCheckpoint, ResumedRunEqualsUninterruptedRun) {
   expect_same(*resumed.best, *whole.best); // bit-identical: every stage is deterministic
 }
 
+TEST(LearningCheckpoint, ResumedRunEqualsUninterruptedRun) {
+  Fixture f;
+  expect_resume_equals_whole(f, 1); // interrupted after the first iteration
+}
+
+TEST(LearningCheckpoint, ResumedForwardFitEqualsUninterruptedRun) {
+  // The forward fit after the loop: interrupted after its first step (checkpoint 4 = iterations
+  // 0–2 of the loop, then that step), resumed with the saved μ from the best correction.
+  Fixture f;
+  f.options.forward_fit.max_iterations = 2;
+  expect_resume_equals_whole(f, 4);
+}
+
 TEST(LearningCheckpoint, RefusesACheckpointOfOtherInputs) {
   Fixture f;
   learn::LearningState state;
   state.next_iteration = 3;
   state.divergences_in_a_row = 2;
+  state.forward_fit_steps = 1;
+  state.forward_fit_damping = 3.3e-3;
   write_learning_checkpoint(f.file, f.inputs, state);
   const learn::LearningState read = read_learning_checkpoint(f.file, f.inputs);
   EXPECT_EQ(read.next_iteration, 3);
   EXPECT_EQ(read.divergences_in_a_row, 2);
+  EXPECT_EQ(read.forward_fit_steps, 1);
+  EXPECT_EQ(read.forward_fit_damping, 3.3e-3);
   auto other = f.inputs;
   other.scene = "other.json";
   EXPECT_THROW(read_learning_checkpoint(f.file, other), InputError);

@@ -45,12 +45,15 @@ void ForwardFitOptions::validate() const {
     throw InputError("forward_fit.max_iterations", "must be ≥ 0, got " + std::to_string(max_iterations));
   if (!std::isfinite(damping) || damping <= 0)
     throw InputError("forward_fit.damping", "must be finite and > 0");
+  if (sensitivities == Sensitivities::none)
+    throw InputError("forward_fit.sensitivities", "the fit needs sensitivities (projected or exact)");
 }
 
 ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, const observe::Observation& observed,
-    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& unknowns, bool sensitivities,
+    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& unknowns, Sensitivities mode,
     const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
+  const bool sensitivities = mode != Sensitivities::none;
   ForwardSensitivityPass pass;
   const sim::Scene corrected
       = with_correction(scene, std::make_shared<material::RbfCorrection>(design.correction(unknowns)));
@@ -61,6 +64,7 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
     return pass;
   }
   TrajectoryPhysics physics(corrected);
+  physics.set_project_tangent(mode != Sensitivities::exact);
   const fem::DofMap& dofs = physics.dofs();
   const int u = design.num_unknowns(), n_free = dofs.num_free();
   const double h = scene.dt;
@@ -90,7 +94,7 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
   if (sensitivities && corrected.initial.kind == sim::InitialCondition::Kind::StaticLoad) {
     // Static start f(x_0, 0; w) + loads = 0: K_0 S_0 = ∂f_0/∂w, and x_{−1} = x_0 moves with it.
     physics.residual(frames[0], frames[0], frames[0], 0.0, residual);
-    physics.jacobians(system, damping); // K + D/h and D at v = 0 (PSD: the static solve's tangent)
+    physics.jacobians(system, damping); // K + D/h and D at v = 0
     const fem::SparseMatrix k0 = system.matrix() - damping.matrix() / h;
     rhs = jacobian->transposed(frames[0], VecX::Zero(frames[0].size())).transpose();
     if (!solver->factorize(k0) || !solver->solve(rhs, s_previous, 0.0)) {
@@ -123,18 +127,9 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
     if (sensitivities) {
       const VecX& x_before = t >= 2 ? frames[t - 2] : x_start_before;
       physics.residual(x_before, frames[t - 1], frames[t], simulator.time(), residual);
-      // The step's exact Jacobian (K + D/h and D at the converged state) gives the exact
-      // sensitivities; where it is not positive definite, the simulator's PSD projection.
-      physics.set_project_tangent(false);
-      physics.jacobians(system, damping);
+      physics.jacobians(system, damping); // K + D/h and D at the converged step
       system.add_diagonal(masses, 1.0 / (h * h));
-      bool factored = solver->factorize(system.matrix());
-      if (!factored) {
-        physics.set_project_tangent(true);
-        physics.jacobians(system, damping);
-        system.add_diagonal(masses, 1.0 / (h * h));
-        factored = solver->factorize(system.matrix());
-      }
+      const bool factored = solver->factorize(system.matrix());
       if (!factored) {
         pass.message = "frame " + std::to_string(t) + ": the step's Jacobian is not positive definite";
         return pass;
@@ -169,7 +164,7 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
   const auto started = std::chrono::steady_clock::now();
   ForwardFitResult result;
   result.unknowns = start;
-  ForwardSensitivityPass current = simulate_with_sensitivities(scene, observed, mesh, design, start, true, progress);
+  ForwardSensitivityPass current = simulate_with_sensitivities(scene, observed, mesh, design, start, options.sensitivities, progress);
   if (!current.completed)
     throw InputError("forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
   result.rms_history.push_back(current.error.rms);
@@ -184,7 +179,7 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
     a.diagonal().array() += mu;
     const VecX step = (a.llt().solve(-current.gradient.cwiseQuotient(scale))).cwiseQuotient(scale);
     const VecX trial = result.unknowns + step;
-    ForwardSensitivityPass next = simulate_with_sensitivities(scene, observed, mesh, design, trial, true, progress);
+    ForwardSensitivityPass next = simulate_with_sensitivities(scene, observed, mesh, design, trial, options.sensitivities, progress);
     result.rms_history.push_back(next.completed ? next.error.rms : -1.0);
     const bool accepted = next.completed && next.squared_error < current.squared_error;
     if (accepted) {
