@@ -240,6 +240,8 @@ void add_learn_command(CLI::App& root) {
                   "Levenberg-Marquardt steps on the forward simulation's error after the loop (0 = none)")
       ->capture_default_str();
   cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")->capture_default_str();
+  cmd->add_flag("--neo-hookean-tail", l.rbf.neo_hookean_tail,
+                "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");
   cmd->add_flag("!--allow-rest-stress", l.rbf.stress_free_rest,
                 "let the correction carry a stress at rest (default: N(1, 1, 1) = 0)");
   cmd->add_flag("--network", o->network,

@@ -50,6 +50,7 @@ material::RbfCorrection::Parameters rbf_parameters(int centres, unsigned seed) {
   p.other_slope = awkward(rng);
   p.constant = awkward(rng);
   for (auto& q : p.quadratic) q = awkward(rng);
+  for (auto& r : p.neo_hookean) r = awkward(rng);
   p.damping_weights.resize(centres);
   fill(p.damping_weights, rng);
   p.damping_slope = awkward(rng);
@@ -137,6 +138,7 @@ TEST(MaterialFile, RbfRoundTripIsBitExact) {
   EXPECT_EQ(p.other_slope, q.other_slope);
   EXPECT_EQ(p.constant, q.constant);
   EXPECT_EQ(p.quadratic, q.quadratic);
+  EXPECT_EQ(p.neo_hookean, q.neo_hookean);
   EXPECT_EQ(p.damping_weights, q.damping_weights);
   EXPECT_EQ(p.damping_slope, q.damping_slope);
   EXPECT_EQ(p.damping_floor, q.damping_floor);

@@ -5,6 +5,7 @@
 #include <elastolearn/learn/kmeans.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
 #include <elastolearn/material/corotated.hpp>
+#include <elastolearn/material/elastic_model_type.hpp>
 
 #include <gtest/gtest.h>
 
@@ -176,9 +177,10 @@ TEST(RbfFit, ElasticOnlyFitIgnoresRatesAndSortsSamples) {
   }
   RbfFitOptions options;
   options.fit_damping = false;
+  options.neo_hookean_tail = true;
   options.stress_free_rest = false; // the truth has a pressure at rest: the tail's c carries it
   const RbfDesign design(centres_for(train, 20), options);
-  EXPECT_EQ(design.num_unknowns(), 20 + 3 + 4); // kernels, linear and quadratic tails
+  EXPECT_EQ(design.num_unknowns(), 20 + 3 + 4 + 2); // kernels, linear, quadratic and neo-Hookean tails
   const RbfFitResult a = fit_rbf_correction(design, train),
                      b = fit_rbf_correction(design, shuffled);
   EXPECT_LE((a.unknowns - b.unknowns).norm(), 1e-9 * a.unknowns.norm());
@@ -231,7 +233,9 @@ TEST(RbfDesign, OutputGradientMatchesFiniteDifferences) {
   // layout error is O(1).
   MatX centres(3, 3);
   centres << 1.1, 1.0, 0.9, 1.0, 0.95, 0.9, 1.2, 1.1, 0.8;
-  const RbfDesign design(centres, RbfFitOptions {});
+  RbfFitOptions options;
+  options.neo_hookean_tail = true; // every column type
+  const RbfDesign design(centres, options);
   const int u = design.elastic_unknowns();
   RbfDesign::OutputMatrix a(3, u), plus(3, u), minus(3, u), again(3, u);
   RbfDesign::OutputGradient gradient(9, u);
@@ -284,5 +288,31 @@ TEST(RbfDesign, StressFreeRestKeepsTheRestShapeUnstressed) {
       EXPECT_LE(at_rest, 1e-10 * x.norm()); // rounding of Σ w_i (φ_i(1) − φ_i(1))
     else
       EXPECT_GT(at_rest, 1.0); // random weights and pressure: a prestress of order 1e3 Pa
+  }
+}
+
+TEST(RbfFit, NeoHookeanTailExtrapolatesNeoHookeanMinusCorotatedIntoStrongCompression) {
+  // Neo-Hookean minus corotated principal stress (other Lamé parameters) is the linear tail plus
+  // −μ g₁ + λ g₂ exactly. Fitted on stretches in [0.8, 1.25], the correction must reproduce it
+  // at σ₃ = 0.45, where the neo-Hookean barrier dominates: measured relative error 1.5e-6 (exact
+  // data; the Tikhonov 1e-9 bias), allowed 1e-5; without the tail 50–60 %.
+  const auto neo = material::make_elastic_model(material::ElasticModelType::NeoHookean, material::Lame::from_young_poisson(1e5, 0.43));
+  const auto corotated = material::make_elastic_model(material::ElasticModelType::Corotated, material::Lame::from_young_poisson(1.2e5, 0.43));
+  const Truth truth = [&](const Vec3& s, const Vec3&) { return Vec3(neo->principal_stress(s) - corotated->principal_stress(s)); };
+  const StressSamples train = make_samples(3000, 40, truth);
+  RbfFitOptions options;
+  options.fit_damping = false;
+  options.neo_hookean_tail = true;
+  const MatX centres = centres_for(train, 20);
+  const material::RbfCorrection with = fit_rbf_correction(RbfDesign(centres, options), train).correction;
+  options.neo_hookean_tail = false;
+  const material::RbfCorrection without = fit_rbf_correction(RbfDesign(centres, options), train).correction;
+  for (const Vec3& s : { Vec3(1.1, 1.0, 0.45), Vec3(0.9, 0.7, 0.5) }) {
+    const Vec3 want = truth(s, Vec3::Zero());
+    const double e_with = (with.correction(s, Vec3::Zero()) - want).norm() / want.norm();
+    const double e_without = (without.correction(s, Vec3::Zero()) - want).norm() / want.norm();
+    std::cout << "[ barrier  ] σ = " << s.transpose() << ": relative error " << e_with << " with the tail, " << e_without << " without\n";
+    EXPECT_LT(e_with, 1e-5);
+    EXPECT_GT(e_without, 0.1);
   }
 }

@@ -36,6 +36,7 @@ RbfCorrection::Parameters test_parameters(double epsilon) {
   p.other_slope = -2e3;
   p.constant = 10;
   p.quadratic = Eigen::Vector4d(3e4, -2e4, 1e4, 4e4);
+  p.neo_hookean = Eigen::Vector2d(-2e4, 3e4);
   p.damping_slope = 0.01;
   p.damping_constant = 0.03;
   p.epsilon = epsilon;
@@ -163,7 +164,9 @@ TEST(RbfCorrection, ElasticAndDampingPartsAreTheDocumentedRbfs) {
     expected_elastic[k] = p.own_slope * (y[0] - 1) + p.other_slope * (y[1] + y[2] - 2) + p.constant +
                           p.quadratic[0] * (y[0] - 1) * (y[0] - 1) + p.quadratic[1] * (y[0] - 1) * (y[1] + y[2] - 2) +
                           p.quadratic[2] * (y[1] + y[2] - 2) * (y[1] + y[2] - 2) +
-                          p.quadratic[3] * (y[1] - 1) * (y[2] - 1);
+                          p.quadratic[3] * (y[1] - 1) * (y[2] - 1) +
+                          p.neo_hookean[0] * (y[0] + 1 / y[0] - 2) +
+                          p.neo_hookean[1] * (std::log(y[0] * y[1] * y[2]) / y[0] - (y[0] + y[1] + y[2] - 3));
     for (int i = 0; i < 6; ++i)
       expected_elastic[k] += p.weights[i] * rbf_kernel((y - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
   }
@@ -210,6 +213,7 @@ TEST(RbfCorrection, ZeroWithoutWeightsAndWithoutDampingPart) {
   p.weights.setZero();
   p.own_slope = p.other_slope = p.constant = 0;
   p.quadratic.setZero();
+  p.neo_hookean.setZero();
   p.damping_weights.resize(0); // no damping RBF; the damping tail alone remains
   p.damping_slope = 0;
   p.damping_constant = 0;
@@ -241,6 +245,7 @@ TEST(RbfCorrection, RejectsInconsistentParameters) {
   expect_error([](auto& p) { p.epsilon = -1; }, "epsilon");
   expect_error([](auto& p) { p.damping_constant = INFINITY; }, "damping_constant");
   expect_error([](auto& p) { p.quadratic[2] = std::nan(""); }, "quadratic");
+  expect_error([](auto& p) { p.neo_hookean[1] = std::nan(""); }, "neo_hookean");
 }
 
 TEST(RbfCorrection, BlendIsTheWeightedSumOfTwoCorrections) {
@@ -249,6 +254,7 @@ TEST(RbfCorrection, BlendIsTheWeightedSumOfTwoCorrections) {
   pb.weights *= -0.7;
   pb.damping_weights.resize(0); // b without a damping RBF
   pb.quadratic *= 2;
+  pb.neo_hookean *= -1;
   const RbfCorrection a(pa), b(pb);
   const RbfCorrection half = blend(a, &b, 0.25), none = blend(a, nullptr, 0.5);
   EXPECT_EQ(half.num_centres(), 12);

@@ -104,6 +104,7 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
           {"max_reconstruction_frames", o.max_reconstruction_frames},
           {"rbf", {{"epsilon", o.rbf.epsilon}, {"elastic_polynomial", o.rbf.elastic_polynomial},
                    {"quadratic_tail", o.rbf.quadratic_tail}, {"stress_free_rest", o.rbf.stress_free_rest},
+                   {"neo_hookean_tail", o.rbf.neo_hookean_tail},
                    {"fit_damping", o.rbf.fit_damping}, {"damping_polynomial", o.rbf.damping_polynomial},
                    {"regularization", o.rbf.regularization},
                    {"damping_regularization", o.rbf.damping_regularization}}},

@@ -45,6 +45,7 @@ Json rbf_to_json(const material::RbfCorrection& c) {
     { "weights", vector_to_json(p.weights) }, { "own_slope", p.own_slope },
     { "other_slope", p.other_slope }, { "constant", p.constant },
     { "quadratic", vector_to_json(p.quadratic) },
+    { "neo_hookean", vector_to_json(p.neo_hookean) },
     { "damping_weights", vector_to_json(p.damping_weights) }, { "damping_slope", p.damping_slope },
     { "damping_constant", p.damping_constant }, { "damping_floor", floor } };
 }
@@ -126,7 +127,7 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
 
 std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "epsilon", "centres", "weights", "own_slope", "other_slope",
-      "constant", "quadratic", "damping_weights", "damping_slope", "damping_constant",
+      "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slope", "damping_constant",
       "damping_floor" });
   material::RbfCorrection::Parameters p;
   p.epsilon = o.number("epsilon");
@@ -137,6 +138,8 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
   p.constant = o.number("constant", 0.0);
   if (o.has("quadratic"))
     p.quadratic = read_vector(o, "quadratic", 4);
+  if (o.has("neo_hookean"))
+    p.neo_hookean = read_vector(o, "neo_hookean", 2);
   if (o.has("damping_weights")) {
     p.damping_weights = read_vector(o, "damping_weights");
     if (p.damping_weights.size() != 0 && p.damping_weights.size() != p.centres.rows()) {

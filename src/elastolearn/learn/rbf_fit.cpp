@@ -57,6 +57,10 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_o
       m_quadratic = m_elastic;
       m_elastic += 4;
     }
+    if (options.neo_hookean_tail) {
+      m_neo_hookean = m_elastic;
+      m_elastic += 2;
+    }
   }
   m_damping = options.fit_damping ? m + (options.damping_polynomial ? 2 : 0) : 0;
 }
@@ -73,6 +77,7 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
       out(k, m + 1) = y[1] + y[2] - 2;
       if (m_constant >= 0) out(k, m_constant) = 1;
       if (m_quadratic >= 0) out.block<1, 4>(k, m_quadratic) = material::quadratic_tail_basis(y).transpose();
+      if (m_neo_hookean >= 0) out.block<1, 2>(k, m_neo_hookean) = material::neo_hookean_tail_basis(y).transpose();
     }
   }
 }
@@ -104,6 +109,12 @@ void RbfDesign::output_matrix(
         add(m_quadratic + 2, Vec3(0, 2 * s, 2 * s));
         add(m_quadratic + 3, Vec3(0, y[2] - 1, y[1] - 1));
       }
+      if (m_neo_hookean >= 0) {
+        Eigen::Matrix<double, 2, 3> d_g;
+        material::neo_hookean_tail_basis(y, &d_g);
+        add(m_neo_hookean, d_g.row(0).transpose());
+        add(m_neo_hookean + 1, d_g.row(1).transpose());
+      }
     }
   }
 }
@@ -134,6 +145,7 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
     p.other_slope = x[m + 1];
     if (m_constant >= 0) p.constant = x[m_constant];
     if (m_quadratic >= 0) p.quadratic = x.segment<4>(m_quadratic);
+    if (m_neo_hookean >= 0) p.neo_hookean = x.segment<2>(m_neo_hookean);
   }
   if (m_damping > 0) {
     const auto v = x.tail(m_damping);
@@ -155,6 +167,7 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();
   const bool has_damping = p.damping_weights.size() > 0 || p.damping_slope != 0 || p.damping_constant != 0;
   if ((has_tail && !m_options.elastic_polynomial) || (!p.quadratic.isZero() && m_quadratic < 0) ||
+      (!p.neo_hookean.isZero() && m_neo_hookean < 0) ||
       (has_damping && m_damping == 0))
     fail("correction", "it has a term the design does not fit");
   VecX x = VecX::Zero(num_unknowns());
@@ -164,6 +177,7 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
     x[m + 1] = p.other_slope;
     if (m_constant >= 0) x[m_constant] = p.constant;
     if (m_quadratic >= 0) x.segment<4>(m_quadratic) = p.quadratic;
+    if (m_neo_hookean >= 0) x.segment<2>(m_neo_hookean) = p.neo_hookean;
   }
   const double prestress = p.constant + p.weights.dot(m_rest_kernels);
   if (m_constant < 0 && std::abs(prestress) > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels) + 1))

@@ -46,6 +46,20 @@ Eigen::Vector4d quadratic_tail_basis(const Vec3& y) {
   return {e * e, e * s, s * s, (y[1] - 1) * (y[2] - 1)};
 }
 
+Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3>* d_y) {
+  constexpr double floor = 1e-3;
+  const Vec3 z = y.cwiseMax(floor);
+  const double log_j = std::log(z[0] * z[1] * z[2]);
+  const Eigen::Vector2d g(z[0] + 1 / z[0] - 2, log_j / z[0] - (z[0] + z[1] + z[2] - 3));
+  if (d_y) {
+    d_y->row(0) = Eigen::RowVector3d(1 - 1 / (z[0] * z[0]), 0, 0);
+    d_y->row(1) = Eigen::RowVector3d((1 - log_j) / (z[0] * z[0]) - 1, 1 / (z[0] * z[1]) - 1, 1 / (z[0] * z[2]) - 1);
+    for (int c = 0; c < 3; ++c)
+      if (y[c] < floor) d_y->col(c).setZero();
+  }
+  return g;
+}
+
 RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
   const Eigen::Index m = m_p.centres.rows();
   if (m_p.weights.size() != m)
@@ -63,6 +77,7 @@ RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
   finite("other_slope", std::isfinite(m_p.other_slope));
   finite("constant", std::isfinite(m_p.constant));
   finite("quadratic", m_p.quadratic.allFinite());
+  finite("neo_hookean", m_p.neo_hookean.allFinite());
   finite("damping_weights", m_p.damping_weights.allFinite());
   finite("damping_slope", std::isfinite(m_p.damping_slope));
   finite("damping_constant", std::isfinite(m_p.damping_constant));
@@ -82,6 +97,11 @@ double RbfCorrection::elastic_view(const Vec3& y, Vec3* d_y) const {
   if (d_y) {
     const double d_other = m_p.other_slope + q[1] * e + 2 * q[2] * s;
     *d_y = Vec3(m_p.own_slope + 2 * q[0] * e + q[1] * s, d_other + q[3] * (y[2] - 1), d_other + q[3] * (y[1] - 1));
+  }
+  if (!m_p.neo_hookean.isZero(0)) {
+    Eigen::Matrix<double, 2, 3> d_g;
+    h += m_p.neo_hookean.dot(neo_hookean_tail_basis(y, d_y ? &d_g : nullptr));
+    if (d_y) *d_y += d_g.transpose() * m_p.neo_hookean;
   }
   const double eps2 = m_p.epsilon * m_p.epsilon;
   for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i) {
@@ -142,7 +162,7 @@ bool RbfCorrection::has_damping() const {
 
 bool RbfCorrection::has_elastic_part() const {
   return !m_p.weights.isZero(0) || m_p.own_slope != 0 || m_p.other_slope != 0 || m_p.constant != 0 ||
-         !m_p.quadratic.isZero(0);
+         !m_p.quadratic.isZero(0) || !m_p.neo_hookean.isZero(0);
 }
 
 RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
@@ -178,6 +198,7 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   p.other_slope = (1 - t) * p.other_slope + t * q.other_slope;
   p.constant = (1 - t) * p.constant + t * q.constant;
   p.quadratic = (1 - t) * p.quadratic + t * q.quadratic;
+  p.neo_hookean = (1 - t) * p.neo_hookean + t * q.neo_hookean;
   p.damping_slope = (1 - t) * p.damping_slope + t * q.damping_slope;
   p.damping_constant = (1 - t) * p.damping_constant + t * q.damping_constant;
   return RbfCorrection(std::move(p));
@@ -188,6 +209,7 @@ RbfCorrection damping_part(const RbfCorrection& c) {
   p.weights.setZero();
   p.own_slope = p.other_slope = p.constant = 0;
   p.quadratic.setZero();
+  p.neo_hookean.setZero();
   return RbfCorrection(std::move(p));
 }
 

@@ -28,10 +28,19 @@ std::array<int, 3> stretch_view_indices(const Vec3& stretches, int k);
 /// y₂, y₃. Zero with zero gradient at rest.
 Eigen::Vector4d quadratic_tail_basis(const Vec3& y);
 
+/// The neo-Hookean tail's basis at a stretch view y: g(y) = (y₁ + 1/y₁ − 2,
+/// ln(y₁y₂y₃)/y₁ − (y₁ + y₂ + y₃ − 3)), zero with zero gradient at rest. Neo-Hookean minus
+/// corotated principal stress with the same Lamé parameters is exactly −μ g₁ + λ g₂ (the
+/// corotated P̂_k = 2μ(σ_k − 1) + λ Σ(σ − 1), the neo-Hookean μ(σ_k − 1/σ_k) + λ ln J/σ_k), and
+/// g₁ → ∞, g₂ → −∞ under strong compression: the barrier that the kernels and polynomial tails
+/// cannot extrapolate. Stretches are floored at 10⁻³ (inverted elements) to stay finite.
+/// `d_y`, if not null, receives ∂g_i/∂y as its rows.
+Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3>* d_y = nullptr);
+
 /// The learned correction, for centres c_i (i = 1..m) in the space of stretch views and
 /// φ_i(y) = φ(‖y − c_i‖):
 ///   N_k(σ)  = h(y_k)                                                                   [Pa]
-///   h(y)    = Σ_i w_i φ_i(y) + a (y₁ − 1) + b (y₂ + y₃ − 2) + c + qᵀ t(y)              (Eq. 10)
+///   h(y)    = Σ_i w_i φ_i(y) + a (y₁ − 1) + b (y₂ + y₃ − 2) + c + qᵀ t(y) + rᵀ g(y)     (Eq. 10)
 ///   Δα₁(σ)  = max(f, Σ_i v_i φ_i(sort↓ σ) + a_d (σ₁ + σ₂ + σ₃ − 3) + a₀)        [s]  (Eq. 13)
 /// One scalar function h serves all three principal directions, each seeing the stretches from
 /// its own side. This makes N isotropic by construction: N(Pσ) = P N(σ) for every permutation P
@@ -43,7 +52,9 @@ Eigen::Vector4d quadratic_tail_basis(const Vec3& y);
 /// (quadratic_tail_basis) spans every isotropic quadratic correction: the leading difference
 /// between two hyperelastic models (e.g. StVK or neo-Hookean against corotated) at moderate
 /// strain, which it extrapolates beyond the stretches seen in training, where the kernels'
-/// linear growth cannot.
+/// linear growth cannot. The optional neo-Hookean tail rᵀ g(y) (neo_hookean_tail_basis) spans
+/// the difference between the neo-Hookean and the corotated model, barrier included, so that
+/// strong compression beyond the training's is extrapolated the way hyperelastic models behave.
 /// Δα₁ is the stiffness-damping correction (Correction::stiffness_damping): the element's
 /// Rayleigh damping force becomes −α₁ K_e v_e − Δα₁ K_e^nom v_e, K_e the corrected and K_e^nom
 /// the nominal model's stiffness, as in paper Eq. (13) (fem::ElasticForce). A positive Δα₁ adds damping; the floor f (damping_floor) bounds how much
@@ -61,6 +72,7 @@ public:
     double other_slope = 0;       ///< b [Pa]
     double constant = 0;          ///< c [Pa]
     Eigen::Vector4d quadratic = Eigen::Vector4d::Zero(); ///< q [Pa] (see quadratic_tail_basis)
+    Eigen::Vector2d neo_hookean = Eigen::Vector2d::Zero(); ///< r [Pa] (see neo_hookean_tail_basis)
     VecX damping_weights;         ///< m damping weights v_i [s], or empty for no damping RBF
     double damping_slope = 0;     ///< a_d [s]
     double damping_constant = 0;  ///< a₀ [s]
@@ -90,7 +102,7 @@ public:
   Vec3 elastic_correction(const Vec3& stretches) const;
   /// True if Δα₁ is not identically zero.
   bool has_damping() const;
-  /// True if N is not identically zero (a weight, slope, constant or quadratic term ≠ 0).
+  /// True if N is not identically zero (a weight, slope, constant, quadratic or neo-Hookean term ≠ 0).
   bool has_elastic_part() const;
   int num_centres() const { return static_cast<int>(m_p.centres.rows()); }
   const Parameters& parameters() const { return m_p; }
