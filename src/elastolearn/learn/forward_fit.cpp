@@ -6,7 +6,6 @@
 
 #include <elastolearn/sim/linear_solver.hpp>
 
-#include <Eigen/Cholesky>
 
 #include <chrono>
 #include <cmath>
@@ -104,18 +103,19 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
   }
   if (sensitivities) s_before = s_previous;
 
-  const auto accumulate = [&](int t, const VecX& x) {
+  const auto accumulate = [&](int t, const VecX& x) { // the Gauss–Newton sums of frame t
     for (int i = 0; i < k; ++i) {
       const ObservedDof& o = observed_dofs[i];
       observed_error[i] = x[dofs.free_dofs()[o.free]] - observed.positions[t](o.slot, o.component);
+      observed_rows.row(i) = s_now.row(o.free);
     }
-    if (!sensitivities) return;
-    for (int i = 0; i < k; ++i) observed_rows.row(i) = s_now.row(observed_dofs[i].free);
     pass.normal.selfadjointView<Eigen::Lower>().rankUpdate(observed_rows.transpose());
     pass.gradient.noalias() += observed_rows.transpose() * observed_error;
   };
-  if (sensitivities) s_now = s_previous;
-  accumulate(0, frames[0]);
+  if (sensitivities) {
+    s_now = s_previous;
+    accumulate(0, frames[0]);
+  }
 
   for (int t = 1; t <= scene.frames; ++t) {
     const auto report = simulator.step();
@@ -145,8 +145,8 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
       }
       std::swap(s_before, s_previous);
       s_previous = s_now;
+      accumulate(t, frames[t]);
     }
-    accumulate(t, frames[t]);
     if (progress) progress(t, scene.frames, sensitivities ? "forward simulation with sensitivities" : "forward simulation");
   }
   pass.completed = true;
@@ -169,15 +169,11 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
     throw InputError("forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
   result.rms_history.push_back(current.error.rms);
   double mu = options.damping;
-  const Eigen::Index u = start.size();
   for (int it = 0; it < options.max_iterations; ++it) {
-    // Jacobi-scaled Levenberg–Marquardt step: (Ĥ + μ I) Δ̂ = −ĝ, Δ = Δ̂ / s, s = √diag(H).
-    VecX scale = current.normal.diagonal().cwiseSqrt();
-    for (Eigen::Index i = 0; i < u; ++i)
-      if (!(scale[i] > 0)) scale[i] = 1;
-    MatX a = scale.cwiseInverse().asDiagonal() * current.normal * scale.cwiseInverse().asDiagonal();
-    a.diagonal().array() += mu;
-    const VecX step = (a.llt().solve(-current.gradient.cwiseQuotient(scale))).cwiseQuotient(scale);
+    // Levenberg–Marquardt step on the Jacobi-scaled normal equations, (Ĥ + μ I) Δ̂ = −ĝ: the RBF
+    // fit's regularised solve with μ as its (dimensionless) Tikhonov weight.
+    const VecX step = solve_regularised_normal_equations(current.normal, -current.gradient,
+        VecX::Constant(start.size(), mu), current.error.samples);
     const VecX trial = result.unknowns + step;
     ForwardSensitivityPass next = simulate_with_sensitivities(scene, observed, mesh, design, trial, options.sensitivities, progress);
     result.rms_history.push_back(next.completed ? next.error.rms : -1.0);

@@ -127,6 +127,16 @@ ForwardRun simulate_positions(const sim::Scene& scene, const ProgressCallback& p
 
 namespace {
 
+/// RBF centres: k-means over the stretch views of `positions` (at most options.centres).
+MatX rbf_centres(const ReconstructionMesh& mesh, const std::vector<VecX>& positions, const LearningOptions& options,
+                 std::uint64_t seed) {
+  const MatX stretches = stretch_views(collect_stretches(mesh, positions, options.stretch_samples));
+  KMeansOptions kmeans_options;
+  kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(stretches.rows()));
+  kmeans_options.seed = seed;
+  return kmeans(stretches, kmeans_options).centres;
+}
+
 /// The stage after the loop: Levenberg–Marquardt on the forward error from the best correction
 /// (LearningOptions::forward_fit). Each step is one IterationRecord and one checkpoint; a resumed
 /// run restarts from the best correction with the saved μ, so it takes the same steps.
@@ -140,12 +150,7 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
   if (state.best) {
     centres = state.best->parameters().centres;
   } else {
-    const ForwardRun nominal = simulate_positions(scene, callbacks.progress);
-    KMeansOptions kmeans_options;
-    const MatX stretches = stretch_views(collect_stretches(mesh, nominal.positions, options.stretch_samples));
-    kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(stretches.rows()));
-    kmeans_options.seed = options.seed;
-    centres = kmeans(stretches, kmeans_options).centres;
+    centres = rbf_centres(mesh, simulate_positions(scene, callbacks.progress).positions, options, options.seed);
   }
   const RbfDesign design(centres, options.rbf);
   const VecX start = state.best ? design.unknowns(*state.best) : VecX(VecX::Zero(design.num_unknowns()));
@@ -163,12 +168,13 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
         if (trial.completed) record.forward_error = trial.error;
         record.centres = design.num_centres();
         record.seconds_forward = trial.seconds;
+        // The kept unknowns are the best correction (the start's, until a step is accepted).
+        state.correction = std::make_shared<material::RbfCorrection>(design.correction(kept));
         if (accepted) {
-          state.best = std::make_shared<material::RbfCorrection>(design.correction(kept));
+          state.best = state.correction;
           state.best_error = trial.error.rms;
           state.best_iteration = record.iteration;
         }
-        state.correction = std::make_shared<material::RbfCorrection>(design.correction(kept));
         ++state.forward_fit_steps;
         state.forward_fit_damping = damping;
         state.next_iteration = record.iteration + 1;
@@ -291,13 +297,9 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       t0 = Clock::now();
       const auto targets = trajectory_residuals(nominal_physics, optimized.positions, forward.initial_velocity);
       const auto velocities = finite_difference_velocities(optimized.positions, forward.initial_velocity, scene.dt);
-      const MatX stretches =
-          stretch_views(collect_stretches(reconstruction_mesh, optimized.positions, options.stretch_samples));
-      KMeansOptions kmeans_options;
-      kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(stretches.rows()));
-      kmeans_options.seed = options.seed + static_cast<std::uint64_t>(record.iteration);
-      const KMeansResult clusters = kmeans(stretches, kmeans_options);
-      const RbfDesign design(clusters.centres, rbf);
+      const RbfDesign design(rbf_centres(reconstruction_mesh, optimized.positions, options,
+                                         options.seed + static_cast<std::uint64_t>(record.iteration)),
+                             rbf);
       StressReconstructionOptions reconstruction_options = options.reconstruction;
       if (options.max_reconstruction_frames > 0)
         reconstruction_options.frame_stride =
