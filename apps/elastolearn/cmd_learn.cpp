@@ -239,6 +239,9 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--forward-fit", l.forward_fit.max_iterations,
                   "Levenberg-Marquardt steps on the forward simulation's error after the loop (0 = none)")
       ->capture_default_str();
+  cmd->add_option("--damping-prior", l.forward_fit.damping_prior,
+                  "forward fit: Tikhonov weight (Jacobi-scaled) pulling the damping correction towards 0")
+      ->capture_default_str();
   cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")->capture_default_str();
   cmd->add_flag("--neo-hookean-tail", l.rbf.neo_hookean_tail,
                 "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");

@@ -44,6 +44,8 @@ void ForwardFitOptions::validate() const {
     throw InputError("forward_fit.max_iterations", "must be ≥ 0, got " + std::to_string(max_iterations));
   if (!std::isfinite(damping) || damping <= 0)
     throw InputError("forward_fit.damping", "must be finite and > 0");
+  if (!std::isfinite(damping_prior) || damping_prior < 0)
+    throw InputError("forward_fit.damping_prior", "must be finite and ≥ 0");
   if (sensitivities == Sensitivities::none)
     throw InputError("forward_fit.sensitivities", "the fit needs sensitivities (projected or exact)");
 }
@@ -169,15 +171,28 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
     throw InputError("forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
   result.rms_history.push_back(current.error.rms);
   double mu = options.damping;
+  const int first_damping = design.elastic_unknowns(), n_damping = design.damping_unknowns();
   for (int it = 0; it < options.max_iterations; ++it) {
+    // The prior ρ_d Σ (s_i w_i)² on the damping unknowns, with s fixed by the current pass so
+    // that the trial and the current objective are measured alike (and a resumed fit, which
+    // recomputes the current pass, takes the same steps).
+    VecX prior_weights = VecX::Zero(start.size());
+    prior_weights.segment(first_damping, n_damping)
+        = options.damping_prior * current.normal.diagonal().segment(first_damping, n_damping);
+    const auto objective = [&](const ForwardSensitivityPass& pass, const VecX& w) {
+      return pass.squared_error + w.dot(prior_weights.cwiseProduct(w));
+    };
+    MatX normal = current.normal;
+    normal.diagonal() += prior_weights;
+    const VecX gradient = current.gradient + prior_weights.cwiseProduct(result.unknowns);
     // Levenberg–Marquardt step on the Jacobi-scaled normal equations, (Ĥ + μ I) Δ̂ = −ĝ: the RBF
     // fit's regularised solve with μ as its (dimensionless) Tikhonov weight.
-    const VecX step = solve_regularised_normal_equations(current.normal, -current.gradient,
+    const VecX step = solve_regularised_normal_equations(std::move(normal), -gradient,
         VecX::Constant(start.size(), mu), current.error.samples);
     const VecX trial = result.unknowns + step;
     ForwardSensitivityPass next = simulate_with_sensitivities(scene, observed, mesh, design, trial, options.sensitivities, progress);
     result.rms_history.push_back(next.completed ? next.error.rms : -1.0);
-    const bool accepted = next.completed && next.squared_error < current.squared_error;
+    const bool accepted = next.completed && objective(next, trial) < objective(current, result.unknowns);
     if (accepted) {
       result.unknowns = trial;
       ++result.accepted;
