@@ -53,7 +53,7 @@ material::RbfCorrection::Parameters rbf_parameters(int centres, unsigned seed) {
   for (auto& r : p.neo_hookean) r = awkward(rng);
   p.damping_weights.resize(centres);
   fill(p.damping_weights, rng);
-  p.damping_slope = awkward(rng);
+  p.damping_slopes = Vec3(awkward(rng), awkward(rng), awkward(rng));
   p.damping_constant = awkward(rng);
   p.damping_floor = -0.002 / 3;
   p.epsilon = 1e-3 / 3;
@@ -140,7 +140,7 @@ TEST(MaterialFile, RbfRoundTripIsBitExact) {
   EXPECT_EQ(p.quadratic, q.quadratic);
   EXPECT_EQ(p.neo_hookean, q.neo_hookean);
   EXPECT_EQ(p.damping_weights, q.damping_weights);
-  EXPECT_EQ(p.damping_slope, q.damping_slope);
+  EXPECT_EQ(p.damping_slopes, q.damping_slopes);
   EXPECT_EQ(p.damping_floor, q.damping_floor);
   EXPECT_EQ(p.damping_constant, q.damping_constant);
   EXPECT_EQ(p.epsilon, q.epsilon);
@@ -249,6 +249,13 @@ TEST(MaterialFile, BadFilesNameTheFileAndField) {
   j["correction"]["damping_weights"].erase(0);
   expect_bad(j, { "bad.json: correction.damping_weights" });
 
+  j = valid_rbf_file();
+  j["correction"]["damping_slope"] = 0.1; // the older scalar slope besides the sorted ones
+  expect_bad(j, { "bad.json: correction.damping_slope", "not both" });
+  j = valid_rbf_file();
+  j["correction"]["damping_slopes"] = Json::array({ 0.1, 0.2 });
+  expect_bad(j, { "bad.json: correction.damping_slopes", "3 numbers" });
+
   // JSON has no NaN: nlohmann writes a NaN as null, and a hand-edited "NaN" is invalid JSON.
   j = valid_rbf_file();
   j["correction"]["weights"][2] = std::nan("");
@@ -311,6 +318,16 @@ TEST(MaterialFile, BadFilesNameTheFileAndField) {
   j = material_file_to_json(nn);
   j["correction"]["damping"]["type"] = "nn";
   expect_bad(j, { "bad.json: correction.damping.type", "\"rbf\"" });
+}
+
+TEST(MaterialFile, OlderScalarDampingSlopeReadsAsEqualSortedSlopes) {
+  // Files written before the sorted slopes carry one slope a_d along Σσ − 3 = Σ (s_k − 1).
+  Json j = valid_rbf_file();
+  j["correction"].erase("damping_slopes");
+  j["correction"]["damping_slope"] = 0.25;
+  const auto file = parse_material_file(j, "old.json");
+  const auto& c = dynamic_cast<const material::RbfCorrection&>(*file.correction);
+  EXPECT_EQ(c.parameters().damping_slopes, Vec3::Constant(0.25));
 }
 
 TEST(MaterialFile, BrokenJsonNamesTheLine) {

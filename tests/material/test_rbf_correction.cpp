@@ -37,7 +37,7 @@ RbfCorrection::Parameters test_parameters(double epsilon) {
   p.constant = 10;
   p.quadratic = Eigen::Vector4d(3e4, -2e4, 1e4, 4e4);
   p.neo_hookean = Eigen::Vector2d(-2e4, 3e4);
-  p.damping_slope = 0.01;
+  p.damping_slopes = Vec3(0.01, -0.02, 0.005);
   p.damping_constant = 0.03;
   p.epsilon = epsilon;
   return p;
@@ -157,7 +157,7 @@ TEST(RbfCorrection, ElasticAndDampingPartsAreTheDocumentedRbfs) {
   const Vec3 s(1.15, 0.97, 0.88), r(0.3, -0.5, 0.1);
   // N(σ) and Δα₁(σ) are the documented RBF + linear tail; N does not see the stretch rates (the
   // damping acts through Δα₁ on the nominal stiffness, fem::ElasticForce).
-  double expected_alpha = p.damping_slope * (s.sum() - 3) + p.damping_constant;
+  double expected_alpha = p.damping_slopes.dot(s - Vec3::Ones()) + p.damping_constant; // s sorted ↓
   Vec3 expected_elastic;
   for (int k = 0; k < 3; ++k) {
     const Vec3 y = stretch_view(s, k);
@@ -187,12 +187,12 @@ TEST(RbfCorrection, ElasticAndDampingPartsAreTheDocumentedRbfs) {
 TEST(RbfCorrection, DampingFloorBoundsTheDampingCorrection) {
   RbfCorrection::Parameters p = test_parameters(1e-3);
   p.damping_weights.resize(0);
-  p.damping_slope = 1.0; // Δα₁ = Σσ − 3 + a₀
+  p.damping_slopes = Vec3(1.0, 0.0, 0.0); // Δα₁ = max σ − 1 + a₀
   p.damping_constant = 0;
   p.damping_floor = -0.05;
   const RbfCorrection n(p);
-  EXPECT_NEAR(n.stiffness_damping(Vec3(1.1, 1.0, 1.0)), 0.1, 1e-14);
-  EXPECT_EQ(n.stiffness_damping(Vec3(0.9, 0.9, 1.0)), -0.05); // −0.2 clamped
+  EXPECT_NEAR(n.stiffness_damping(Vec3(1.0, 1.1, 0.95)), 0.1, 1e-14); // the largest stretch, wherever it is
+  EXPECT_EQ(n.stiffness_damping(Vec3(0.9, 0.8, 0.85)), -0.05); // −0.1 clamped
 }
 
 TEST(RbfCorrection, LinearTailIsAnIsotropicLameChange) {
@@ -215,7 +215,7 @@ TEST(RbfCorrection, ZeroWithoutWeightsAndWithoutDampingPart) {
   p.quadratic.setZero();
   p.neo_hookean.setZero();
   p.damping_weights.resize(0); // no damping RBF; the damping tail alone remains
-  p.damping_slope = 0;
+  p.damping_slopes.setZero();
   p.damping_constant = 0;
   const RbfCorrection n(p);
   EXPECT_EQ(n.correction(Vec3(1.2, 1.0, 0.7), Vec3(1, 2, 3)), Vec3::Zero());

@@ -46,7 +46,7 @@ Json rbf_to_json(const material::RbfCorrection& c) {
     { "other_slope", p.other_slope }, { "constant", p.constant },
     { "quadratic", vector_to_json(p.quadratic) },
     { "neo_hookean", vector_to_json(p.neo_hookean) },
-    { "damping_weights", vector_to_json(p.damping_weights) }, { "damping_slope", p.damping_slope },
+    { "damping_weights", vector_to_json(p.damping_weights) }, { "damping_slopes", vector_to_json(p.damping_slopes) },
     { "damping_constant", p.damping_constant }, { "damping_floor", floor } };
 }
 
@@ -127,7 +127,7 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
 
 std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "epsilon", "centres", "weights", "own_slope", "other_slope",
-      "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slope", "damping_constant",
+      "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes", "damping_slope", "damping_constant",
       "damping_floor" });
   material::RbfCorrection::Parameters p;
   p.epsilon = o.number("epsilon");
@@ -148,7 +148,12 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
               + std::to_string(p.damping_weights.size()));
     }
   }
-  p.damping_slope = o.number("damping_slope", 0.0);
+  if (o.has("damping_slopes") && o.has("damping_slope"))
+    o.fail("damping_slope", "give either damping_slopes or the older damping_slope (a slope along Σσ − 3), not both");
+  if (o.has("damping_slopes"))
+    p.damping_slopes = read_vector(o, "damping_slopes", 3);
+  else // files before version 2 of the tail: one slope along the trace, i.e. equal sorted slopes
+    p.damping_slopes.setConstant(o.number("damping_slope", 0.0));
   p.damping_constant = o.number("damping_constant", 0.0);
   if (o.has("damping_floor") && !o.json().at("damping_floor").is_null())
     p.damping_floor = o.number("damping_floor");

@@ -62,7 +62,7 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_o
       m_elastic += 2;
     }
   }
-  m_damping = options.fit_damping ? m + (options.damping_polynomial ? 2 : 0) : 0;
+  m_damping = options.fit_damping ? m + (options.damping_polynomial ? 4 : 0) : 0;
 }
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
@@ -127,8 +127,8 @@ void RbfDesign::damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd
   for (Eigen::Index i = 0; i < m; ++i)
     out[i] = material::rbf_kernel((s - m_centres.row(i).transpose()).squaredNorm(), m_options.epsilon);
   if (m_options.damping_polynomial) {
-    out[m] = s.sum() - 3;
-    out[m + 1] = 1;
+    out.segment<3>(m) = (s - Vec3::Ones()).transpose();
+    out[m + 3] = 1;
   }
 }
 
@@ -151,8 +151,8 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
     const auto v = x.tail(m_damping);
     p.damping_weights = v.head(m);
     if (m_options.damping_polynomial) {
-      p.damping_slope = v[m];
-      p.damping_constant = v[m + 1];
+      p.damping_slopes = v.segment<3>(m);
+      p.damping_constant = v[m + 3];
     }
     p.damping_floor = m_options.damping_floor;
   }
@@ -165,7 +165,8 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon)
     fail("correction", "its centres or kernel smoothing differ from the design's");
   const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();
-  const bool has_damping = p.damping_weights.size() > 0 || p.damping_slope != 0 || p.damping_constant != 0;
+  const bool has_damping_tail = !p.damping_slopes.isZero(0) || p.damping_constant != 0;
+  const bool has_damping = p.damping_weights.size() > 0 || has_damping_tail;
   if ((has_tail && !m_options.elastic_polynomial) || (!p.quadratic.isZero() && m_quadratic < 0) ||
       (!p.neo_hookean.isZero() && m_neo_hookean < 0) ||
       (has_damping && m_damping == 0))
@@ -185,9 +186,9 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   if (m_damping > 0) {
     if (p.damping_weights.size() == m) x.segment(m_elastic, m) = p.damping_weights;
     if (m_options.damping_polynomial) {
-      x[m_elastic + m] = p.damping_slope;
-      x[m_elastic + m + 1] = p.damping_constant;
-    } else if (p.damping_slope != 0 || p.damping_constant != 0)
+      x.segment<3>(m_elastic + m) = p.damping_slopes;
+      x[m_elastic + m + 3] = p.damping_constant;
+    } else if (has_damping_tail)
       fail("correction", "it has a damping tail the design does not fit");
   }
   return x;

@@ -79,7 +79,7 @@ RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
   finite("quadratic", m_p.quadratic.allFinite());
   finite("neo_hookean", m_p.neo_hookean.allFinite());
   finite("damping_weights", m_p.damping_weights.allFinite());
-  finite("damping_slope", std::isfinite(m_p.damping_slope));
+  finite("damping_slopes", m_p.damping_slopes.allFinite());
   finite("damping_constant", std::isfinite(m_p.damping_constant));
   if (std::isnan(m_p.damping_floor) || m_p.damping_floor == std::numeric_limits<double>::infinity())
     fail("damping_floor", "must be a number or −infinity");
@@ -114,10 +114,10 @@ double RbfCorrection::elastic_view(const Vec3& y, Vec3* d_y) const {
 }
 
 double RbfCorrection::stiffness_damping(const Vec3& stretches) const {
-  double alpha = m_p.damping_slope * (stretches.sum() - 3) + m_p.damping_constant;
+  const auto p = descending_order(stretches);
+  const Vec3 s(stretches[p[0]], stretches[p[1]], stretches[p[2]]);
+  double alpha = m_p.damping_slopes.dot(s - Vec3::Ones()) + m_p.damping_constant;
   if (m_p.damping_weights.size() > 0) {
-    const auto p = descending_order(stretches);
-    const Vec3 s(stretches[p[0]], stretches[p[1]], stretches[p[2]]);
     for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i)
       alpha += m_p.damping_weights[i] * rbf_kernel((s - m_p.centres.row(i).transpose()).squaredNorm(), m_p.epsilon);
   }
@@ -156,7 +156,7 @@ Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
 }
 
 bool RbfCorrection::has_damping() const {
-  return m_p.damping_weights.size() > 0 || m_p.damping_slope != 0 || m_p.damping_constant != 0 ||
+  return m_p.damping_weights.size() > 0 || !m_p.damping_slopes.isZero(0) || m_p.damping_constant != 0 ||
          m_p.damping_floor > 0;
 }
 
@@ -199,7 +199,7 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   p.constant = (1 - t) * p.constant + t * q.constant;
   p.quadratic = (1 - t) * p.quadratic + t * q.quadratic;
   p.neo_hookean = (1 - t) * p.neo_hookean + t * q.neo_hookean;
-  p.damping_slope = (1 - t) * p.damping_slope + t * q.damping_slope;
+  p.damping_slopes = (1 - t) * p.damping_slopes + t * q.damping_slopes;
   p.damping_constant = (1 - t) * p.damping_constant + t * q.damping_constant;
   return RbfCorrection(std::move(p));
 }

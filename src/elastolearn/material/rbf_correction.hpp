@@ -41,7 +41,7 @@ Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3
 /// φ_i(y) = φ(‖y − c_i‖):
 ///   N_k(σ)  = h(y_k)                                                                   [Pa]
 ///   h(y)    = Σ_i w_i φ_i(y) + a (y₁ − 1) + b (y₂ + y₃ − 2) + c + qᵀ t(y) + rᵀ g(y)     (Eq. 10)
-///   Δα₁(σ)  = max(f, Σ_i v_i φ_i(sort↓ σ) + a_d (σ₁ + σ₂ + σ₃ − 3) + a₀)        [s]  (Eq. 13)
+///   Δα₁(σ)  = max(f, Σ_i v_i φ_i(s) + a_dᵀ (s − 1) + a₀),  s = sort↓ σ             [s]  (Eq. 13)
 /// One scalar function h serves all three principal directions, each seeing the stretches from
 /// its own side. This makes N isotropic by construction: N(Pσ) = P N(σ) for every permutation P
 /// and, crucially, N_i = N_j whenever σ_i = σ_j, so that P = U diag(P̂ + N) Vᵀ is a continuous
@@ -74,7 +74,11 @@ public:
     Eigen::Vector4d quadratic = Eigen::Vector4d::Zero(); ///< q [Pa] (see quadratic_tail_basis)
     Eigen::Vector2d neo_hookean = Eigen::Vector2d::Zero(); ///< r [Pa] (see neo_hookean_tail_basis)
     VecX damping_weights;         ///< m damping weights v_i [s], or empty for no damping RBF
-    double damping_slope = 0;     ///< a_d [s]
+    /// a_d [s]: Δα₁'s slope along each sorted stretch s₁ ≥ s₂ ≥ s₃. A linear function of the
+    /// sorted stretches is symmetric (isotropic) like the kernels, and spans damping that grows
+    /// with the largest stretch only, which a slope along the trace Σσ − 3 (all three equal)
+    /// cannot: in bending, σ₁ − 1 is of one size on both sides while the trace nearly vanishes.
+    Vec3 damping_slopes = Vec3::Zero();
     double damping_constant = 0;  ///< a₀ [s]
     /// Δα₁ is clamped below at this value [s] when evaluated: set it to −α₁ of the nominal
     /// model so that the total stiffness damping never turns negative (energy would grow).
