@@ -152,7 +152,7 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
     o.fail("damping_slope", "give either damping_slopes or the older damping_slope (a slope along Σσ − 3), not both");
   if (o.has("damping_slopes"))
     p.damping_slopes = read_vector(o, "damping_slopes", 3);
-  else // files before version 2 of the tail: one slope along the trace, i.e. equal sorted slopes
+  else // older files: one slope along the trace Σσ − 3 = Σ (s_k − 1), i.e. equal sorted slopes
     p.damping_slopes.setConstant(o.number("damping_slope", 0.0));
   p.damping_constant = o.number("damping_constant", 0.0);
   if (o.has("damping_floor") && !o.json().at("damping_floor").is_null())
