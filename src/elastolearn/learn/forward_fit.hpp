@@ -62,9 +62,10 @@ struct ForwardFitOptions {
   /// Weight ρ_d of a Tikhonov prior on the damping unknowns (Δα₁): the fit minimises
   /// E(w) + ρ_d Σ_{i damping} (s_i w_i)², s_i = √(JᵀJ)_ii of the current accepted pass, so ρ_d is
   /// dimensionless like μ. Observations of a few motions constrain Δα₁ only at the stretches
-  /// they reach, and an unconstrained Δα₁ extrapolates badly: on the quick sphere-compression
-  /// case the test err_L went 2.398 % (ρ_d = 0) → 0.940 % (ρ_d = 1), nominal 2.252 %
-  /// (docs/benchmarks_learning.md, "Update 8"). 0 turns the prior off.
+  /// they reach, and an unconstrained Δα₁ extrapolates badly: on the full-size
+  /// sphere-compression case (with the neo-Hookean tail) the test simulation diverged with
+  /// ρ_d = 0 and tests at 1.250 % with ρ_d = 1, nominal 2.294 % (docs/benchmarks_learning.md,
+  /// "Update 8"). 0 turns the prior off.
   double damping_prior = 0;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;

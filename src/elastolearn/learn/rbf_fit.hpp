@@ -26,7 +26,7 @@ struct RbfFitOptions {
   /// distilled network 0.349 % instead of 0.0462 %. The sphere cases turn it on, with a prior on
   /// Δα₁ in the forward fit (ForwardFitOptions::damping_prior): alone it rescued the quick
   /// sphere-compression's test simulation but tested above the nominal (2.398 % against 2.252 %);
-  /// together they bring the full-size case to 1.238 % (docs/benchmarks_learning.md, "Update 8").
+  /// together they bring the full-size case to 1.250 % (docs/benchmarks_learning.md, "Update 8").
   bool neo_hookean_tail = false;
   /// Fit the stiffness-damping RBF Δα₁(σ) (only the stress reconstruction can: it needs the
   /// elements' damping forces, which principal stress samples do not carry).
