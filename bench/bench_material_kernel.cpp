@@ -9,6 +9,7 @@
 #include <elastolearn/fem/tet_element.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/material/principal_stress.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
 #include <elastolearn/material/svd3.hpp>
 
 #include <Eigen/SVD>
@@ -239,6 +240,37 @@ void BM_Element(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Element);
+
+/// A learned RBF correction N(σ) with its stretch gradient, as every element evaluates it per
+/// force evaluation during learning: m centres (the learning default is 40) spread like stretch
+/// samples (1 ± 0.05), a quadratic tail, weights of realistic size; the state's stretches.
+void BM_RbfCorrectionWithGradient(benchmark::State& state) {
+  const int m = static_cast<int>(state.range(0));
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  material::RbfCorrection::Parameters p;
+  p.centres.resize(m, 3);
+  p.weights.resize(m);
+  for (int i = 0; i < m; ++i) {
+    p.centres.row(i) = Eigen::RowVector3d(1 + 0.05 * n(rng), 1 + 0.05 * n(rng), 1 + 0.05 * n(rng));
+    p.weights[i] = 1e3 * n(rng);
+  }
+  p.own_slope = 5e3;
+  p.quadratic = Eigen::Vector4d(3e4, -2e4, 1e4, 4e4);
+  const material::RbfCorrection correction(p);
+  const auto& in = prepared();
+  int k = 0;
+  for (auto _ : state) {
+    Mat3 ds, dr;
+    Vec3 N = correction.correction_with_gradient(in[k].frame.stretches, Vec3::Zero(), ds, dr);
+    benchmark::DoNotOptimize(N);
+    benchmark::DoNotOptimize(ds);
+    k = (k + 1) & (kStates - 1);
+  }
+  state.counters["time/kernel"] = benchmark::Counter(3.0 * m * static_cast<double>(state.iterations()),
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_RbfCorrectionWithGradient)->ArgName("centres")->Arg(40)->Arg(160);
 
 } // namespace
 

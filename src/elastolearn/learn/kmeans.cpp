@@ -4,10 +4,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <sstream>
+#include <type_traits>
 
 namespace elastolearn::learn {
 
@@ -19,66 +21,239 @@ template <typename T> std::string str(T v) {
   return s.str();
 }
 
-/// Label and squared distance of every point to its nearest centre (ties: lowest index).
-/// `points_t` and `centres_t` are d × n and d × k (column-major: each point contiguous); the
-/// distance of a point does not depend on how the range is split, so the result is deterministic.
-template <int D>
-void assign_fixed(
-    const MatX& points_t, const MatX& centres_t, std::vector<int>& labels, VecX& distance) {
-  const Eigen::Index n = points_t.cols();
-  const Eigen::Index k = centres_t.cols();
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+/// Squared distance of two d-vectors (D = d, or 0 for any d), summed in coordinate order. Every
+/// distance in this file goes through here, so a distance recomputed later is bitwise the same.
+template <int D> double squared_distance(const double* p, const double* q, Eigen::Index d) {
+  double sum = 0;
+  for (Eigen::Index j = 0; j < (D > 0 ? D : d); ++j) {
+    const double diff = p[j] - q[j];
+    sum += diff * diff;
+  }
+  return sum;
+}
+
+/// Run `f(std::integral_constant<int, D>)` with D = d for the common dimensions (an unrolled
+/// inner loop), else with D = 0.
+template <typename F> void with_dimension(Eigen::Index d, F&& f) {
+  switch (d) {
+  case 3:
+    return f(std::integral_constant<int, 3> {});
+  case 6:
+    return f(std::integral_constant<int, 6> {});
+  default:
+    return f(std::integral_constant<int, 0> {});
+  }
+}
+
+struct Nearest {
+  int label = 0; ///< nearest centre (ties: lowest index)
+  double best = infinity; ///< its squared distance
+  double second = infinity; ///< squared distance to the nearest other centre (∞ if k = 1)
+};
+
+/// Nearest centre of the point p among the columns of the d × k `centres_t`.
+template <int D> Nearest nearest(const double* p, const MatX& centres_t) {
+  const Eigen::Index d = centres_t.rows();
+  Nearest r;
+  for (Eigen::Index c = 0; c < centres_t.cols(); ++c) {
+    const double sum = squared_distance<D>(p, centres_t.data() + c * d, d);
+    if (sum < r.best) {
+      r.second = r.best;
+      r.best = sum;
+      r.label = static_cast<int>(c);
+    } else {
+      r.second = std::min(r.second, sum);
+    }
+  }
+  return r;
+}
+
+/// Parallel loop over the n points; `body(i, p)` gets the index and the point's coordinates.
+/// Each point's result depends only on that point, never on the thread split.
+template <typename Body> void for_each_point(const MatX& points_t, Body&& body) {
   const Eigen::Index d = points_t.rows();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 4096),
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, points_t.cols(), 4096),
       [&](const tbb::blocked_range<Eigen::Index>& range) {
-        for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
-          const double* p = points_t.data() + i * d;
-          double best = std::numeric_limits<double>::infinity();
-          int label = 0;
-          for (Eigen::Index c = 0; c < k; ++c) {
-            const double* q = centres_t.data() + c * d;
-            double sum = 0;
-            for (Eigen::Index j = 0; j < (D > 0 ? D : d); ++j) {
-              const double diff = p[j] - q[j];
-              sum += diff * diff;
-            }
-            if (sum < best) {
-              best = sum;
-              label = static_cast<int>(c);
-            }
-          }
-          labels[i] = label;
-          distance[i] = best;
-        }
+        for (Eigen::Index i = range.begin(); i != range.end(); ++i)
+          body(i, points_t.data() + i * d);
       });
 }
 
-void assign(const MatX& points_t, const MatX& centres_t, std::vector<int>& labels, VecX& distance) {
-  switch (points_t.rows()) { // the common dimensions get an unrolled inner loop
-  case 3:
-    return assign_fixed<3>(points_t, centres_t, labels, distance);
-  case 6:
-    return assign_fixed<6>(points_t, centres_t, labels, distance);
-  default:
-    return assign_fixed<0>(points_t, centres_t, labels, distance);
+/// Sum of the points of each cluster (columns of the d × k `sums`) and the cluster sizes,
+/// accumulated in point order so that the centres do not depend on anything else.
+template <int D>
+void cluster_sums(const MatX& points_t, const std::vector<int>& labels, MatX& sums, VecX& sizes) {
+  const Eigen::Index d = points_t.rows();
+  sums.setZero();
+  sizes.setZero();
+  for (Eigen::Index i = 0; i < points_t.cols(); ++i) {
+    const double* p = points_t.data() + i * d;
+    double* sum = sums.data() + labels[i] * d;
+    for (Eigen::Index j = 0; j < (D > 0 ? D : d); ++j)
+      sum[j] += p[j];
+    sizes[labels[i]] += 1;
   }
 }
 
-/// Squared distance of every point (columns of the d × n `points_t`) to `centre` (length d).
-void squared_distances(const MatX& points_t, const VecX& centre, VecX& out) {
+/// Squared distance of every point to the centre it is labelled with.
+template <int D>
+void labelled_distances(
+    const MatX& points_t, const MatX& centres_t, const std::vector<int>& labels, VecX& distance) {
   const Eigen::Index d = points_t.rows();
-  for (Eigen::Index i = 0; i < points_t.cols(); ++i) {
-    const double* p = points_t.data() + i * d;
-    double sum = 0;
-    for (Eigen::Index j = 0; j < d; ++j)
-      sum += (p[j] - centre[j]) * (p[j] - centre[j]);
-    out[i] = sum;
+  for_each_point(points_t, [&](Eigen::Index i, const double* p) {
+    distance[i] = squared_distance<D>(p, centres_t.data() + labels[i] * d, d);
+  });
+}
+
+/// Lloyd's assignment step accelerated with Hamerly's bounds ("Making k-means even faster",
+/// SDM 2010), because it is the hot path: plain Lloyd computes all n·k distances every
+/// iteration. Per point, an upper bound on the distance to its centre and one lower bound on
+/// the distance to every other centre (moved by the centre shifts) prove that most points keep
+/// their centre. A point whose bounds fail visits the other centres by increasing gap from its
+/// own and stops once the triangle inequality puts the rest beyond the second-nearest: the
+/// same nearest and second-nearest as comparing all k, for a fraction of the distances.
+/// Exactness: bounds are on plain distances, upper ones rounded up and lower ones down by
+/// `slack`, and a centre is only ruled out by a relative margin of `slack`, far above the
+/// rounding of a squared distance; so labels equal plain Lloyd's, lowest-index ties included.
+class HamerlyAssignment {
+  public:
+  HamerlyAssignment(Eigen::Index n, Eigen::Index d, int k)
+      : m_upper(n)
+      , m_lower(n)
+      , m_shift(VecX::Zero(k))
+      , m_half_gap(k)
+      , m_gap(k, k)
+      , m_order(k - 1, k)
+      , m_slack(16 * double(d + 10) * std::numeric_limits<double>::epsilon()) { }
+
+  /// Label every point with its nearest centre (columns of the d × k `centres_t`). `labels`
+  /// must hold the previous labels unless the bounds were invalidated.
+  template <int D>
+  void assign(const MatX& points_t, const MatX& centres_t, std::vector<int>& labels);
+
+  /// Record how far centre c moved since the last `assign`.
+  void set_shift(int c, double distance) { m_shift[c] = distance; }
+  /// Forget the bounds: the next `assign` compares every point with all centres (as on first
+  /// use; after a re-seed, where a centre jumps).
+  void invalidate() { m_valid = false; }
+
+  private:
+  double up(double x) const { return x * (1 + m_slack); }
+  double down(double x) const { return x * (1 - m_slack); }
+  template <int D> void update_gaps(const MatX& centres_t);
+  template <int D>
+  Nearest nearest_around(
+      const double* p, const MatX& centres_t, int a, double best, double upper) const;
+
+  VecX m_upper; ///< n: ≥ distance of each point to its labelled centre
+  VecX m_lower; ///< n: ≤ distance of each point to every other centre
+  VecX m_shift; ///< k: distance each centre moved since the last assign
+  VecX m_half_gap; ///< k: ≤ half the distance of each centre to its nearest other centre
+  MatX m_gap; ///< k × k: ≤ distance between two centres
+  Eigen::MatrixXi m_order; ///< (k − 1) × k: column a = the other centres by increasing gap from a
+  double m_slack; ///< 16 × the relative rounding of a squared distance, about (d + 3) ε
+  bool m_valid = false; ///< false: m_upper and m_lower mean nothing
+};
+
+template <int D> void HamerlyAssignment::update_gaps(const MatX& centres_t) {
+  const Eigen::Index d = centres_t.rows();
+  const int k = static_cast<int>(centres_t.cols());
+  for (int a = 0; a < k; ++a) {
+    m_gap(a, a) = 0;
+    for (int b = a + 1; b < k; ++b) {
+      m_gap(a, b) = m_gap(b, a) = down(
+          std::sqrt(squared_distance<D>(centres_t.data() + a * d, centres_t.data() + b * d, d)));
+    }
   }
+  for (int a = 0; a < k; ++a) {
+    int* order = m_order.col(a).data();
+    for (int c = 0, row = 0; c < k; ++c) {
+      if (c != a)
+        order[row++] = c;
+    }
+    std::sort(order, order + k - 1, [&](int b, int c) { // ties by index: deterministic
+      return m_gap(b, a) < m_gap(c, a) || (m_gap(b, a) == m_gap(c, a) && b < c);
+    });
+    m_half_gap[a] = k > 1 ? 0.5 * m_gap(order[0], a) : infinity;
+  }
+}
+
+/// Nearest centre of the point p labelled a, given `best` = its squared distance to centre a
+/// and `upper` ≥ the plain distance.
+template <int D>
+Nearest HamerlyAssignment::nearest_around(
+    const double* p, const MatX& centres_t, int a, double best, double upper) const {
+  const Eigen::Index d = centres_t.rows();
+  Nearest r { a, best, infinity };
+  for (Eigen::Index row = 0; row < m_order.rows(); ++row) {
+    const int c = m_order(row, a);
+    const double rest = down(m_gap(c, a) - upper); // ≤ distance of p to c and all after it
+    if (rest > 0 && down(rest * rest) > r.second)
+      break;
+    const double sum = squared_distance<D>(p, centres_t.data() + c * d, d);
+    if (sum < r.best || (sum == r.best && c < r.label)) { // Lloyd's rule: lowest index wins
+      r.second = r.best;
+      r.best = sum;
+      r.label = c;
+    } else {
+      r.second = std::min(r.second, sum);
+    }
+  }
+  return r;
+}
+
+template <int D>
+void HamerlyAssignment::assign(
+    const MatX& points_t, const MatX& centres_t, std::vector<int>& labels) {
+  const Eigen::Index d = points_t.rows();
+  if (!m_valid) {
+    for_each_point(points_t, [&](Eigen::Index i, const double* p) {
+      const Nearest near = nearest<D>(p, centres_t);
+      labels[i] = near.label;
+      m_upper[i] = up(std::sqrt(near.best));
+      m_lower[i] = down(std::sqrt(near.second));
+    });
+    m_valid = true;
+    return;
+  }
+  update_gaps<D>(centres_t);
+  // A lower bound drops by the largest shift of the other centres: the largest overall, or
+  // the second largest for points labelled with the centre that moved most.
+  Eigen::Index most = 0;
+  const double largest = up(m_shift.maxCoeff(&most));
+  double second = 0;
+  for (Eigen::Index c = 0; c < m_shift.size(); ++c)
+    second = c == most ? second : std::max(second, m_shift[c]);
+  second = up(second);
+  for_each_point(points_t, [&](Eigen::Index i, const double* p) {
+    const int a = labels[i];
+    double upper = up(m_upper[i] + m_shift[a]);
+    double lower = down(m_lower[i]) - (a == most ? second : largest);
+    // Within half the gap to its nearest other centre, or below the lower bound, a point
+    // keeps its centre.
+    const double bound = std::max(m_half_gap[a], lower);
+    if (up(upper) >= bound) { // the upper bound may be loose: measure the distance
+      const double own = squared_distance<D>(p, centres_t.data() + a * d, d);
+      upper = up(std::sqrt(own));
+      if (up(upper) >= bound) { // another centre may be as near
+        const Nearest near = nearest_around<D>(p, centres_t, a, own, upper);
+        labels[i] = near.label;
+        upper = up(std::sqrt(near.best));
+        lower = down(std::sqrt(near.second));
+      }
+    }
+    m_upper[i] = upper;
+    m_lower[i] = lower;
+  });
 }
 
 /// k-means++ seeding on the d × n points; returns k × d centres.
 MatX seed_centres(const MatX& points_t, int k, std::mt19937_64& rng) {
   const Eigen::Index n = points_t.cols();
-  MatX centres(k, points_t.rows());
+  const Eigen::Index d = points_t.rows();
+  MatX centres(k, d);
   std::uniform_int_distribution<Eigen::Index> uniform(0, n - 1);
   VecX nearest(n), candidate(n);
   for (int c = 0; c < k; ++c) {
@@ -103,7 +278,9 @@ MatX seed_centres(const MatX& points_t, int k, std::mt19937_64& rng) {
     }
     const VecX centre = points_t.col(pick);
     centres.row(c) = centre.transpose();
-    squared_distances(points_t, centre, candidate);
+    for_each_point(points_t, [&](Eigen::Index i, const double* p) {
+      candidate[i] = squared_distance<0>(p, centre.data(), d);
+    });
     nearest = c == 0 ? candidate : nearest.cwiseMin(candidate);
   }
   return centres;
@@ -123,6 +300,7 @@ void KMeansOptions::validate() const {
 KMeansResult kmeans(ConstRef<MatX> points, const KMeansOptions& options) {
   options.validate();
   const Eigen::Index n = points.rows();
+  const Eigen::Index d = points.cols();
   const int k = options.clusters;
   if (n < k) {
     throw InputError(
@@ -141,18 +319,26 @@ KMeansResult kmeans(ConstRef<MatX> points, const KMeansOptions& options) {
   const VecX mean = points_t.rowwise().mean();
   const double spread = std::sqrt((points_t.colwise() - mean).colwise().squaredNorm().mean());
 
-  MatX sums(points.cols(), k); // d × k, column c = sum of the points of cluster c
+  // Everything the iterations touch is allocated here, once.
+  MatX centres_t = result.centres.transpose(); // d × k, column c = centre c
+  MatX sums(d, k); // column c = sum of the points of cluster c
+  Eigen::RowVectorXd centre(d);
+  result.cluster_sizes = VecX::Zero(k);
+  HamerlyAssignment assignment(n, d, k);
   for (int it = 0; it < options.max_iterations; ++it) {
-    assign(points_t, result.centres.transpose(), result.labels, distance);
-    sums.setZero();
-    result.cluster_sizes = VecX::Zero(k);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      sums.col(result.labels[i]) += points_t.col(i);
-      result.cluster_sizes[result.labels[i]] += 1;
+    with_dimension(d, [&](auto D) {
+      assignment.assign<decltype(D)::value>(points_t, centres_t, result.labels);
+      cluster_sums<decltype(D)::value>(points_t, result.labels, sums, result.cluster_sizes);
+    });
+    if (result.cluster_sizes.minCoeff() == 0) {
+      // Re-seeding needs every point's distance; a re-seeded centre jumps, so start afresh.
+      with_dimension(d, [&](auto D) {
+        labelled_distances<decltype(D)::value>(points_t, centres_t, result.labels, distance);
+      });
+      assignment.invalidate();
     }
     double shift = 0;
     for (int c = 0; c < k; ++c) {
-      Eigen::RowVectorXd centre;
       if (result.cluster_sizes[c] > 0) {
         centre = sums.col(c).transpose() / result.cluster_sizes[c];
       } else { // re-seed an empty cluster at the worst-served point
@@ -161,17 +347,25 @@ KMeansResult kmeans(ConstRef<MatX> points, const KMeansOptions& options) {
         centre = points.row(far);
         distance[far] = 0;
       }
-      shift = std::max(shift, (centre - result.centres.row(c)).norm());
+      const double moved = (centre - result.centres.row(c)).norm();
+      assignment.set_shift(c, moved);
+      shift = std::max(shift, moved);
       result.centres.row(c) = centre;
     }
+    centres_t = result.centres.transpose();
     result.iterations = it + 1;
     if (shift <= options.tolerance * spread) {
       result.converged = true;
       break;
     }
   }
-  assign(points_t, result.centres.transpose(), result.labels, distance);
-  result.cluster_sizes = VecX::Zero(k);
+  // Final labels for the final centres (the bounds still hold after the last update), then
+  // the exact squared distances for the inertia.
+  with_dimension(d, [&](auto D) {
+    assignment.assign<decltype(D)::value>(points_t, centres_t, result.labels);
+    labelled_distances<decltype(D)::value>(points_t, centres_t, result.labels, distance);
+  });
+  result.cluster_sizes.setZero();
   for (Eigen::Index i = 0; i < n; ++i)
     result.cluster_sizes[result.labels[i]] += 1;
   result.inertia = distance.sum();

@@ -112,8 +112,10 @@ public:
   const Parameters& parameters() const { return m_p; }
 
 private:
-  /// h(y) and, if d_y is non-null, ∂h/∂y.
-  double elastic_view(const Vec3& y, Vec3* d_y) const;
+  /// The tails' part of h(y) (all but the kernels) and, if d_y is non-null, its ∂/∂y.
+  double elastic_tail(const Vec3& y, Vec3* d_y) const;
+  /// h(y_k) of the three views y_k = column k of `y` and, if d_y is non-null, column k of *d_y = ∂h/∂y at y_k.
+  Vec3 elastic_views(const Mat3& y, Mat3* d_y) const;
   Parameters m_p;
 };
 
