@@ -105,8 +105,10 @@ TEST(KMeans, RejectsBadInput) {
 }
 
 // The accelerated assignment (Hamerly's bounds) must give exactly what plain Lloyd gives: the
-// reference below is the previous implementation, which computed all n·k distances every
-// iteration, copied verbatim in its arithmetic (serial; its result never depended on threads).
+// reference below is the previous implementation's Lloyd iterations, which computed all n·k
+// distances every iteration, copied verbatim in its arithmetic (serial; its result never
+// depended on threads). Both start from the same k-means++ centres: kmeans with
+// max_iterations = 0 is the seeding alone.
 namespace {
 
 struct Reference {
@@ -141,53 +143,15 @@ void reference_assign(
   }
 }
 
-MatX reference_seed(const MatX& points_t, int k, std::mt19937_64& rng) {
-  const Eigen::Index n = points_t.cols();
-  MatX centres(k, points_t.rows());
-  std::uniform_int_distribution<Eigen::Index> uniform(0, n - 1);
-  VecX nearest(n), candidate(n);
-  for (int c = 0; c < k; ++c) {
-    Eigen::Index pick = 0;
-    const double total = c == 0 ? 0.0 : nearest.sum();
-    if (total > 0) {
-      const double target = std::uniform_real_distribution<double>(0.0, total)(rng);
-      double cumulative = 0;
-      pick = -1;
-      for (Eigen::Index i = 0; i < n; ++i) {
-        cumulative += nearest[i];
-        if (cumulative > target && nearest[i] > 0) {
-          pick = i;
-          break;
-        }
-      }
-      if (pick < 0) {
-        for (pick = n - 1; pick > 0 && nearest[pick] <= 0; --pick) { }
-      }
-    } else {
-      pick = uniform(rng);
-    }
-    const VecX centre = points_t.col(pick);
-    centres.row(c) = centre.transpose();
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double* p = points_t.data() + i * points_t.rows();
-      double sum = 0;
-      for (Eigen::Index j = 0; j < points_t.rows(); ++j)
-        sum += (p[j] - centre[j]) * (p[j] - centre[j]);
-      candidate[i] = sum;
-    }
-    nearest = c == 0 ? candidate : nearest.cwiseMin(candidate);
-  }
-  return centres;
-}
-
 Reference reference_kmeans(const MatX& points, const KMeansOptions& options) {
   const Eigen::Index n = points.rows();
   const int k = options.clusters;
   const MatX points_t = points.transpose();
-  std::mt19937_64 rng(options.seed);
+  KMeansOptions seeding = options;
+  seeding.max_iterations = 0;
   Reference ref;
   KMeansResult& result = ref.result;
-  result.centres = reference_seed(points_t, k, rng);
+  result.centres = kmeans(points, seeding).centres;
   result.labels.assign(n, 0);
   VecX distance(n);
   const VecX mean = points_t.rowwise().mean();

@@ -123,7 +123,6 @@ class HamerlyAssignment {
       : m_upper(n)
       , m_lower(n)
       , m_shift(VecX::Zero(k))
-      , m_half_gap(k)
       , m_gap(k, k)
       , m_order(k - 1, k)
       , m_slack(16 * double(d + 10) * std::numeric_limits<double>::epsilon()) { }
@@ -142,6 +141,8 @@ class HamerlyAssignment {
   private:
   double up(double x) const { return x * (1 + m_slack); }
   double down(double x) const { return x * (1 - m_slack); }
+  /// ≤ half the distance of centre a to its nearest other centre (∞ for one centre).
+  double half_gap(int a) const { return m_order.rows() > 0 ? 0.5 * m_gap(m_order(0, a), a) : infinity; }
   template <int D> void update_gaps(const MatX& centres_t);
   template <int D>
   Nearest nearest_around(
@@ -150,7 +151,6 @@ class HamerlyAssignment {
   VecX m_upper; ///< n: ≥ distance of each point to its labelled centre
   VecX m_lower; ///< n: ≤ distance of each point to every other centre
   VecX m_shift; ///< k: distance each centre moved since the last assign
-  VecX m_half_gap; ///< k: ≤ half the distance of each centre to its nearest other centre
   MatX m_gap; ///< k × k: ≤ distance between two centres
   Eigen::MatrixXi m_order; ///< (k − 1) × k: column a = the other centres by increasing gap from a
   double m_slack; ///< 16 × the relative rounding of a squared distance, about (d + 3) ε
@@ -176,7 +176,6 @@ template <int D> void HamerlyAssignment::update_gaps(const MatX& centres_t) {
     std::sort(order, order + k - 1, [&](int b, int c) { // ties by index: deterministic
       return m_gap(b, a) < m_gap(c, a) || (m_gap(b, a) == m_gap(c, a) && b < c);
     });
-    m_half_gap[a] = k > 1 ? 0.5 * m_gap(order[0], a) : infinity;
   }
 }
 
@@ -233,7 +232,7 @@ void HamerlyAssignment::assign(
     double lower = down(m_lower[i]) - (a == most ? second : largest);
     // Within half the gap to its nearest other centre, or below the lower bound, a point
     // keeps its centre.
-    const double bound = std::max(m_half_gap[a], lower);
+    const double bound = std::max(half_gap(a), lower);
     if (up(upper) >= bound) { // the upper bound may be loose: measure the distance
       const double own = squared_distance<D>(p, centres_t.data() + a * d, d);
       upper = up(std::sqrt(own));
