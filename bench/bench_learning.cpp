@@ -11,6 +11,7 @@
 // seconds to minutes. Set-up and measured numbers: docs/benchmarks_learning.md.
 #include "learning_cases.hpp"
 
+#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 
 #include <chrono>
@@ -128,6 +129,10 @@ Row run_case(const LearningCase& c) {
               "observing %d of %zu surface vertices\n",
               seconds_since(t0), row.train_deformation, row.test_deformation, size, row.observed,
               c.train.mesh.surface_vertices().size());
+  // How far the test leaves the training's stretches (what the correction must extrapolate).
+  std::printf("   truth stretches: train %s; test %s\n",
+              learn::describe(learn::trajectory_stretch_range(c.train.mesh, truth_train)).c_str(),
+              learn::describe(learn::trajectory_stretch_range(c.test.mesh, truth_test)).c_str());
   std::fflush(stdout);
   if (g_truth_only) {
     // Scene tuning: how wrong the nominal model is on the test motion (what learning must fix).

@@ -12,6 +12,7 @@
 #include <elastolearn/io/scene_output.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 
 #include <chrono>
@@ -77,7 +78,8 @@ void run_demo(const fs::path& out, double fraction) {
   options.forward_fit.max_iterations = 2;
   learn::run_learning(train, observed, options, state, callbacks);
   io::MaterialFile learned{nlohmann::json::parse(app::kDemoTrainScene).at("material"), state.best,
-                           {{"demo", true}, {"best_iteration", state.best_iteration}}};
+                           {{"demo", true}, {"best_iteration", state.best_iteration}},
+                           learn::training_stretch_range(train, state.best)};
   io::write_material_file(out / "learned.json", learned);
   std::printf("   learned material: %s\n", (out / "learned.json").c_str());
 
@@ -90,6 +92,14 @@ void run_demo(const fs::path& out, double fraction) {
   std::printf("\n   %-8s %10s %10s\n", "model", "err_L [%]", "mean [%]");
   std::printf("   %-8s %10.3f %10.4f\n   %-8s %10.3f %10.4f\n", "nominal", e_nominal.max, e_nominal.mean, "learned",
               e_learned.max, e_learned.mean);
+  if (learned.training_stretches) {
+    learn::StretchCoverage coverage(test.mesh, learned.training_stretches);
+    for (const auto& x : test_learned) coverage.add_frame(x);
+    std::printf("   stretches: training %s; test %s\n", learn::describe(*learned.training_stretches).c_str(),
+                learn::describe(coverage.visited()).c_str());
+    if (const std::string note = learn::extrapolation_note(coverage); !note.empty())
+      std::printf("   note: %s\n", note.c_str());
+  }
   std::printf("   err_L %.0fx lower with the learned correction; demo took %.0f s\n", e_nominal.max / e_learned.max,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }

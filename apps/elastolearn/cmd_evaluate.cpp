@@ -9,6 +9,7 @@
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
+#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/learn/trajectory_error.hpp>
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
@@ -123,7 +124,8 @@ void run_evaluate(const EvaluateOptions& opts) {
     file.scene.linear_solver = sim::linear_solver_type_from_string(opts.solver);
   const sim::Scene& nominal_scene = file.scene;
   sim::Scene learned_scene = file.scene;
-  learned_scene.material = io::material_model(io::read_material_file(opts.material), opts.material);
+  const io::MaterialFile material_file = io::read_material_file(opts.material);
+  learned_scene.material = io::material_model(material_file, opts.material);
   const std::vector<VecX> truth = read_truth(opts.truth, nominal_scene);
   const double size = nominal_scene.mesh.bounding_box_diagonal();
 
@@ -165,9 +167,21 @@ void run_evaluate(const EvaluateOptions& opts) {
     std::printf("improvement: the learned material reproduces the truth exactly\n");
   if (!opts.output.empty() && !learned.frames.empty())
     std::printf("learned trajectory: %s\n", opts.output.c_str());
+  // Where the test motion leaves the correction's training range (files that record it).
+  std::optional<learn::StretchCoverage> coverage;
+  if (material_file.training_stretches && material_file.correction) {
+    coverage.emplace(nominal_scene.mesh, material_file.training_stretches);
+    for (const VecX& x : learned.frames)
+      coverage->add_frame(x);
+    std::printf("stretches: %s (the correction was trained on %s)\n",
+        learn::describe(coverage->visited()).c_str(),
+        learn::describe(*material_file.training_stretches).c_str());
+    if (const std::string note = learn::extrapolation_note(*coverage); !note.empty())
+      std::printf("note: %s\n", note.c_str());
+  }
 
   if (!opts.json.empty()) {
-    const nlohmann::json report = { { "format", "elastolearn-evaluation/1" },
+    nlohmann::json report = { { "format", "elastolearn-evaluation/1" },
       { "scene", opts.scene }, { "material", opts.material }, { "truth", opts.truth },
       { "vertices", nominal_scene.mesh.num_vertices() }, { "tets", nominal_scene.mesh.num_tets() },
       { "frames", truth.size() }, { "dt", nominal_scene.dt }, { "size", size },
@@ -175,6 +189,11 @@ void run_evaluate(const EvaluateOptions& opts) {
       { "improvement",
           { { "err_L", max_ratio ? nlohmann::json(*max_ratio) : nlohmann::json(nullptr) },
               { "mean", mean_ratio ? nlohmann::json(*mean_ratio) : nlohmann::json(nullptr) } } } };
+    if (coverage) {
+      report["stretches"] = { { "visited", io::stretch_range_to_json(coverage->visited()) },
+        { "trained", io::stretch_range_to_json(*coverage->trained()) },
+        { "fraction_outside", coverage->fraction_outside() } };
+    }
     io::write_json_file(opts.json, report);
     std::printf("report: %s\n", opts.json.c_str());
   }

@@ -12,6 +12,7 @@
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/material/nn_correction.hpp>
 
@@ -168,6 +169,7 @@ void run_learn(const LearnOptions& o) {
   const nlohmann::json root = io::read_json_file(o.scene);
   io::MaterialFile learned = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
   learned.correction = state.best;
+  learned.training_stretches = learn::training_stretch_range(scene, state.best);
   learned.training = {{"scene", o.scene},
                       {"observations", o.observations},
                       {"observed_vertices", observed.num_observed()},
@@ -193,6 +195,9 @@ void run_learn(const LearnOptions& o) {
               100 * first.max / diagonal, total_seconds);
   std::printf("learned material: %s (%s)\n", o.output.c_str(),
               learned.correction ? io::describe_correction(*learned.correction).c_str() : "no correction beat the nominal model");
+  if (learned.training_stretches)
+    std::printf("training stretches: %s (simulate and evaluate note where a motion leaves them)\n",
+                learn::describe(*learned.training_stretches).c_str());
   if (!o.report.empty()) std::printf("report: %s/convergence.csv, report.json\n", o.report.c_str());
 }
 

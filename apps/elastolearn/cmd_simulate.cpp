@@ -7,6 +7,7 @@
 #include <elastolearn/io/scene_output.hpp>
 
 #include <cstdio>
+#include <optional>
 
 namespace {
 
@@ -39,8 +40,11 @@ void add_simulate_command(CLI::App& root) {
     if (!opts->solver.empty()) file.scene.linear_solver = sim::linear_solver_type_from_string(opts->solver);
     if (opts->frames > 0) file.scene.frames = opts->frames;
     std::string material_source = "the scene";
+    std::optional<material::StretchRange> trained = file.material_training_stretches;
     if (!opts->material.empty()) {
-      file.scene.material = io::material_model(io::read_material_file(opts->material), opts->material);
+      const io::MaterialFile material = io::read_material_file(opts->material);
+      file.scene.material = io::material_model(material, opts->material);
+      trained = material.training_stretches;
       material_source = opts->material;
     }
     io::SceneOutputOptions out;
@@ -56,13 +60,23 @@ void add_simulate_command(CLI::App& root) {
                 sim::to_string(s.linear_solver).c_str());
     std::printf("material: %s (from %s)\n", io::describe_material_model(s.material).c_str(), material_source.c_str());
     std::filesystem::path pvd;
-    const auto report = io::simulate_to_files(s, out, opts->quiet ? ProgressCallback{} : terminal_progress("simulate"), &pvd);
+    // A learned correction that recorded its training range: say where this motion leaves it.
+    std::optional<learn::StretchCoverage> coverage;
+    if (trained && s.material.correction) coverage.emplace(s.mesh, trained);
+    const auto report = io::simulate_to_files(s, out, opts->quiet ? ProgressCallback{} : terminal_progress("simulate"), &pvd,
+                                              coverage ? &*coverage : nullptr);
     std::printf("%s: %d frames in %.2f s (%.1f ms/step, %.2f Newton iterations/step)\n",
                 report.completed ? "completed" : "stopped", report.frames_written, report.seconds,
                 1e3 * report.seconds / std::max(1, report.frames_written - 1),
                 double(report.newton_iterations) / std::max(1, report.frames_written - 1));
     if (report.frames_written > 0) std::printf("trajectory: %s\n", out.trajectory.c_str());
     if (!pvd.empty()) std::printf("paraview:   %s\n", pvd.c_str());
+    if (coverage) {
+      std::printf("stretches:  %s (the correction was trained on %s)\n", learn::describe(coverage->visited()).c_str(),
+                  learn::describe(*trained).c_str());
+      if (const std::string note = learn::extrapolation_note(*coverage); !note.empty())
+        std::printf("note: %s\n", note.c_str());
+    }
     if (!report.completed) {
       std::fprintf(stderr, "elastolearn: error: %s\n", report.message.c_str());
       throw CLI::RuntimeError(1);

@@ -61,6 +61,9 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   const auto file = elastolearn::io::read_material_file(path("learned.json"));
   ASSERT_NE(file.correction, nullptr) << "a correction beat the nominal model";
   EXPECT_EQ(file.training.at("history").size(), 4u);
+  ASSERT_TRUE(file.training_stretches.has_value()) << "learn records the training motion's stretches";
+  EXPECT_GT(file.training_stretches->max[0], 1.0) << "the droop stretches the bar";
+  EXPECT_LT(file.training_stretches->min[2], 1.0) << "and compresses it";
 
   const auto evaluated = run("evaluate " + path("scene.json") + " --material " + path("learned.json") + " --truth " +
                              path("truth.h5") + " -q");
@@ -69,6 +72,28 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   ASSERT_GT(nominal, 0) << evaluated.output;
   ASSERT_GE(learned_error, 0) << evaluated.output;
   EXPECT_LT(learned_error, nominal / 5) << evaluated.output;
+  // Evaluated on its own training motion, the learned model stays inside its training stretches.
+  EXPECT_NE(evaluated.output.find("stretches:"), std::string::npos) << evaluated.output;
+  EXPECT_EQ(evaluated.output.find("note:"), std::string::npos) << evaluated.output;
+
+  // A training range narrowed to half the stretches: evaluate and simulate say where the motion
+  // leaves it, and the evaluation report counts the samples outside.
+  auto narrow = file;
+  narrow.training_stretches->max[0] = 1.0 + 0.5 * (file.training_stretches->max[0] - 1.0);
+  elastolearn::io::write_material_file(path("narrow.json"), narrow);
+  const auto noted = run("evaluate " + path("scene.json") + " --material " + path("narrow.json") + " --truth " +
+                         path("truth.h5") + " --json " + path("evaluation.json") + " -q");
+  ASSERT_EQ(noted.exit_code, 0) << noted.output;
+  EXPECT_NE(noted.output.find("note:"), std::string::npos) << noted.output;
+  EXPECT_NE(noted.output.find("s₁ up to"), std::string::npos) << noted.output;
+  const auto report = elastolearn::io::read_json_file(path("evaluation.json"));
+  const double outside = report.at("stretches").at("fraction_outside").get<double>();
+  EXPECT_GT(outside, 0.0);
+  EXPECT_LT(outside, 1.0);
+  const auto simulated = run("simulate " + path("scene.json") + " --material " + path("narrow.json") + " -o " +
+                             path("narrow.h5") + " -q");
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+  EXPECT_NE(simulated.output.find("note:"), std::string::npos) << simulated.output;
 
   // --resume of a finished run changes nothing and says where it resumed.
   const auto resumed = run("learn " + path("scene.json") + " --observations " + path("obs.h5") + " -o " +

@@ -147,6 +147,32 @@ TEST(MaterialFile, RbfRoundTripIsBitExact) {
   expect_same_function(*original, *back);
 }
 
+TEST(MaterialFile, TrainingStretchesRoundTripAndAreOptional) {
+  MaterialFile f = parse_material_file(valid_rbf_file(), "old.json");
+  EXPECT_FALSE(f.training_stretches.has_value()) << "files before the field read without it";
+  f.training_stretches.emplace();
+  f.training_stretches->include(Vec3(1.0223, 1.0012, 0.9731));
+  f.training_stretches->include(Vec3(1.0, 0.9876543210987654, 0.95));
+  const Json j = material_file_to_json(f);
+  const MaterialFile g = parse_material_file(Json::parse(j.dump()), "f.json");
+  ASSERT_TRUE(g.training_stretches.has_value());
+  EXPECT_EQ(g.training_stretches->min, f.training_stretches->min);
+  EXPECT_EQ(g.training_stretches->max, f.training_stretches->max);
+
+  Json bad = j;
+  bad["training_stretches"]["max"][2] = 0.9; // below min's 0.95
+  expect_bad(bad, { "bad.json: training_stretches.max", "entry 2" });
+  bad = j;
+  bad["training_stretches"]["min"][0] = 0.0;
+  expect_bad(bad, { "bad.json: training_stretches.min", "positive" });
+  bad = j;
+  bad["training_stretches"]["min"] = Json::array({ 1.0, 1.0 });
+  expect_bad(bad, { "bad.json: training_stretches.min", "3 finite numbers" });
+  bad = j;
+  bad["training_stretches"]["mean"] = Json::array({ 1.0, 1.0, 1.0 });
+  expect_bad(bad, { "bad.json: training_stretches", "mean" });
+}
+
 TEST(MaterialFile, RbfWithoutDampingFloorRoundTrips) {
   // The default floor is −∞ ("no floor"), which JSON cannot hold: it travels as null.
   auto p = rbf_parameters(3, 8);

@@ -208,6 +208,10 @@ std::shared_ptr<const material::Correction> correction_from_json(const JsonObjec
   return type == "rbf" ? rbf_from_json(object) : nn_from_json(object);
 }
 
+Json stretch_range_to_json(const material::StretchRange& range) {
+  return { { "min", vector_to_json(range.min) }, { "max", vector_to_json(range.max) } };
+}
+
 std::string describe_correction(const material::Correction& correction) {
   if (const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&correction)) {
     std::string s = "rbf, " + std::to_string(rbf->num_centres()) + " centres";
@@ -235,10 +239,30 @@ std::string describe_material_model(const fem::MaterialModel& model) {
   return s;
 }
 
+namespace {
+
+/// {"min": [s₁, s₂, s₃], "max": [...]}: positive, min ≤ max per sorted stretch.
+material::StretchRange stretch_range_from_json(const JsonObject& object) {
+  object.reject_unknown_keys({ "min", "max" });
+  material::StretchRange range;
+  range.min = object.vec3("min");
+  range.max = object.vec3("max");
+  for (int k = 0; k < 3; ++k) {
+    if (!(range.min[k] > 0))
+      object.fail("min", "stretches must be positive, got " + std::to_string(range.min[k]));
+    if (!(range.min[k] <= range.max[k]))
+      object.fail("max", "entry " + std::to_string(k) + " (" + std::to_string(range.max[k])
+              + ") is below min's (" + std::to_string(range.min[k]) + ")");
+  }
+  return range;
+}
+
+} // namespace
+
 MaterialFile parse_material_file(const Json& json, const std::string& file) {
   const JsonObject root(json, file);
   check_format(root, k_format_kind, k_format_version);
-  root.reject_unknown_keys({ "format", "material", "correction", "training" });
+  root.reject_unknown_keys({ "format", "material", "correction", "training", "training_stretches" });
   MaterialFile out;
   out.material = root.object("material").json();
   (void)parse_material(root.object("material")); // validate now, naming this file
@@ -246,6 +270,8 @@ MaterialFile parse_material_file(const Json& json, const std::string& file) {
     out.correction = correction_from_json(root.object("correction"));
   if (root.has("training"))
     out.training = root.object("training").json();
+  if (root.has("training_stretches") && !root.json().at("training_stretches").is_null())
+    out.training_stretches = stretch_range_from_json(root.object("training_stretches"));
   return out;
 }
 
@@ -258,6 +284,8 @@ Json material_file_to_json(const MaterialFile& file) {
     { "material", file.material } };
   out["correction"] = file.correction ? correction_to_json(*file.correction) : Json(nullptr);
   out["training"] = file.training;
+  if (file.training_stretches)
+    out["training_stretches"] = stretch_range_to_json(*file.training_stretches);
   return out;
 }
 
@@ -300,10 +328,16 @@ MaterialFile scene_material(const JsonObject& scene, const std::filesystem::path
   return out;
 }
 
-fem::MaterialModel scene_material_model(
-    const JsonObject& scene, const std::filesystem::path& base_dir) {
-  if (const auto path = referenced_material(scene, base_dir))
-    return material_model(read_material_file(*path), path->string());
+fem::MaterialModel scene_material_model(const JsonObject& scene, const std::filesystem::path& base_dir,
+    std::optional<material::StretchRange>* training_stretches) {
+  if (training_stretches)
+    training_stretches->reset();
+  if (const auto path = referenced_material(scene, base_dir)) {
+    MaterialFile file = read_material_file(*path);
+    if (training_stretches)
+      *training_stretches = file.training_stretches;
+    return material_model(file, path->string());
+  }
   return parse_material(scene.object("material"));
 }
 

@@ -8,11 +8,13 @@
 #include <elastolearn/fem/elastic_force.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/material/correction.hpp>
+#include <elastolearn/material/stretch_range.hpp>
 
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace elastolearn::io {
@@ -23,6 +25,9 @@ struct MaterialFile {
   std::shared_ptr<const material::Correction> correction; ///< null, RbfCorrection or NnCorrection
   nlohmann::json training
       = nlohmann::json::object(); ///< free-form provenance (iterations, errors, options)
+  /// The sorted stretches of the training motion (learn::StretchCoverage): outside them the
+  /// correction extrapolates. Optional ("training_stretches"; absent in files before it).
+  std::optional<material::StretchRange> training_stretches;
 };
 
 /// Read and validate a material file (format, nominal material, correction sizes and finite
@@ -54,6 +59,9 @@ nlohmann::json correction_to_json(const material::Correction& correction);
 /// The inverse of correction_to_json; errors name `object`'s file and field.
 std::shared_ptr<const material::Correction> correction_from_json(const JsonObject& object);
 
+/// A stretch range as {"min": [s₁, s₂, s₃], "max": [...]} (the file's "training_stretches").
+nlohmann::json stretch_range_to_json(const material::StretchRange& range);
+
 /// One line for users: "rbf, 40 centres, with damping correction" or "nn, 6-6-6-3".
 std::string describe_correction(const material::Correction& correction);
 
@@ -68,7 +76,9 @@ MaterialFile scene_material(const JsonObject& scene, const std::filesystem::path
 
 /// material_model(scene_material(scene, base_dir)), with errors of an inline material naming
 /// the scene's field ("scene.json: material.young") and of a referenced one its file.
-fem::MaterialModel scene_material_model(
-    const JsonObject& scene, const std::filesystem::path& base_dir);
+/// If `training_stretches` is not null it receives the referenced file's training range (none
+/// for an inline material or a file without one).
+fem::MaterialModel scene_material_model(const JsonObject& scene, const std::filesystem::path& base_dir,
+    std::optional<material::StretchRange>* training_stretches = nullptr);
 
 } // namespace elastolearn::io

@@ -152,7 +152,7 @@ SceneFile parse_scene(const nlohmann::json& json, const std::string& file, const
   sim::Scene& s = out.scene;
   s.name = root.string("name", std::filesystem::path(file).stem().string());
   s.mesh = parse_mesh(root.object("mesh"), base_dir);
-  s.material = scene_material_model(root, base_dir); // inline object or path of a material file
+  s.material = scene_material_model(root, base_dir, &out.material_training_stretches); // inline object or path of a material file
   s.mass = root.choice("mass", {"lumped", "consistent"}, "lumped") == "lumped" ? fem::MassType::Lumped
                                                                              : fem::MassType::Consistent;
   s.gravity = root.vec3("gravity", Vec3::Zero());

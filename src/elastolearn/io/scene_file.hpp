@@ -2,6 +2,7 @@
 /// \file Scene JSON files ("format": "elastolearn-scene/1"); the format is documented in
 /// docs/scene_format.md. Every error names the file and the field.
 #include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/material/stretch_range.hpp>
 #include <elastolearn/sim/scene.hpp>
 
 #include <filesystem>
@@ -20,6 +21,8 @@ struct SceneOutputs {
 struct SceneFile {
   sim::Scene scene;
   SceneOutputs outputs;
+  /// The training range of a learned material the scene references (io::MaterialFile).
+  std::optional<material::StretchRange> material_training_stretches;
   std::filesystem::path path;
 };
 

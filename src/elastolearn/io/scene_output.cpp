@@ -4,7 +4,8 @@
 namespace elastolearn::io {
 
 sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutputOptions& options,
-                                        const ProgressCallback& progress, std::filesystem::path* pvd) {
+                                        const ProgressCallback& progress, std::filesystem::path* pvd,
+                                        learn::StretchCoverage* coverage) {
   TrajectoryWriter writer(options.trajectory, scene.mesh.rest_positions(), scene.mesh.tets(), Edges(),
                           scene.mesh.surface_faces());
   TrajectoryData series; // in memory only when a ParaView series is requested
@@ -14,6 +15,7 @@ sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutp
   }
   const int every = std::max(1, options.every);
   auto sink = [&](int frame, double time, const VecX& x, const VecX& v) {
+    if (coverage) coverage->add_frame(x);
     if (frame % every != 0) return;
     const Positions positions = unflatten(x);
     const Positions velocities = unflatten(v);

@@ -3,6 +3,7 @@
 /// ParaView series (VTU per frame + PVD). A diverged run keeps the frames before the failure
 /// (file attribute status = "diverged: ...").
 #include <elastolearn/core/progress.hpp>
+#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 
 #include <filesystem>
@@ -17,9 +18,11 @@ struct SceneOutputOptions {
 };
 
 /// Simulate `scene` and write the outputs. Returns the simulation report; the .pvd path (if any)
-/// is stored in `pvd`.
+/// is stored in `pvd`. If `coverage` is given, every simulated frame (recorded or not) is added
+/// to it.
 sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutputOptions& options,
                                         const ProgressCallback& progress,
-                                        std::filesystem::path* pvd = nullptr);
+                                        std::filesystem::path* pvd = nullptr,
+                                        learn::StretchCoverage* coverage = nullptr);
 
 } // namespace elastolearn::io
