@@ -1,8 +1,11 @@
-// elastolearn info FILE: a summary of a tet mesh, surface mesh, trajectory or scene.
+// elastolearn info FILE: a summary of a tet mesh, surface mesh, trajectory, scene or learned material.
 #include "command.hpp"
 
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
+#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/mesh/read_tet_mesh.hpp>
 #include <elastolearn/mesh/surface_mesh.hpp>
@@ -41,6 +44,15 @@ void info(const std::filesystem::path& path) {
     print_box(Box3(t.rest_positions.colwise().minCoeff().transpose(), t.rest_positions.colwise().maxCoeff().transpose()));
     std::printf("  largest displacement from rest: %g m\n", max_disp);
     for (const auto& [k, v] : t.metadata) std::printf("  %s: %s\n", k.c_str(), v.c_str());
+  } else if (ext == ".json" && io::read_json_file(path).value("format", "").starts_with("elastolearn-material")) {
+    const auto f = io::read_material_file(path);
+    std::printf("  learned material: %s\n", io::describe_material_model(io::material_model(f, path.string())).c_str());
+    for (const char* key : {"scene", "observations", "best_iteration", "seconds"})
+      if (f.training.contains(key)) std::printf("  training %s: %s\n", key, f.training.at(key).dump().c_str());
+    if (f.training_stretches)
+      std::printf("  training stretches: %s\n", learn::describe(*f.training_stretches).c_str());
+    else if (f.correction)
+      std::printf("  training stretches: not recorded (a file from before they were)\n");
   } else if (ext == ".json") {
     const auto f = io::read_scene_file(path);
     const auto& s = f.scene;
@@ -62,7 +74,7 @@ void info(const std::filesystem::path& path) {
 
 void add_info_command(CLI::App& root) {
   auto files = std::make_shared<std::vector<std::string>>();
-  auto* cmd = root.add_subcommand("info", "Summarise a mesh (.node/.ele/.msh/.veg/.obj/.off/.ply/.stl), trajectory (.h5) or scene (.json)");
+  auto* cmd = root.add_subcommand("info", "Summarise a mesh (.node/.ele/.msh/.veg/.obj/.off/.ply/.stl), trajectory (.h5), scene or learned material (.json)");
   cmd->add_option("files", *files, "files to describe")->required();
   cmd->callback([files] {
     for (const auto& f : *files) info(f);

@@ -64,6 +64,10 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   ASSERT_TRUE(file.training_stretches.has_value()) << "learn records the training motion's stretches";
   EXPECT_GT(file.training_stretches->max[0], 1.0) << "the droop stretches the bar";
   EXPECT_LT(file.training_stretches->min[2], 1.0) << "and compresses it";
+  const auto described = run("info " + path("learned.json"));
+  ASSERT_EQ(described.exit_code, 0) << described.output;
+  EXPECT_NE(described.output.find("correction (rbf, 15 centres"), std::string::npos) << described.output;
+  EXPECT_NE(described.output.find("training stretches: s₁ 1.0"), std::string::npos) << described.output;
 
   const auto evaluated = run("evaluate " + path("scene.json") + " --material " + path("learned.json") + " --truth " +
                              path("truth.h5") + " -q");
