@@ -370,6 +370,8 @@ TEST(MaterialFile, SceneMayReferenceAMaterialFile) {
   MaterialFile f;
   f.material = k_nominal;
   f.correction = std::make_shared<material::RbfCorrection>(rbf_parameters(5, 4));
+  f.training_stretches.emplace();
+  f.training_stretches->include(Vec3(1.03, 1.0, 0.97));
   write_material_file(dir / "materials" / "learned.json", f);
   const std::string scene = R"({"format": "elastolearn-scene/1",
     "mesh": {"type": "box", "size": [0.1, 0.02, 0.02], "cells": [2, 1, 1]},
@@ -379,6 +381,8 @@ TEST(MaterialFile, SceneMayReferenceAMaterialFile) {
   ASSERT_NE(s.scene.material.correction, nullptr);
   expect_same_function(*f.correction, *s.scene.material.correction);
   EXPECT_EQ(s.scene.material.elastic->name(), "corotated");
+  ASSERT_TRUE(s.material_training_stretches.has_value()) << "simulate compares with it";
+  EXPECT_EQ(s.material_training_stretches->max, Vec3(1.03, 1.0, 0.97));
 
   // scene_material gives the nominal JSON too (what `learn` needs to save a result).
   const Json scene_json = Json::parse(scene);
