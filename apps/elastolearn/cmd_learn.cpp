@@ -198,6 +198,8 @@ void run_learn(const LearnOptions& o) {
   if (learned.training_stretches)
     std::printf("training stretches: %s (simulate and evaluate note where a motion leaves them)\n",
                 learn::describe(*learned.training_stretches).c_str());
+  else if (learned.correction)
+    std::printf("training stretches: not recorded (the learned model's training simulation did not complete)\n");
   if (!o.report.empty()) std::printf("report: %s/convergence.csv, report.json\n", o.report.c_str());
 }
 

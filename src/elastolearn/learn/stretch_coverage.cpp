@@ -57,8 +57,7 @@ std::optional<material::StretchRange> training_stretch_range(const sim::Scene& t
                                                              std::shared_ptr<const material::Correction> correction) {
   if (!correction) return std::nullopt;
   const ForwardRun run = simulate_positions(with_correction(training, std::move(correction)));
-  if (!run.completed)
-    throw InputError("training range", "the learned model's training simulation diverged (" + run.message + ")");
+  if (!run.completed) return std::nullopt;
   return trajectory_stretch_range(training.mesh, run.positions);
 }
 

@@ -53,8 +53,9 @@ material::StretchRange trajectory_stretch_range(const mesh::TetMesh& mesh, const
 
 /// The training range of a learned correction: the stretch range of the training scene
 /// simulated with it (the model that fits the observations; the observed vertices alone cannot
-/// give the interior's stretches). Nothing if `correction` is null. Throws InputError if that
-/// simulation diverges.
+/// give the interior's stretches). Nothing if `correction` is null or that simulation does not
+/// complete (it did when the loop chose the correction; a caller must not lose a learned
+/// correction over its metadata).
 std::optional<material::StretchRange> training_stretch_range(const sim::Scene& training,
                                                              std::shared_ptr<const material::Correction> correction);
 
