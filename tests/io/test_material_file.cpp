@@ -163,8 +163,11 @@ TEST(MaterialFile, TrainingStretchesRoundTripAndAreOptional) {
   bad["training_stretches"]["max"][2] = 0.9; // below min's 0.95
   expect_bad(bad, { "bad.json: training_stretches.max", "entry 2" });
   bad = j;
-  bad["training_stretches"]["min"][0] = 0.0;
-  expect_bad(bad, { "bad.json: training_stretches.min", "positive" });
+  bad["training_stretches"]["min"][0] = nullptr; // what nlohmann writes for a NaN
+  expect_bad(bad, { "bad.json: training_stretches.min", "3 finite numbers" });
+  Json inverted = j; // an inverted element's smallest stretch is negative: valid
+  inverted["training_stretches"]["min"][2] = -0.2;
+  EXPECT_EQ(parse_material_file(inverted, "inv.json").training_stretches->min[2], -0.2);
   bad = j;
   bad["training_stretches"]["min"] = Json::array({ 1.0, 1.0 });
   expect_bad(bad, { "bad.json: training_stretches.min", "3 finite numbers" });

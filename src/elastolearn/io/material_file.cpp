@@ -241,15 +241,14 @@ std::string describe_material_model(const fem::MaterialModel& model) {
 
 namespace {
 
-/// {"min": [s₁, s₂, s₃], "max": [...]}: positive, min ≤ max per sorted stretch.
+/// {"min": [s₁, s₂, s₃], "max": [...]}: finite, min ≤ max per sorted stretch (s₃ may be
+/// negative: an inverted element's smallest stretch is, material::principal_frame).
 material::StretchRange stretch_range_from_json(const JsonObject& object) {
   object.reject_unknown_keys({ "min", "max" });
   material::StretchRange range;
   range.min = object.vec3("min");
   range.max = object.vec3("max");
   for (int k = 0; k < 3; ++k) {
-    if (!(range.min[k] > 0))
-      object.fail("min", "stretches must be positive, got " + std::to_string(range.min[k]));
     if (!(range.min[k] <= range.max[k]))
       object.fail("max", "entry " + std::to_string(k) + " (" + std::to_string(range.max[k])
               + ") is below min's (" + std::to_string(range.min[k]) + ")");
