@@ -95,10 +95,7 @@ void run_demo(const fs::path& out, double fraction) {
   if (learned.training_stretches) {
     learn::StretchCoverage coverage(test.mesh, learned.training_stretches);
     for (const auto& x : test_learned) coverage.add_frame(x);
-    std::printf("   stretches: training %s; test %s\n", learn::describe(*learned.training_stretches).c_str(),
-                learn::describe(coverage.visited()).c_str());
-    if (const std::string note = learn::extrapolation_note(coverage); !note.empty())
-      std::printf("   note: %s\n", note.c_str());
+    std::fputs(learn::coverage_report(coverage, "   ").c_str(), stdout);
   }
   std::printf("   err_L %.0fx lower with the learned correction; demo took %.0f s\n", e_nominal.max / e_learned.max,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());

@@ -173,11 +173,7 @@ void run_evaluate(const EvaluateOptions& opts) {
     coverage.emplace(nominal_scene.mesh, material_file.training_stretches);
     for (const VecX& x : learned.frames)
       coverage->add_frame(x);
-    std::printf("stretches: %s (the correction was trained on %s)\n",
-        learn::describe(coverage->visited()).c_str(),
-        learn::describe(*material_file.training_stretches).c_str());
-    if (const std::string note = learn::extrapolation_note(*coverage); !note.empty())
-      std::printf("note: %s\n", note.c_str());
+    std::fputs(learn::coverage_report(*coverage).c_str(), stdout);
   }
 
   if (!opts.json.empty()) {

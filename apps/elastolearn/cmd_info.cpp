@@ -44,8 +44,9 @@ void info(const std::filesystem::path& path) {
     print_box(Box3(t.rest_positions.colwise().minCoeff().transpose(), t.rest_positions.colwise().maxCoeff().transpose()));
     std::printf("  largest displacement from rest: %g m\n", max_disp);
     for (const auto& [k, v] : t.metadata) std::printf("  %s: %s\n", k.c_str(), v.c_str());
-  } else if (ext == ".json" && io::read_json_file(path).value("format", "").starts_with("elastolearn-material")) {
-    const auto f = io::read_material_file(path);
+  } else if (const auto json = ext == ".json" ? io::read_json_file(path) : nlohmann::json();
+             json.is_object() && json.value("format", "").starts_with("elastolearn-material")) {
+    const auto f = io::parse_material_file(json, path.string());
     std::printf("  learned material: %s\n", io::describe_material_model(io::material_model(f, path.string())).c_str());
     for (const char* key : {"scene", "observations", "best_iteration", "seconds"})
       if (f.training.contains(key)) std::printf("  training %s: %s\n", key, f.training.at(key).dump().c_str());
@@ -54,7 +55,7 @@ void info(const std::filesystem::path& path) {
     else if (f.correction)
       std::printf("  training stretches: not recorded (a file from before they were)\n");
   } else if (ext == ".json") {
-    const auto f = io::read_scene_file(path);
+    const auto f = io::parse_scene(json, path.string(), path.parent_path()); // already read above
     const auto& s = f.scene;
     std::printf("  scene '%s': %s, density %g, %s mass, %zu fixed and %zu keyframed groups, %zu loads\n", s.name.c_str(),
                 s.material.elastic->name().c_str(), s.material.density, fem::to_string(s.mass), s.fixed_vertices.size(),

@@ -71,12 +71,7 @@ void add_simulate_command(CLI::App& root) {
                 double(report.newton_iterations) / std::max(1, report.frames_written - 1));
     if (report.frames_written > 0) std::printf("trajectory: %s\n", out.trajectory.c_str());
     if (!pvd.empty()) std::printf("paraview:   %s\n", pvd.c_str());
-    if (coverage) {
-      std::printf("stretches:  %s (the correction was trained on %s)\n", learn::describe(coverage->visited()).c_str(),
-                  learn::describe(*trained).c_str());
-      if (const std::string note = learn::extrapolation_note(*coverage); !note.empty())
-        std::printf("note: %s\n", note.c_str());
-    }
+    if (coverage) std::fputs(learn::coverage_report(*coverage).c_str(), stdout);
     if (!report.completed) {
       std::fprintf(stderr, "elastolearn: error: %s\n", report.message.c_str());
       throw CLI::RuntimeError(1);

@@ -94,4 +94,11 @@ std::string extrapolation_note(const StretchCoverage& coverage) {
   return text + beyond;
 }
 
+std::string coverage_report(const StretchCoverage& coverage, const std::string& indent) {
+  std::string report = indent + "stretches: " + describe(coverage.visited()) + " (the correction was trained on " +
+                       describe(*coverage.trained()) + ")\n";
+  if (const std::string note = extrapolation_note(coverage); !note.empty()) report += indent + "note: " + note + "\n";
+  return report;
+}
+
 } // namespace elastolearn::learn

@@ -67,4 +67,9 @@ std::string describe(const material::StretchRange& range);
 /// extrapolates there. Requires coverage.trained().
 std::string extrapolation_note(const StretchCoverage& coverage);
 
+/// What simulate, evaluate and demo print, each line starting with `indent`:
+/// "stretches: <visited> (the correction was trained on <trained>)" and, if any sample left
+/// the training range, "note: <extrapolation_note>". Requires coverage.trained().
+std::string coverage_report(const StretchCoverage& coverage, const std::string& indent = "");
+
 } // namespace elastolearn::learn
