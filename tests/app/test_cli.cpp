@@ -104,10 +104,15 @@ TEST_F(CliTest, ExampleScenesParse) {
 TEST_F(CliTest, InterruptKeepsTheFramesSoFarAndLeavesNoTemporaryFile) {
   std::string text = kSmallScene;
   text.replace(text.find("\"frames\": 20"), 12, "\"frames\": 100000");
-  const auto out = m_dir / "long.h5";
-  const std::string command = std::string(ELASTOLEARN_EXECUTABLE) + " simulate " + write("long.json", text).string() +
-                              " -o " + out.string() + " -q > /dev/null 2>&1 & pid=$!; sleep 1.5; kill -INT $pid; wait $pid";
-  const int status = std::system(("bash -c '" + command + "'").c_str());
+  const auto out = m_dir / "long.h5", log = m_dir / "long.log";
+  // Interrupt only once the first progress line is out: it comes after frame 1 is written, so
+  // frames 0 and 1 must survive. A fixed sleep instead failed on a loaded CI machine.
+  const auto script = write("interrupt.sh", std::string(ELASTOLEARN_EXECUTABLE) + " simulate " +
+                                                write("long.json", text).string() + " -o " + out.string() + " > " +
+                                                log.string() + " 2>&1 & pid=$!\n" +
+                                                "for i in $(seq 600); do grep -q 'simulate ' " + log.string() +
+                                                " && break; sleep 0.1; done\nkill -INT $pid; wait $pid\n");
+  const int status = std::system(("bash " + script.string()).c_str());
   EXPECT_NE(status, 0);
   const auto t = elastolearn::io::read_trajectory_h5(out);
   EXPECT_GE(t.positions.size(), 2u);
