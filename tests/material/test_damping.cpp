@@ -79,3 +79,24 @@ TEST(StretchDependentRayleigh, RejectsNegativeSplines) {
         EXPECT_EQ(e.where(), "bar.damping.alpha1");
     }
 }
+
+TEST(StretchPolynomial, HornerValueAndDerivativeAgreeWithTheExpandedForm) {
+    const StretchPolynomial p({ 0.2, 1.0, 20.0, -3.0 });
+    for (double s : { 0.95, 1.0, 1.04, 1.3 }) {
+        const double t = s - 1;
+        double v, d;
+        p.evaluate(s, v, d);
+        EXPECT_NEAR(v, 0.2 + t + 20 * t * t - 3 * t * t * t, 1e-14) << s;
+        EXPECT_NEAR(d, 1 + 40 * t - 9 * t * t, 1e-13) << s;
+    }
+}
+
+TEST(StretchPolynomial, ClampsAtZeroAndRejectsBadCoefficients) {
+    const StretchDependentRayleigh d(StretchCurve::constant(0.0), StretchPolynomial({ 0.1, 2.0 }));
+    EXPECT_DOUBLE_EQ(d.coefficients(1.1).alpha1, 0.3);
+    EXPECT_EQ(d.coefficients(0.9).alpha1, 0.0); // 0.1 − 0.2 < 0
+    EXPECT_EQ(d.coefficient_derivatives(0.9).alpha1, 0.0);
+    EXPECT_DOUBLE_EQ(d.coefficient_derivatives(1.1).alpha1, 2.0);
+    EXPECT_THROW(StretchPolynomial({}), InputError);
+    EXPECT_THROW(StretchPolynomial({ 0.1, std::nan("") }), InputError);
+}

@@ -23,15 +23,19 @@ std::shared_ptr<const material::DampingModel> parse_damping(const JsonObject& d)
   if (!splines)
     return std::make_shared<material::RayleighDamping>(d.number("alpha0", 0.0), d.number("alpha1", 0.0),
                                                        d.file() + ": " + d.path());
-  auto spline_or_constant = [&](const std::string& key) {
-    if (!d.has(key)) return material::CubicSpline({1.0}, {0.0});
-    if (!d.json().at(key).is_object()) return material::CubicSpline({1.0}, {d.number(key)});
+  // A coefficient is a number, a spline {"stretches", "values"} or a polynomial in σ₁ − 1
+  // {"polynomial": [c₀, c₁, ...]}.
+  auto curve = [&](const std::string& key) -> material::StretchCurve {
+    if (!d.has(key)) return material::StretchCurve::constant(0.0);
+    if (!d.json().at(key).is_object()) return material::StretchCurve::constant(d.number(key));
     const JsonObject s = d.object(key);
-    s.reject_unknown_keys({"stretches", "values"});
-    return parse_spline(s, "stretches", "values");
+    s.reject_unknown_keys({"stretches", "values", "polynomial"});
+    if (!s.has("polynomial")) return parse_spline(s, "stretches", "values");
+    if (s.has("stretches") || s.has("values"))
+      s.fail("polynomial", "give either a polynomial or a spline's \"stretches\" and \"values\", not both");
+    return material::StretchPolynomial(s.numbers("polynomial"), s.file() + ": " + s.field("polynomial"));
   };
-  return std::make_shared<material::StretchDependentRayleigh>(spline_or_constant("alpha0"),
-                                                              spline_or_constant("alpha1"),
+  return std::make_shared<material::StretchDependentRayleigh>(curve("alpha0"), curve("alpha1"),
                                                               d.file() + ": " + d.path());
 }
 

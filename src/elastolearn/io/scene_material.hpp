@@ -5,8 +5,9 @@
 ///    "edit": {"base": "neohookean"|"corotated", "region": "tension"|"compression",
 ///             "stretches": [...], "scales": [...]}            (spline_edited only)
 ///    "damping": {"alpha0": 1/s, "alpha1": s}
-///            or {"alpha0": {"stretches": [...], "values": [...]},
-///                "alpha1": {"stretches": [...], "values": [...]}} (splines of the largest stretch)}
+///            where either coefficient may instead be a function of the largest stretch σ₁:
+///            {"stretches": [...], "values": [...]} (a monotone spline) or
+///            {"polynomial": [c₀, c₁, ...]} (Σ cₖ (σ₁ − 1)ᵏ, clamped at 0)}
 #include <elastolearn/fem/elastic_force.hpp>
 #include <elastolearn/io/json_fields.hpp>
 

@@ -6,22 +6,22 @@
 namespace elastolearn::material {
 
 namespace {
-void check_spline(const CubicSpline& s, const std::string& where) {
-    if (s.min_value() < 0) {
+void check_non_negative(const StretchCurve& s, const std::string& where) {
+    if (s.lower_bound() < 0) {
         std::ostringstream os;
         os << "Rayleigh coefficient spline must be non-negative, got a knot value "
-           << s.min_value();
+           << s.lower_bound();
         throw InputError(where, os.str());
     }
 }
 } // namespace
 
 StretchDependentRayleigh::StretchDependentRayleigh(
-    CubicSpline alpha0, CubicSpline alpha1, const std::string& where)
+    StretchCurve alpha0, StretchCurve alpha1, const std::string& where)
     : m_alpha0(std::move(alpha0))
     , m_alpha1(std::move(alpha1)) {
-    check_spline(m_alpha0, where + ".alpha0");
-    check_spline(m_alpha1, where + ".alpha1");
+    check_non_negative(m_alpha0, where + ".alpha0");
+    check_non_negative(m_alpha1, where + ".alpha1");
 }
 
 RayleighCoefficients StretchDependentRayleigh::coefficients(double max_stretch) const {
