@@ -76,7 +76,7 @@ bool g_no_fit = false;     ///< --no-fit: skip the parameter-fit baseline (for t
 int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_halvings = -1, g_forward_fit = -1;
 long g_seed = -1;
 double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1, g_kernel_smoothing = -1,
-       g_full_space_weight = -1, g_damping_prior = -1;
+       g_full_space_weight = -1, g_damping_prior = -1, g_elastic_prior = -1;
 bool g_neo_hookean_tail = false, g_linear_tail = false, g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false;
 
 void apply_overrides(learn::LearningOptions& o) {
@@ -87,6 +87,7 @@ void apply_overrides(learn::LearningOptions& o) {
   if (g_free_halvings >= 0) o.free_halvings = g_free_halvings;
   if (g_forward_fit >= 0) o.forward_fit.max_iterations = g_forward_fit;
   if (g_damping_prior >= 0) o.forward_fit.damping_prior = g_damping_prior;
+  if (g_elastic_prior >= 0) o.forward_fit.elastic_prior = g_elastic_prior;
   if (g_seed >= 0) o.seed = static_cast<std::uint64_t>(g_seed);
   if (g_regularization >= 0) o.rbf.regularization = g_regularization;
   if (g_kernel_smoothing >= 0) o.rbf.epsilon = g_kernel_smoothing;
@@ -269,6 +270,7 @@ int main(int argc, char** argv) {
     else if (a == "--free-halvings" && i + 1 < argc) g_free_halvings = std::stoi(argv[++i]);
     else if (a == "--forward-fit" && i + 1 < argc) g_forward_fit = std::stoi(argv[++i]);
     else if (a == "--damping-prior" && i + 1 < argc) g_damping_prior = std::stod(argv[++i]);
+    else if (a == "--elastic-prior" && i + 1 < argc) g_elastic_prior = std::stod(argv[++i]);
     else if (a == "--seed" && i + 1 < argc) g_seed = std::stol(argv[++i]);
     else if (a == "--regularization" && i + 1 < argc) g_regularization = std::stod(argv[++i]);
     else if (a == "--kernel-smoothing" && i + 1 < argc) g_kernel_smoothing = std::stod(argv[++i]);
@@ -283,7 +285,7 @@ int main(int argc, char** argv) {
     else if (a == "--full-space-weight" && i + 1 < argc) g_full_space_weight = std::stod(argv[++i]);
     else if (a == "--data" && i + 1 < argc) data = argv[++i];
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] [--forward-fit F] [--damping-prior RHO] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--neo-hookean-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] [--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--neo-hookean-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
       for (const auto& n : kCases) std::printf(" %s", n.c_str());
       std::printf(" (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
                   "data/meshes are (extracted there if missing)\n");

@@ -249,6 +249,9 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--damping-prior", l.forward_fit.damping_prior,
                   "forward fit: Tikhonov weight (Jacobi-scaled) pulling the damping correction towards 0")
       ->capture_default_str();
+  cmd->add_option("--elastic-prior", l.forward_fit.elastic_prior,
+                  "forward fit: the same on the elastic correction (a large value learns the damping only)")
+      ->capture_default_str();
   cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")->capture_default_str();
   cmd->add_flag("--neo-hookean-tail", l.rbf.neo_hookean_tail,
                 "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");

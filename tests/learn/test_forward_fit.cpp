@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <iostream>
 #include <random>
 
@@ -123,36 +125,69 @@ TEST(ForwardFit, RecoversACorrectionTheDesignCanExpressFromHalfTheVertices) {
   EXPECT_LE((got - want).norm(), 0.05 * want.norm()) << "got " << got.transpose() << ", want " << want.transpose();
 }
 
-TEST(ForwardFit, DampingPriorHoldsTheDampingCorrectionNearZero) {
-  // The truth damps more (α₁ 0.02 → 0.1) and is stiffer (E 2e4 → 2.6e4). Without a prior the fit
-  // explains the motion with both corrections; with a strong prior (ρ_d = 1e6 in Jacobi-scaled
-  // units) it must keep Δα₁ near zero and still fit the elastic part. A prior on the wrong
-  // unknowns, or missing from the normal equations or the acceptance test, fails one of these.
-  sim::Scene nominal = small_bar();
-  nominal.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.02);
-  sim::Scene truth = nominal;
-  truth.material.elastic = material::make_elastic_model(material::ElasticModelType::Corotated,
-      material::Lame::from_young_poisson(2.6e4, 0.4));
-  truth.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.1);
-  const observe::Observation observed = observe_run(truth);
-  const ReconstructionMesh mesh(nominal.mesh, nominal.material);
-  const RbfDesign design(centres(), RbfFitOptions{});
-  ASSERT_GT(design.damping_unknowns(), 0);
-  const Vec3 probe(1.02, 0.995, 0.99);
-  const auto fit_with = [&](double prior) {
+/// A bar whose truth damps more (α₁ 0.02 → 0.1) and is stiffer (E 2e4 → 2.6e4) than its
+/// nominal, and a fit of either correction with priors (ρ_d, ρ_e) on the damping / elastic unknowns.
+struct StifferAndMoreDamped {
+  sim::Scene nominal = nominal_scene();
+  observe::Observation observed = observe_truth();
+  ReconstructionMesh mesh{nominal.mesh, nominal.material};
+  RbfDesign design{centres(), RbfFitOptions{}};
+  static sim::Scene nominal_scene() {
+    sim::Scene s = small_bar();
+    s.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.02);
+    return s;
+  }
+  static observe::Observation observe_truth() {
+    sim::Scene truth = small_bar();
+    truth.material.elastic = material::make_elastic_model(material::ElasticModelType::Corotated,
+        material::Lame::from_young_poisson(2.6e4, 0.4));
+    truth.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.1);
+    return observe_run(truth);
+  }
+  ForwardFitResult fit(double damping_prior, double elastic_prior) const {
     ForwardFitOptions options;
     options.max_iterations = 4;
-    options.damping_prior = prior;
+    options.damping_prior = damping_prior;
+    options.elastic_prior = elastic_prior;
     return fit_to_observations(nominal, observed, mesh, design, VecX::Zero(design.num_unknowns()), options);
-  };
-  const ForwardFitResult free = fit_with(0.0), held = fit_with(1e6);
-  const double free_alpha = design.correction(free.unknowns).stiffness_damping(probe);
-  const double held_alpha = design.correction(held.unknowns).stiffness_damping(probe);
+  }
+};
+
+TEST(ForwardFit, DampingPriorHoldsTheDampingCorrectionNearZero) {
+  // Without a prior the fit explains the motion with both corrections; with a strong prior
+  // (ρ_d = 1e6 in Jacobi-scaled units) it must keep Δα₁ near zero and still fit the elastic part.
+  // A prior on the wrong unknowns, or missing from the normal equations or the acceptance test,
+  // fails one of these.
+  const StifferAndMoreDamped c;
+  ASSERT_GT(c.design.damping_unknowns(), 0);
+  const Vec3 probe(1.02, 0.995, 0.99);
+  const ForwardFitResult free = c.fit(0.0, 0.0), held = c.fit(1e6, 0.0);
+  const double free_alpha = c.design.correction(free.unknowns).stiffness_damping(probe);
+  const double held_alpha = c.design.correction(held.unknowns).stiffness_damping(probe);
   std::cout << "[ prior ] Δα₁ " << free_alpha << " (free) vs " << held_alpha << " (held); rms "
             << free.rms_history.back() << " vs " << held.rms_history.back() << " from " << held.rms_history.front() << "\n";
   EXPECT_NEAR(free_alpha, 0.08, 0.04); // the free fit finds the extra damping (truth +0.08)
   EXPECT_LT(std::abs(held_alpha), 1e-2 * free_alpha);
   EXPECT_LT(held.rms_history.back(), 0.5 * held.rms_history.front()); // the elastic part still fits
+  EXPECT_LT(free.rms_history.back(), held.rms_history.back());
+}
+
+TEST(ForwardFit, ElasticPriorHoldsTheElasticCorrectionNearZero) {
+  // The mirror image: with ρ_e = 1e6 the elastic correction stays near zero while Δα₁ still
+  // lowers the error; the free fit's elastic correction is far from zero (the truth is stiffer).
+  const StifferAndMoreDamped c;
+  const Vec3 probe(1.02, 0.995, 0.99);
+  const ForwardFitResult free = c.fit(0.0, 0.0), held = c.fit(0.0, 1e6);
+  const double free_n = c.design.correction(free.unknowns).correction(probe, Vec3::Zero()).norm();
+  const double held_n = c.design.correction(held.unknowns).correction(probe, Vec3::Zero()).norm();
+  const double held_alpha = c.design.correction(held.unknowns).stiffness_damping(probe);
+  std::cout << "[ prior ] |N| " << free_n << " Pa (free) vs " << held_n << " Pa (held), held Δα₁ " << held_alpha
+            << "; rms " << free.rms_history.back() << " vs " << held.rms_history.back() << " from "
+            << held.rms_history.front() << "\n";
+  EXPECT_GT(free_n, 10.0);
+  EXPECT_LT(held_n, 1e-2 * free_n);
+  EXPECT_GT(held_alpha, 0.0);                                         // the damping takes up what it can
+  EXPECT_LT(held.rms_history.back(), 0.9 * held.rms_history.front()); // and lowers the error
   EXPECT_LT(free.rms_history.back(), held.rms_history.back());
 }
 
@@ -168,6 +203,9 @@ TEST(ForwardFit, RejectsBadOptions) {
   EXPECT_THROW(options.validate(), InputError);
   options.sensitivities = Sensitivities::projected;
   options.damping_prior = -1;
+  EXPECT_THROW(options.validate(), InputError);
+  options.damping_prior = 0;
+  options.elastic_prior = std::nan("");
   EXPECT_THROW(options.validate(), InputError);
 }
 

@@ -116,7 +116,8 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
                                {"max_samples", o.stretch_samples.max_samples}}},
           {"seed", o.seed},
           {"forward_fit", {{"max_iterations", o.forward_fit.max_iterations}, {"damping", o.forward_fit.damping},
-                           {"damping_prior", o.forward_fit.damping_prior}}}};
+                           {"damping_prior", o.forward_fit.damping_prior},
+                           {"elastic_prior", o.forward_fit.elastic_prior}}}};
 }
 
 void write_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs,

@@ -46,6 +46,8 @@ void ForwardFitOptions::validate() const {
     throw InputError("forward_fit.damping", "must be finite and > 0");
   if (!std::isfinite(damping_prior) || damping_prior < 0)
     throw InputError("forward_fit.damping_prior", "must be finite and ≥ 0");
+  if (!std::isfinite(elastic_prior) || elastic_prior < 0)
+    throw InputError("forward_fit.elastic_prior", "must be finite and ≥ 0");
   if (sensitivities == Sensitivities::none)
     throw InputError("forward_fit.sensitivities", "the fit needs sensitivities (projected or exact)");
 }
@@ -173,10 +175,11 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
   double mu = options.damping;
   const int first_damping = design.elastic_unknowns(), n_damping = design.damping_unknowns();
   for (int it = 0; it < options.max_iterations; ++it) {
-    // The prior ρ_d Σ (s_i w_i)² on the damping unknowns, with s fixed by the current pass so
-    // that the trial and the current objective are measured alike (and a resumed fit, which
-    // recomputes the current pass, takes the same steps).
+    // The priors ρ Σ (s_i w_i)² on the damping (ρ_d) and the elastic (ρ_e) unknowns, with s
+    // fixed by the current pass so that the trial and the current objective are measured alike
+    // (and a resumed fit, which recomputes the current pass, takes the same steps).
     VecX prior_weights = VecX::Zero(start.size());
+    prior_weights.head(first_damping) = options.elastic_prior * current.normal.diagonal().head(first_damping);
     prior_weights.segment(first_damping, n_damping)
         = options.damping_prior * current.normal.diagonal().segment(first_damping, n_damping);
     const auto objective = [&](const ForwardSensitivityPass& pass, const VecX& w) {

@@ -67,6 +67,12 @@ struct ForwardFitOptions {
   /// ρ_d = 0 and tests at 1.250 % with ρ_d = 1, nominal 2.294 % (docs/benchmarks_learning.md,
   /// "Update 8"). 0 turns the prior off.
   double damping_prior = 0;
+  /// Weight ρ_e of the same prior on the elastic unknowns (N's kernels and tail): for a nominal
+  /// whose elasticity is known to be right, so that only the damping is learned (ρ_e = 10⁶). A
+  /// motion whose velocity stays nearly proportional to its displacement cannot tell extra
+  /// stiffness damping from an elastic softening, and a free fit may split the two wrongly
+  /// (docs/benchmarks_learning.md, "Update 11"). 0 turns the prior off.
+  double elastic_prior = 0;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;
 };
