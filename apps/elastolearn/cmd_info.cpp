@@ -5,8 +5,8 @@
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
-#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
+#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/mesh/read_tet_mesh.hpp>
 #include <elastolearn/mesh/surface_mesh.hpp>
 

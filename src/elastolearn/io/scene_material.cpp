@@ -18,9 +18,9 @@ material::CubicSpline parse_spline(const JsonObject& o, const std::string& x_key
 
 std::shared_ptr<const material::DampingModel> parse_damping(const JsonObject& d) {
   d.reject_unknown_keys({"alpha0", "alpha1"});
-  const bool splines = (d.has("alpha0") && d.json().at("alpha0").is_object()) ||
-                       (d.has("alpha1") && d.json().at("alpha1").is_object());
-  if (!splines)
+  const bool stretch_dependent = (d.has("alpha0") && d.json().at("alpha0").is_object()) ||
+                                 (d.has("alpha1") && d.json().at("alpha1").is_object());
+  if (!stretch_dependent)
     return std::make_shared<material::RayleighDamping>(d.number("alpha0", 0.0), d.number("alpha1", 0.0),
                                                        d.file() + ": " + d.path());
   // A coefficient is a number, a spline {"stretches", "values"} or a polynomial in σ₁ − 1
