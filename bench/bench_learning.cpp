@@ -77,7 +77,7 @@ int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_hal
 long g_seed = -1;
 double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1, g_kernel_smoothing = -1,
        g_full_space_weight = -1, g_damping_prior = -1, g_elastic_prior = -1;
-bool g_neo_hookean_tail = false, g_linear_tail = false, g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false;
+bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false, g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false;
 
 void apply_overrides(learn::LearningOptions& o) {
   if (g_modes > 0) o.pod.max_modes = g_modes;
@@ -94,6 +94,7 @@ void apply_overrides(learn::LearningOptions& o) {
   if (g_damping_regularization >= 0) o.rbf.damping_regularization = g_damping_regularization;
   if (g_linear_tail) o.rbf.quadratic_tail = false;
   if (g_neo_hookean_tail) o.rbf.neo_hookean_tail = true;
+  if (g_damping_quadratic) o.rbf.damping_quadratic_tail = true;
   if (g_full_space) o.full_space = true;
   if (g_pod_forward_only) o.pod_with_constrained = false;
   if (g_no_damping) o.rbf.fit_damping = false;
@@ -277,6 +278,7 @@ int main(int argc, char** argv) {
     else if (a == "--damping-regularization" && i + 1 < argc) g_damping_regularization = std::stod(argv[++i]);
     else if (a == "--linear-tail") g_linear_tail = true;
     else if (a == "--neo-hookean-tail") g_neo_hookean_tail = true;
+    else if (a == "--damping-quadratic-tail") g_damping_quadratic = true;
     else if (a == "--full-space") g_full_space = true;
     else if (a == "--pod-forward-only") g_pod_forward_only = true;
     else if (a == "--no-damping") g_no_damping = true;
@@ -285,7 +287,7 @@ int main(int argc, char** argv) {
     else if (a == "--full-space-weight" && i + 1 < argc) g_full_space_weight = std::stod(argv[++i]);
     else if (a == "--data" && i + 1 < argc) data = argv[++i];
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] [--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--neo-hookean-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] [--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--neo-hookean-tail] [--damping-quadratic-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
       for (const auto& n : kCases) std::printf(" %s", n.c_str());
       std::printf(" (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
                   "data/meshes are (extracted there if missing)\n");

@@ -255,6 +255,8 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")->capture_default_str();
   cmd->add_flag("--neo-hookean-tail", l.rbf.neo_hookean_tail,
                 "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");
+  cmd->add_flag("--damping-quadratic-tail", l.rbf.damping_quadratic_tail,
+                "RBF damping Δα₁ with a quadratic tail too (carries its curvature beyond the training's stretches)");
   cmd->add_flag("!--allow-rest-stress", l.rbf.stress_free_rest,
                 "let the correction carry a stress at rest (default: N(1, 1, 1) = 0)");
   cmd->add_flag("--network", o->network,

@@ -55,6 +55,7 @@ material::RbfCorrection::Parameters rbf_parameters(int centres, unsigned seed) {
   fill(p.damping_weights, rng);
   p.damping_slopes = Vec3(awkward(rng), awkward(rng), awkward(rng));
   p.damping_constant = awkward(rng);
+  p.damping_quadratic = Vec3(awkward(rng), awkward(rng), awkward(rng));
   p.damping_floor = -0.002 / 3;
   p.epsilon = 1e-3 / 3;
   return p;
@@ -143,6 +144,7 @@ TEST(MaterialFile, RbfRoundTripIsBitExact) {
   EXPECT_EQ(p.damping_slopes, q.damping_slopes);
   EXPECT_EQ(p.damping_floor, q.damping_floor);
   EXPECT_EQ(p.damping_constant, q.damping_constant);
+  EXPECT_EQ(p.damping_quadratic, q.damping_quadratic);
   EXPECT_EQ(p.epsilon, q.epsilon);
   expect_same_function(*original, *back);
 }

@@ -39,6 +39,7 @@ RbfCorrection::Parameters test_parameters(double epsilon) {
   p.neo_hookean = Eigen::Vector2d(-2e4, 3e4);
   p.damping_slopes = Vec3(0.01, -0.02, 0.005);
   p.damping_constant = 0.03;
+  p.damping_quadratic = Vec3(2.0, -1.0, 0.5);
   p.epsilon = epsilon;
   return p;
 }
@@ -158,6 +159,7 @@ TEST(RbfCorrection, ElasticAndDampingPartsAreTheDocumentedRbfs) {
   // N(σ) and Δα₁(σ) are the documented RBF + linear tail; N does not see the stretch rates (the
   // damping acts through Δα₁ on the nominal stiffness, fem::ElasticForce).
   double expected_alpha = p.damping_slopes.dot(s - Vec3::Ones()) + p.damping_constant; // s sorted ↓
+  for (int k = 0; k < 3; ++k) expected_alpha += p.damping_quadratic[k] * (s[k] - 1) * (s[k] - 1);
   Vec3 expected_elastic;
   for (int k = 0; k < 3; ++k) {
     const Vec3 y = stretch_view(s, k);
@@ -189,6 +191,7 @@ TEST(RbfCorrection, DampingFloorBoundsTheDampingCorrection) {
   p.damping_weights.resize(0);
   p.damping_slopes = Vec3(1.0, 0.0, 0.0); // Δα₁ = max σ − 1 + a₀
   p.damping_constant = 0;
+  p.damping_quadratic.setZero();
   p.damping_floor = -0.05;
   const RbfCorrection n(p);
   EXPECT_NEAR(n.stiffness_damping(Vec3(1.0, 1.1, 0.95)), 0.1, 1e-14); // the largest stretch, wherever it is
@@ -217,6 +220,7 @@ TEST(RbfCorrection, ZeroWithoutWeightsAndWithoutDampingPart) {
   p.damping_weights.resize(0); // no damping RBF; the damping tail alone remains
   p.damping_slopes.setZero();
   p.damping_constant = 0;
+  p.damping_quadratic.setZero();
   const RbfCorrection n(p);
   EXPECT_EQ(n.correction(Vec3(1.2, 1.0, 0.7), Vec3(1, 2, 3)), Vec3::Zero());
   EXPECT_EQ(n.stiffness_damping(Vec3(1.2, 1.0, 0.7)), 0.0);

@@ -74,7 +74,7 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
         c.has_tangent = true;
         if (c.alpha.alpha1 != 0) P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
         if (c.alpha1_change != 0) {
-          c.nominal_tangent = material::principal_tangent(*elastic, c.frame, m_project_tangent);
+          c.nominal_tangent = material::damping_tangent(*elastic, c.frame);
           P += c.alpha1_change * material::first_piola_differential(c.frame, c.nominal_tangent, F_rate);
         }
       }

@@ -34,9 +34,9 @@ struct MaterialModel {
 /// force stays linear in the correction's unknowns (learn::reconstruct_rbf_correction). α₁'s
 /// K_e is material::damping_tangent of P̂ + N(σ, 0): exact, without its flip part, unprojected
 /// (a projected one would make the force nonlinear in the correction, and the learned correction
-/// diverged with it; measured in docs/learning.md, "Damping part"). Δα₁'s K_e^nom is the
-/// nominal's PSD-projected tangent (independent of the unknowns). The correction's rate
-/// dependence adds
+/// diverged with it; measured in docs/learning.md, "Damping part"). Δα₁'s K_e^nom is the same
+/// damping tangent of the nominal P̂ (independent of the unknowns), so that where N = 0 a learned
+/// Δα₁ is exactly a change of α₁. The correction's rate dependence adds
 /// D_e = vol Bᵀ ∂P/∂Ḟ B
 /// (symmetrised, clamped PSD). The Jacobian drops ∂K/∂x·v (Rayleigh) and the variation of
 /// Ḟ̂ through U, V (correction): standard, and the residual is still exact.
@@ -71,7 +71,7 @@ private:
     /// A correction's Δα₁ as applied: (α₁ + Δα₁)⁺ − α₁ ≥ −α₁ (0 without a correction).
     double alpha1_change = 0;
     material::PrincipalTangent tangent; ///< material::damping_tangent of P̂ + N; valid if has_tangent
-    material::PrincipalTangent nominal_tangent; ///< dP/dF of P̂ (projected unless disabled); valid if alpha1_change ≠ 0
+    material::PrincipalTangent nominal_tangent; ///< material::damping_tangent of P̂; valid if alpha1_change ≠ 0
     bool has_tangent = false;
   };
   bool cache_matches(const ForceState& state) const;

@@ -106,6 +106,7 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
                    {"quadratic_tail", o.rbf.quadratic_tail}, {"stress_free_rest", o.rbf.stress_free_rest},
                    {"neo_hookean_tail", o.rbf.neo_hookean_tail},
                    {"fit_damping", o.rbf.fit_damping}, {"damping_polynomial", o.rbf.damping_polynomial},
+                   {"damping_quadratic_tail", o.rbf.damping_quadratic_tail},
                    {"regularization", o.rbf.regularization},
                    {"damping_regularization", o.rbf.damping_regularization}}},
           {"reconstruction", {{"method", learn::reconstruction_method_name(o.reconstruction.method)},

@@ -47,7 +47,8 @@ Json rbf_to_json(const material::RbfCorrection& c) {
     { "quadratic", vector_to_json(p.quadratic) },
     { "neo_hookean", vector_to_json(p.neo_hookean) },
     { "damping_weights", vector_to_json(p.damping_weights) }, { "damping_slopes", vector_to_json(p.damping_slopes) },
-    { "damping_constant", p.damping_constant }, { "damping_floor", floor } };
+    { "damping_constant", p.damping_constant }, { "damping_quadratic", vector_to_json(p.damping_quadratic) },
+    { "damping_floor", floor } };
 }
 
 Json nn_to_json(const material::NnCorrection& c) {
@@ -128,7 +129,7 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
 std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "epsilon", "centres", "weights", "own_slope", "other_slope",
       "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes", "damping_slope", "damping_constant",
-      "damping_floor" });
+      "damping_quadratic", "damping_floor" });
   material::RbfCorrection::Parameters p;
   p.epsilon = o.number("epsilon");
   p.centres = read_rows(o, "centres", -1, 3);
@@ -155,6 +156,8 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
   else // older files: one slope along the trace Σσ − 3 = Σ (s_k − 1), i.e. equal sorted slopes
     p.damping_slopes.setConstant(o.number("damping_slope", 0.0));
   p.damping_constant = o.number("damping_constant", 0.0);
+  if (o.has("damping_quadratic"))
+    p.damping_quadratic = read_vector(o, "damping_quadratic", 3);
   if (o.has("damping_floor") && !o.json().at("damping_floor").is_null())
     p.damping_floor = o.number("damping_floor");
   return construct(

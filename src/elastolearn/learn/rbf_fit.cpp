@@ -36,6 +36,8 @@ void RbfFitOptions::validate() const {
     fail("damping_regularization", "must be finite and ≥ 0, got " + str(damping_regularization));
   if (std::isnan(damping_floor) || damping_floor > 0)
     fail("damping_floor", "must be ≤ 0 (or −infinity), got " + str(damping_floor));
+  if (damping_quadratic_tail && !damping_polynomial)
+    fail("damping_quadratic_tail", "needs damping_polynomial (the linear tail)");
 }
 
 RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_options(options) {
@@ -62,7 +64,7 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_o
       m_elastic += 2;
     }
   }
-  m_damping = options.fit_damping ? m + (options.damping_polynomial ? 4 : 0) : 0;
+  m_damping = options.fit_damping ? m + (options.damping_polynomial ? 4 : 0) + (options.damping_quadratic_tail ? 3 : 0) : 0;
 }
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
@@ -129,6 +131,7 @@ void RbfDesign::damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd
   if (m_options.damping_polynomial) {
     out.segment<3>(m) = (s - Vec3::Ones()).transpose();
     out[m + 3] = 1;
+    if (m_options.damping_quadratic_tail) out.segment<3>(m + 4) = (s - Vec3::Ones()).cwiseAbs2().transpose();
   }
 }
 
@@ -153,6 +156,7 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
     if (m_options.damping_polynomial) {
       p.damping_slopes = v.segment<3>(m);
       p.damping_constant = v[m + 3];
+      if (m_options.damping_quadratic_tail) p.damping_quadratic = v.segment<3>(m + 4);
     }
     p.damping_floor = m_options.damping_floor;
   }
@@ -165,7 +169,7 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon)
     fail("correction", "its centres or kernel smoothing differ from the design's");
   const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();
-  const bool has_damping_tail = !p.damping_slopes.isZero(0) || p.damping_constant != 0;
+  const bool has_damping_tail = !p.damping_slopes.isZero(0) || p.damping_constant != 0 || !p.damping_quadratic.isZero(0);
   const bool has_damping = p.damping_weights.size() > 0 || has_damping_tail;
   if ((has_tail && !m_options.elastic_polynomial) || (!p.quadratic.isZero() && m_quadratic < 0) ||
       (!p.neo_hookean.isZero() && m_neo_hookean < 0) ||
@@ -188,6 +192,8 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
     if (m_options.damping_polynomial) {
       x.segment<3>(m_elastic + m) = p.damping_slopes;
       x[m_elastic + m + 3] = p.damping_constant;
+      if (m_options.damping_quadratic_tail) x.segment<3>(m_elastic + m + 4) = p.damping_quadratic;
+      else if (!p.damping_quadratic.isZero(0)) fail("correction", "it has a quadratic damping tail the design does not fit");
     } else if (has_damping_tail)
       fail("correction", "it has a damping tail the design does not fit");
   }

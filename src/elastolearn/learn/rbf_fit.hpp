@@ -32,6 +32,8 @@ struct RbfFitOptions {
   /// elements' damping forces, which principal stress samples do not carry).
   bool fit_damping = true;
   bool damping_polynomial = true; ///< fit the linear tail a_dᵀ(sort↓σ − 1) + a₀ of Δα₁
+  /// Also fit Δα₁'s quadratic tail Σ_k d_k (s_k − 1)² (needs damping_polynomial).
+  bool damping_quadratic_tail = false;
   /// Tikhonov weight λ ≥ 0 on the Jacobi-scaled unknowns: (S⁻¹JᵀJS⁻¹ + λI) S x = S⁻¹Jᵀy with
   /// S = √diag(JᵀJ), so λ is dimensionless and independent of the units of each unknown.
   double regularization = 1e-9;
@@ -48,10 +50,10 @@ struct RbfFitOptions {
 /// The unknowns of an RBF correction with given centres, and the linear maps from them to N and
 /// Δα₁. Unknowns x = [x_e; x_d] with x_e = [w (m); a, b, c, q, r (with the elastic tail; c only
 /// without stress_free_rest, q only with quadratic_tail, r only with neo_hookean_tail)] and x_d = [v (m); a_d (3), a₀ (with the
-/// damping tail)] (only when fit_damping), in the notation of material::RbfCorrection (before
-/// Δα₁'s floor):
+/// damping tail); d (3) (with damping_quadratic_tail)] (only when fit_damping), in the notation of
+/// material::RbfCorrection (before Δα₁'s floor):
 ///   N(σ) = A(σ) x_e,   row k of A = [φ_i(y_k) − r_i …, y_k1 − 1, y_k2 + y_k3 − 2, 1, t(y_k)ᵀ, g(y_k)ᵀ],
-///   Δα₁(σ) = d(σ) x_d, d = [φ_i(s) …, (s − 1)ᵀ, 1], s = sort↓ σ,
+///   Δα₁(σ) = d(σ) x_d, d = [φ_i(s) …, (s − 1)ᵀ, 1, ((s − 1)²)ᵀ], s = sort↓ σ,
 /// with r_i = φ_i(1, 1, 1) under stress_free_rest (else 0).
 class RbfDesign {
 public:

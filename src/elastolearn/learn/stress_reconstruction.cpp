@@ -125,7 +125,7 @@ Vec12 stiffness_damping_force(
 
 Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
     const material::ElasticModel& elastic) {
-  return stiffness_damping_force(rest, state, material::principal_tangent(elastic, state.frame, true));
+  return stiffness_damping_force(rest, state, material::damping_tangent(elastic, state.frame));
 }
 
 Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(

@@ -60,8 +60,8 @@ Eigen::Matrix<double, 12, 3> element_force_operator(
     const fem::TetRestData& rest, const material::PrincipalFrame& frame);
 
 /// The element's stiffness-damping force per unit Δα₁ [N·s]: −K_e v_e = −vol (dP/dF : Ḟ) g_a
-/// with dP/dF the PSD-projected tangent of the nominal model `elastic`, exactly as
-/// fem::ElasticForce applies Δα₁. Local dofs ordered x0, y0, z0, x1, ….
+/// with dP/dF the damping tangent (material::damping_tangent) of the nominal model `elastic`,
+/// exactly as fem::ElasticForce applies Δα₁. Local dofs ordered x0, y0, z0, x1, ….
 Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
     const material::ElasticModel& elastic);
 
@@ -74,9 +74,9 @@ Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
     const fem::TetRestData& rest, const ElementState& state);
 
 /// Nodal forces [N] (flat 3n) of a correction: what fem::ElasticForce gives with it minus without
-/// it, f = Σ_e B_e N(σ_e, ḟ_e) + α₁ (−(K_e − K_e^d) v_e) + [(α₁ + Δα₁)⁺ − α₁] (−K_e^nom v_e)
+/// it, f = Σ_e B_e N(σ_e, ḟ_e) + α₁ (−(K_e − K_e^d) v_e) + [(α₁ + Δα₁)⁺ − α₁] (−K_e^d v_e)
 /// with K_e, K_e^d the damping stiffness (material::damping_tangent) of the corrected and the
-/// nominal model and K_e^nom the nominal's projected stiffness (Eq. 1's N term, the nominal
+/// nominal model (Eq. 1's N term, the nominal
 /// Rayleigh term on the corrected stiffness, and Eq. 13's damping term; α₁ from
 /// mesh.nominal.damping). Without mesh.nominal.elastic only the N term. Parallel over elements.
 VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,

@@ -81,6 +81,7 @@ RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
   finite("damping_weights", m_p.damping_weights.allFinite());
   finite("damping_slopes", m_p.damping_slopes.allFinite());
   finite("damping_constant", std::isfinite(m_p.damping_constant));
+  finite("damping_quadratic", m_p.damping_quadratic.allFinite());
   if (std::isnan(m_p.damping_floor) || m_p.damping_floor == std::numeric_limits<double>::infinity())
     fail("damping_floor", "must be a number or −infinity");
   if (!std::isfinite(m_p.epsilon) || m_p.epsilon < 0) {
@@ -151,7 +152,8 @@ Vec3 RbfCorrection::elastic_views(const Mat3& y, Mat3* d_y) const {
 double RbfCorrection::stiffness_damping(const Vec3& stretches) const {
   const auto p = descending_order(stretches);
   const Vec3 s(stretches[p[0]], stretches[p[1]], stretches[p[2]]);
-  double alpha = m_p.damping_slopes.dot(s - Vec3::Ones()) + m_p.damping_constant;
+  const Vec3 e = s - Vec3::Ones();
+  double alpha = m_p.damping_slopes.dot(e) + m_p.damping_constant + m_p.damping_quadratic.dot(e.cwiseAbs2());
   if (m_p.damping_weights.size() > 0) {
     for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i)
       alpha += m_p.damping_weights[i] * rbf_kernel((s - m_p.centres.row(i).transpose()).squaredNorm(), m_p.epsilon);
@@ -194,7 +196,7 @@ Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
 
 bool RbfCorrection::has_damping() const {
   return m_p.damping_weights.size() > 0 || !m_p.damping_slopes.isZero(0) || m_p.damping_constant != 0 ||
-         m_p.damping_floor > 0;
+         !m_p.damping_quadratic.isZero(0) || m_p.damping_floor > 0;
 }
 
 bool RbfCorrection::has_elastic_part() const {
@@ -238,6 +240,7 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   p.neo_hookean = (1 - t) * p.neo_hookean + t * q.neo_hookean;
   p.damping_slopes = (1 - t) * p.damping_slopes + t * q.damping_slopes;
   p.damping_constant = (1 - t) * p.damping_constant + t * q.damping_constant;
+  p.damping_quadratic = (1 - t) * p.damping_quadratic + t * q.damping_quadratic;
   return RbfCorrection(std::move(p));
 }
 

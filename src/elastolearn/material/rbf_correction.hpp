@@ -41,7 +41,7 @@ Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3
 /// φ_i(y) = φ(‖y − c_i‖):
 ///   N_k(σ)  = h(y_k)                                                                   [Pa]
 ///   h(y)    = Σ_i w_i φ_i(y) + a (y₁ − 1) + b (y₂ + y₃ − 2) + c + qᵀ t(y) + rᵀ g(y)     (Eq. 10)
-///   Δα₁(σ)  = max(f, Σ_i v_i φ_i(s) + a_dᵀ (s − 1) + a₀),  s = sort↓ σ             [s]  (Eq. 13)
+///   Δα₁(σ)  = max(f, Σ_i v_i φ_i(s) + a_dᵀ (s − 1) + a₀ + Σ_k d_k (s_k − 1)²),  s = sort↓ σ   [s]  (Eq. 13)
 /// One scalar function h serves all three principal directions, each seeing the stretches from
 /// its own side. This makes N isotropic by construction: N(Pσ) = P N(σ) for every permutation P
 /// and, crucially, N_i = N_j whenever σ_i = σ_j, so that P = U diag(P̂ + N) Vᵀ is a continuous
@@ -80,6 +80,10 @@ public:
     /// cannot: in bending, σ₁ − 1 is of one size on both sides while the trace nearly vanishes.
     Vec3 damping_slopes = Vec3::Zero();
     double damping_constant = 0;  ///< a₀ [s]
+    /// d [s]: Δα₁'s curvature along each sorted stretch, Σ_k d_k (s_k − 1)². Damping that grows
+    /// (or saturates) with strain is convex (concave) in it; the kernels grow only linearly away
+    /// from their centres, so beyond the training's stretches only this term carries the curvature.
+    Vec3 damping_quadratic = Vec3::Zero();
     /// Δα₁ is clamped below at this value [s] when evaluated: set it to −α₁ of the nominal
     /// model so that the total stiffness damping never turns negative (energy would grow).
     double damping_floor = -std::numeric_limits<double>::infinity();
