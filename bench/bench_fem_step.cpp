@@ -26,31 +26,37 @@ using namespace elastolearn;
 
 bool g_jacobian_reuse = true;
 
-constexpr std::array<std::array<int, 3>, 3> kResolutions = {{{16, 4, 4}, {32, 8, 8}, {52, 13, 13}}};
+constexpr std::array<std::array<int, 3>, 3> kResolutions
+    = { { { 16, 4, 4 }, { 32, 8, 8 }, { 52, 13, 13 } } };
 
 sim::Scene bar(material::ElasticModelType type, int resolution, sim::LinearSolverType solver) {
   sim::Scene s;
   s.mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), kResolutions[resolution]);
-  s.material.elastic = material::make_elastic_model(type, material::Lame::from_young_poisson(3e5, 0.4));
+  s.material.elastic
+      = material::make_elastic_model(type, material::Lame::from_young_poisson(3e5, 0.4));
   s.material.damping = std::make_shared<material::RayleighDamping>(0.2, 0.005);
   s.material.density = 1000;
   s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
   s.gravity = Vec3(0, -9.81, 0);
   s.dt = 1e-3;
   s.newton.relative_tolerance = 1e-6;
-  if (!g_jacobian_reuse) s.newton.jacobian_reuse_contraction = 0;
+  if (!g_jacobian_reuse)
+    s.newton.jacobian_reuse_contraction = 0;
   s.linear_solver = solver;
   return s;
 }
 
-void step_benchmark(benchmark::State& state, material::ElasticModelType type, sim::LinearSolverType solver) {
+void step_benchmark(
+    benchmark::State& state, material::ElasticModelType type, sim::LinearSolverType solver) {
   const int resolution = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
   tbb::global_control control(tbb::global_control::max_allowed_parallelism, threads);
-  if (openblas_set_num_threads) openblas_set_num_threads(threads);
+  if (openblas_set_num_threads)
+    openblas_set_num_threads(threads);
   sim::Simulator simulator(bar(type, resolution, solver));
   // Warm up past the first steps (whose Newton solves start far from the answer) as Vega's would.
-  for (int i = 0; i < 3; ++i) simulator.step();
+  for (int i = 0; i < 3; ++i)
+    simulator.step();
   long newton = 0, jacobians = 0, linear = 0, steps = 0;
   sim::SolverTimings timings;
   double seconds = 0;
@@ -58,7 +64,8 @@ void step_benchmark(benchmark::State& state, material::ElasticModelType type, si
     const auto t0 = std::chrono::steady_clock::now();
     const auto report = simulator.step();
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!report.converged) state.SkipWithError(report.message.c_str());
+    if (!report.converged)
+      state.SkipWithError(report.message.c_str());
     newton += report.iterations;
     jacobians += report.jacobians;
     linear += report.linear_iterations;
@@ -69,7 +76,8 @@ void step_benchmark(benchmark::State& state, material::ElasticModelType type, si
   state.counters["ms/step"] = 1e3 * seconds / steps;
   state.counters["newton/step"] = double(newton) / steps;
   state.counters["jacobians/step"] = double(jacobians) / steps;
-  if (solver == sim::LinearSolverType::ConjugateGradient) state.counters["cg_it/step"] = double(linear) / steps;
+  if (solver == sim::LinearSolverType::ConjugateGradient)
+    state.counters["cg_it/step"] = double(linear) / steps;
   state.counters["assembly%"] = 100 * timings.assembly / seconds;
   state.counters["factor%"] = 100 * timings.factorization / seconds;
   state.counters["solve%"] = 100 * timings.solve / seconds;
@@ -78,13 +86,14 @@ void step_benchmark(benchmark::State& state, material::ElasticModelType type, si
 void register_all() {
   using T = material::ElasticModelType;
   using S = sim::LinearSolverType;
-  for (T type : {T::Corotated, T::StVK, T::NeoHookean})
-    for (S solver : {S::Cholmod, S::ConjugateGradient}) {
+  for (T type : { T::Corotated, T::StVK, T::NeoHookean })
+    for (S solver : { S::Cholmod, S::ConjugateGradient }) {
       const std::string name = material::to_string(type) + "/" + sim::to_string(solver);
       auto* b = benchmark::RegisterBenchmark(name.c_str(), step_benchmark, type, solver);
-      b->ArgNames({"size", "threads"})->Unit(benchmark::kMillisecond)->UseRealTime();
+      b->ArgNames({ "size", "threads" })->Unit(benchmark::kMillisecond)->UseRealTime();
       for (int size = 0; size < 3; ++size)
-        for (int threads : {1, 2}) b->Args({size, threads});
+        for (int threads : { 1, 2 })
+          b->Args({ size, threads });
       b->Iterations(10);
     }
 }
@@ -95,7 +104,8 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--no-jacobian-reuse") {
       g_jacobian_reuse = false;
-      for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
+      for (int j = i; j + 1 < argc; ++j)
+        argv[j] = argv[j + 1];
       --argc;
       break;
     }

@@ -5,7 +5,8 @@
 // nominal / fitted / learned with the truth on a different, larger test motion.
 // err_L = max vertex position error over the test trajectory, % of the rest bounding-box diagonal.
 //
-//   bench_learning [--quick] [--data DIR] [--modes R --kernels M ...] [CASE ...]   (no case = all; --help)
+//   bench_learning [--quick] [--data DIR] [--modes R --kernels M ...] [CASE ...]   (no case = all;
+//   --help)
 //
 // A plain program with a table printout (not Google Benchmark): each case runs once and takes
 // seconds to minutes. Set-up and measured numbers: docs/benchmarks_learning.md.
@@ -24,17 +25,20 @@ using namespace elastolearn;
 using namespace bench_learning;
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 struct Row {
   std::string name;
-  int tets = 0, frames = 0, observed = 0, modes = 0, iterations = 0, kernels = 0, best_iteration = -1;
+  int tets = 0, frames = 0, observed = 0, modes = 0, iterations = 0, kernels = 0,
+      best_iteration = -1;
   double visible = 1;
   double train_deformation = 0, test_deformation = 0; ///< max displacement, % of diagonal
   double forward = 0, constrained = 0, space_time = 0, reconstruction = 0, pod = 0, learn_total = 0;
   double fit_seconds = 0;
   double err_nominal = -1, err_fit = -1, err_learned = -1; ///< test err_L [%] (−1: diverged)
-  double train_nominal = -1, train_learned = -1;          ///< training err_L at the observed vertices [%]
+  double train_nominal = -1, train_learned = -1; ///< training err_L at the observed vertices [%]
   double target = 0;
   std::string fitted;
 };
@@ -49,14 +53,16 @@ double deformation(const std::vector<VecX>& frames, const mesh::TetMesh& mesh) {
   const VecX rest = flatten(mesh.rest_positions());
   double worst = 0;
   for (const auto& x : frames)
-    for (Eigen::Index v = 0; v < x.size() / 3; ++v) worst = std::max(worst, (x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
+    for (Eigen::Index v = 0; v < x.size() / 3; ++v)
+      worst = std::max(worst, (x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
   return 100 * worst / mesh.bounding_box_diagonal();
 }
 
 /// Forward simulation of a scene; throws if it does not complete (the truth must).
 std::vector<VecX> simulate_or_throw(const sim::Scene& scene, const std::string& what) {
   auto run = learn::simulate_positions(scene);
-  if (!run.completed) throw InputError(what, "simulation failed: " + run.message);
+  if (!run.completed)
+    throw InputError(what, "simulation failed: " + run.message);
   return std::move(run.positions);
 }
 
@@ -67,40 +73,67 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
     std::fprintf(stderr, "   (diverged: %s)\n", run.message.c_str());
     return -1;
   }
-  return learn::as_percent_of(learn::position_error(run.positions, truth), scene.mesh.bounding_box_diagonal()).max;
+  return learn::as_percent_of(
+      learn::position_error(run.positions, truth), scene.mesh.bounding_box_diagonal())
+      .max;
 }
 
-bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and the nominal test, then stop (for tuning scenes)
-bool g_no_fit = false;     ///< --no-fit: skip the parameter-fit baseline (for tuning the learning)
+bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and the nominal test,
+                           ///< then stop (for tuning scenes)
+bool g_no_fit = false; ///< --no-fit: skip the parameter-fit baseline (for tuning the learning)
 /// Overrides of the learning options for every case (−1: keep the case's).
-int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_halvings = -1, g_forward_fit = -1;
+int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_halvings = -1,
+    g_forward_fit = -1;
 long g_seed = -1;
-double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1, g_kernel_smoothing = -1,
-       g_full_space_weight = -1, g_damping_prior = -1, g_elastic_prior = -1;
-bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false, g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false;
+double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1,
+       g_kernel_smoothing = -1, g_full_space_weight = -1, g_damping_prior = -1,
+       g_elastic_prior = -1;
+bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
+     g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false;
 
 void apply_overrides(learn::LearningOptions& o) {
-  if (g_modes > 0) o.pod.max_modes = g_modes;
-  if (g_kernels > 0) o.centres = g_kernels;
-  if (g_iterations >= 0) o.max_iterations = g_iterations;
-  if (g_patience > 0) o.patience = g_patience;
-  if (g_free_halvings >= 0) o.free_halvings = g_free_halvings;
-  if (g_forward_fit >= 0) o.forward_fit.max_iterations = g_forward_fit;
-  if (g_damping_prior >= 0) o.forward_fit.damping_prior = g_damping_prior;
-  if (g_elastic_prior >= 0) o.forward_fit.elastic_prior = g_elastic_prior;
-  if (g_seed >= 0) o.seed = static_cast<std::uint64_t>(g_seed);
-  if (g_regularization >= 0) o.rbf.regularization = g_regularization;
-  if (g_kernel_smoothing >= 0) o.rbf.epsilon = g_kernel_smoothing;
-  if (g_damping_regularization >= 0) o.rbf.damping_regularization = g_damping_regularization;
-  if (g_linear_tail) o.rbf.quadratic_tail = false;
-  if (g_neo_hookean_tail) o.rbf.neo_hookean_tail = true;
-  if (g_damping_quadratic) o.rbf.damping_quadratic_tail = true;
-  if (g_full_space) o.full_space = true;
-  if (g_pod_forward_only) o.pod_with_constrained = false;
-  if (g_no_damping) o.rbf.fit_damping = false;
-  if (g_position_weight > 0) o.space_time.position_weight = g_position_weight;
-  if (g_unprojected) o.projected_reconstruction = false;
-  if (g_full_space_weight >= 0) o.reconstruction.full_space_weight = g_full_space_weight;
+  if (g_modes > 0)
+    o.pod.max_modes = g_modes;
+  if (g_kernels > 0)
+    o.centres = g_kernels;
+  if (g_iterations >= 0)
+    o.max_iterations = g_iterations;
+  if (g_patience > 0)
+    o.patience = g_patience;
+  if (g_free_halvings >= 0)
+    o.free_halvings = g_free_halvings;
+  if (g_forward_fit >= 0)
+    o.forward_fit.max_iterations = g_forward_fit;
+  if (g_damping_prior >= 0)
+    o.forward_fit.damping_prior = g_damping_prior;
+  if (g_elastic_prior >= 0)
+    o.forward_fit.elastic_prior = g_elastic_prior;
+  if (g_seed >= 0)
+    o.seed = static_cast<std::uint64_t>(g_seed);
+  if (g_regularization >= 0)
+    o.rbf.regularization = g_regularization;
+  if (g_kernel_smoothing >= 0)
+    o.rbf.epsilon = g_kernel_smoothing;
+  if (g_damping_regularization >= 0)
+    o.rbf.damping_regularization = g_damping_regularization;
+  if (g_linear_tail)
+    o.rbf.quadratic_tail = false;
+  if (g_neo_hookean_tail)
+    o.rbf.neo_hookean_tail = true;
+  if (g_damping_quadratic)
+    o.rbf.damping_quadratic_tail = true;
+  if (g_full_space)
+    o.full_space = true;
+  if (g_pod_forward_only)
+    o.pod_with_constrained = false;
+  if (g_no_damping)
+    o.rbf.fit_damping = false;
+  if (g_position_weight > 0)
+    o.space_time.position_weight = g_position_weight;
+  if (g_unprojected)
+    o.projected_reconstruction = false;
+  if (g_full_space_weight >= 0)
+    o.reconstruction.full_space_weight = g_full_space_weight;
 }
 
 Row run_case(const LearningCase& c) {
@@ -111,30 +144,35 @@ Row run_case(const LearningCase& c) {
   row.visible = c.visible_fraction;
   row.target = c.target_err_l;
   const double size = c.train.mesh.bounding_box_diagonal();
-  std::printf("\n== %s: %s\n   truth: %s\n   nominal: %s\n   %s\n   dt %g s, %d frames, %zu fixed vertices, %d vertices\n",
-              c.name.c_str(), c.mesh_label.c_str(), c.truth_label.c_str(), c.nominal_label.c_str(),
-              c.motion_label.c_str(), c.train.dt, c.train.frames, c.train.fixed_vertices.size(),
-              c.train.mesh.num_vertices());
+  std::printf("\n== %s: %s\n   truth: %s\n   nominal: %s\n   %s\n   dt %g s, %d frames, %zu fixed "
+              "vertices, %d vertices\n",
+      c.name.c_str(), c.mesh_label.c_str(), c.truth_label.c_str(), c.nominal_label.c_str(),
+      c.motion_label.c_str(), c.train.dt, c.train.frames, c.train.fixed_vertices.size(),
+      c.train.mesh.num_vertices());
   std::fflush(stdout);
 
   auto t0 = Clock::now();
-  const auto truth_train = simulate_or_throw(with_material(c.train, c.truth), c.name + " truth (train)");
-  const auto truth_test = simulate_or_throw(with_material(c.test, c.truth), c.name + " truth (test)");
+  const auto truth_train
+      = simulate_or_throw(with_material(c.train, c.truth), c.name + " truth (train)");
+  const auto truth_test
+      = simulate_or_throw(with_material(c.test, c.truth), c.name + " truth (test)");
   row.train_deformation = deformation(truth_train, c.train.mesh);
   row.test_deformation = deformation(truth_test, c.test.mesh);
   std::vector<Positions> frames;
-  for (const auto& x : truth_train) frames.emplace_back(unflatten(x));
+  for (const auto& x : truth_train)
+    frames.emplace_back(unflatten(x));
   const auto ids = observe::select_visible_vertices(c.train.mesh, c.visible_fraction, 1);
   const auto observed = observe::observe_vertices(frames, c.train.dt, ids, 0.0, 1);
   row.observed = observed.num_observed();
-  std::printf("   truth simulated in %.1f s: max displacement train %.1f %%, test %.1f %% of the diagonal (%.3f m); "
+  std::printf("   truth simulated in %.1f s: max displacement train %.1f %%, test %.1f %% of the "
+              "diagonal (%.3f m); "
               "observing %d of %zu surface vertices\n",
-              seconds_since(t0), row.train_deformation, row.test_deformation, size, row.observed,
-              c.train.mesh.surface_vertices().size());
+      seconds_since(t0), row.train_deformation, row.test_deformation, size, row.observed,
+      c.train.mesh.surface_vertices().size());
   // How far the test leaves the training's stretches (what the correction must extrapolate).
   std::printf("   truth stretches: train %s; test %s\n",
-              learn::describe(learn::trajectory_stretch_range(c.train.mesh, truth_train)).c_str(),
-              learn::describe(learn::trajectory_stretch_range(c.test.mesh, truth_test)).c_str());
+      learn::describe(learn::trajectory_stretch_range(c.train.mesh, truth_train)).c_str(),
+      learn::describe(learn::trajectory_stretch_range(c.test.mesh, truth_test)).c_str());
   std::fflush(stdout);
   if (g_truth_only) {
     // Scene tuning: how wrong the nominal model is on the test motion (what learning must fix).
@@ -149,22 +187,26 @@ Row run_case(const LearningCase& c) {
   learn::LearningCallbacks callbacks;
   callbacks.iteration = [&](const learn::IterationRecord& r) {
     if (r.forward_completed)
-      std::printf("   iteration %d: forward rms %.4f %%, max %.4f %%", r.iteration, 100 * r.forward_error.rms / size,
-                  100 * r.forward_error.max / size);
+      std::printf("   iteration %d: forward rms %.4f %%, max %.4f %%", r.iteration,
+          100 * r.forward_error.rms / size, 100 * r.forward_error.max / size);
     else
       std::printf("   iteration %d:", r.iteration);
     if (r.forward_fit)
       std::printf(" (forward fit: %s, %d kernels, %.1f s)\n",
-                  !r.forward_completed ? "trial DIVERGED, rejected" : r.forward_fit_accepted ? "accepted" : "rejected",
-                  r.centres, r.seconds_forward);
+          !r.forward_completed         ? "trial DIVERGED, rejected"
+              : r.forward_fit_accepted ? "accepted"
+                                       : "rejected",
+          r.centres, r.seconds_forward);
     else if (r.modes > 0)
-      std::printf("; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N; "
-                  "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
-                  r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target, r.seconds_forward,
-                  r.seconds_constrained, r.seconds_space_time, r.space_time_iterations, r.seconds_reconstruction);
+      std::printf(
+          "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N; "
+          "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
+          r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target,
+          r.seconds_forward, r.seconds_constrained, r.seconds_space_time, r.space_time_iterations,
+          r.seconds_reconstruction);
     else if (!r.forward_completed)
-      std::printf(" -> this correction's forward simulation DIVERGED (%.1f s); %s\n", r.seconds_forward,
-                  r.damped_update ? "trying half its step" : "the loop stops");
+      std::printf(" -> this correction's forward simulation DIVERGED (%.1f s); %s\n",
+          r.seconds_forward, r.damped_update ? "trying half its step" : "the loop stops");
     else
       std::printf(" (final forward check, %.1f s)\n", r.seconds_forward);
     std::fflush(stdout);
@@ -178,16 +220,19 @@ Row run_case(const LearningCase& c) {
     row.constrained += r.seconds_constrained;
     row.space_time += r.seconds_space_time;
     row.reconstruction += r.seconds_reconstruction;
-    if (r.modes > 0) ++row.iterations;
+    if (r.modes > 0)
+      ++row.iterations;
     row.modes = std::max(row.modes, r.modes);
     row.kernels = std::max(row.kernels, r.centres);
   }
   row.best_iteration = state.best_iteration;
-  if (!state.history.empty()) row.train_nominal = 100 * state.history.front().forward_error.max / size;
+  if (!state.history.empty())
+    row.train_nominal = 100 * state.history.front().forward_error.max / size;
   for (const auto& r : state.history)
-    if (r.iteration == state.best_iteration) row.train_learned = 100 * r.forward_error.max / size;
-  std::printf("   learned in %.1f s (%d corrections, best: iteration %d)\n", row.learn_total, row.iterations,
-              state.best_iteration);
+    if (r.iteration == state.best_iteration)
+      row.train_learned = 100 * r.forward_error.max / size;
+  std::printf("   learned in %.1f s (%d corrections, best: iteration %d)\n", row.learn_total,
+      row.iterations, state.best_iteration);
   std::fflush(stdout);
 
   // Parameter-fit baseline on the same observations (all parameters nominal with --no-fit).
@@ -198,12 +243,13 @@ Row run_case(const LearningCase& c) {
     fit = learn::fit_parameters(c.train, c.nominal_type, c.nominal, observed, c.fit);
     row.fit_seconds = seconds_since(t0);
     char fitted[256];
-    std::snprintf(fitted, sizeof fitted, "E %.3g, ν %.3f, α₀ %.3g, α₁ %.3g", fit.fitted.young, fit.fitted.poisson,
-                  fit.fitted.alpha0, fit.fitted.alpha1);
+    std::snprintf(fitted, sizeof fitted, "E %.3g, ν %.3f, α₀ %.3g, α₁ %.3g", fit.fitted.young,
+        fit.fitted.poisson, fit.fitted.alpha0, fit.fitted.alpha1);
     row.fitted = fitted;
-    std::printf("   parameter fit in %.1f s (%d iterations, %d simulations, %s): %s; observation rms %.3f %% -> %.3f %%\n",
-                row.fit_seconds, fit.iterations, fit.simulations, learn::to_string(fit.stop).c_str(), fitted,
-                100 * fit.initial_rms / size, 100 * fit.final_rms / size);
+    std::printf("   parameter fit in %.1f s (%d iterations, %d simulations, %s): %s; observation "
+                "rms %.3f %% -> %.3f %%\n",
+        row.fit_seconds, fit.iterations, fit.simulations, learn::to_string(fit.stop).c_str(),
+        fitted, 100 * fit.initial_rms / size, 100 * fit.final_rms / size);
     std::fflush(stdout);
   }
 
@@ -212,45 +258,59 @@ Row run_case(const LearningCase& c) {
   row.err_nominal = err_l(c.test, truth_test);
   row.err_fit = err_l(learn::scene_with_parameters(c.test, c.nominal_type, fit.fitted), truth_test);
   row.err_learned = err_l(learn::with_correction(c.test, state.best), truth_test);
-  std::printf("   test err_L: nominal %.3f %%, parameter fit %.3f %%, learned %.3f %% (target ≤ %.1f %%; %.1f s)\n",
-              row.err_nominal, row.err_fit, row.err_learned, row.target, seconds_since(t0));
+  std::printf("   test err_L: nominal %.3f %%, parameter fit %.3f %%, learned %.3f %% (target ≤ "
+              "%.1f %%; %.1f s)\n",
+      row.err_nominal, row.err_fit, row.err_learned, row.target, seconds_since(t0));
   std::fflush(stdout);
   return row;
 }
 
-const std::vector<std::string> kCases = {"turtle",        "dragon",       "sphere-tension", "sphere-compression",
-                                         "bar-damping1",  "bar-damping2", "sparse-13",      "sparse-6"};
+const std::vector<std::string> kCases = { "turtle", "dragon", "sphere-tension",
+  "sphere-compression", "bar-damping1", "bar-damping2", "sparse-13", "sparse-6" };
 
 LearningCase make_case(const std::string& name, const fs::path& data, bool quick) {
-  if (name == "turtle") return turtle(data, quick, 1.0);
-  if (name == "sparse-13") return turtle(data, quick, 0.13);
-  if (name == "sparse-6") return turtle(data, quick, 0.06);
-  if (name == "dragon") return dragon(data, quick);
-  if (name == "sphere-tension") return sphere(false, quick);
-  if (name == "sphere-compression") return sphere(true, quick);
-  if (name == "bar-damping1") return bar_damping(1, quick);
-  if (name == "bar-damping2") return bar_damping(2, quick);
+  if (name == "turtle")
+    return turtle(data, quick, 1.0);
+  if (name == "sparse-13")
+    return turtle(data, quick, 0.13);
+  if (name == "sparse-6")
+    return turtle(data, quick, 0.06);
+  if (name == "dragon")
+    return dragon(data, quick);
+  if (name == "sphere-tension")
+    return sphere(false, quick);
+  if (name == "sphere-compression")
+    return sphere(true, quick);
+  if (name == "bar-damping1")
+    return bar_damping(1, quick);
+  if (name == "bar-damping2")
+    return bar_damping(2, quick);
   throw InputError("case", "unknown case '" + name + "'");
 }
 
 std::string err(double e) {
   char buf[32];
-  if (e < 0) return "diverged";
+  if (e < 0)
+    return "diverged";
   std::snprintf(buf, sizeof buf, "%.3f", e);
   return buf;
 }
 
 void print_table(const std::vector<Row>& rows) {
-  std::printf("\n| case | tets | frames | observed | modes | iter | kernels | forward s | constrained s | space-time s | "
-              "reconstr. s | learn total s | fit s | deform. train/test %% | err_L nominal %% | err_L fit %% | "
-              "err_L learned %% | target %% |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("\n| case | tets | frames | observed | modes | iter | kernels | forward s | "
+              "constrained s | space-time s | "
+              "reconstr. s | learn total s | fit s | deform. train/test %% | err_L nominal %% | "
+              "err_L fit %% | "
+              "err_L learned %% | target %% "
+              "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& r : rows)
-    std::printf("| %s | %d | %d | %d (%.0f %%) | %d | %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f / %.1f | "
+    std::printf("| %s | %d | %d | %d (%.0f %%) | %d | %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | "
+                "%.1f | %.1f / %.1f | "
                 "%s | %s | %s | ≤ %.1f |\n",
-                r.name.c_str(), r.tets, r.frames, r.observed, 100 * r.visible, r.modes, r.iterations, r.kernels,
-                r.forward, r.constrained, r.space_time, r.reconstruction, r.learn_total, r.fit_seconds,
-                r.train_deformation, r.test_deformation, err(r.err_nominal).c_str(), err(r.err_fit).c_str(),
-                err(r.err_learned).c_str(), r.target);
+        r.name.c_str(), r.tets, r.frames, r.observed, 100 * r.visible, r.modes, r.iterations,
+        r.kernels, r.forward, r.constrained, r.space_time, r.reconstruction, r.learn_total,
+        r.fit_seconds, r.train_deformation, r.test_deformation, err(r.err_nominal).c_str(),
+        err(r.err_fit).c_str(), err(r.err_learned).c_str(), r.target);
 }
 
 } // namespace
@@ -261,52 +321,90 @@ int main(int argc, char** argv) {
   std::vector<std::string> names;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--quick") quick = true;
-    else if (a == "--truth-only") g_truth_only = true;
-    else if (a == "--no-fit") g_no_fit = true;
-    else if (a == "--modes" && i + 1 < argc) g_modes = std::stoi(argv[++i]);
-    else if (a == "--kernels" && i + 1 < argc) g_kernels = std::stoi(argv[++i]);
-    else if (a == "--iterations" && i + 1 < argc) g_iterations = std::stoi(argv[++i]);
-    else if (a == "--patience" && i + 1 < argc) g_patience = std::stoi(argv[++i]);
-    else if (a == "--free-halvings" && i + 1 < argc) g_free_halvings = std::stoi(argv[++i]);
-    else if (a == "--forward-fit" && i + 1 < argc) g_forward_fit = std::stoi(argv[++i]);
-    else if (a == "--damping-prior" && i + 1 < argc) g_damping_prior = std::stod(argv[++i]);
-    else if (a == "--elastic-prior" && i + 1 < argc) g_elastic_prior = std::stod(argv[++i]);
-    else if (a == "--seed" && i + 1 < argc) g_seed = std::stol(argv[++i]);
-    else if (a == "--regularization" && i + 1 < argc) g_regularization = std::stod(argv[++i]);
-    else if (a == "--kernel-smoothing" && i + 1 < argc) g_kernel_smoothing = std::stod(argv[++i]);
-    else if (a == "--damping-regularization" && i + 1 < argc) g_damping_regularization = std::stod(argv[++i]);
-    else if (a == "--linear-tail") g_linear_tail = true;
-    else if (a == "--neo-hookean-tail") g_neo_hookean_tail = true;
-    else if (a == "--damping-quadratic-tail") g_damping_quadratic = true;
-    else if (a == "--full-space") g_full_space = true;
-    else if (a == "--pod-forward-only") g_pod_forward_only = true;
-    else if (a == "--no-damping") g_no_damping = true;
-    else if (a == "--position-weight" && i + 1 < argc) g_position_weight = std::stod(argv[++i]);
-    else if (a == "--unprojected-reconstruction") g_unprojected = true;
-    else if (a == "--full-space-weight" && i + 1 < argc) g_full_space_weight = std::stod(argv[++i]);
-    else if (a == "--data" && i + 1 < argc) data = argv[++i];
+    if (a == "--quick")
+      quick = true;
+    else if (a == "--truth-only")
+      g_truth_only = true;
+    else if (a == "--no-fit")
+      g_no_fit = true;
+    else if (a == "--modes" && i + 1 < argc)
+      g_modes = std::stoi(argv[++i]);
+    else if (a == "--kernels" && i + 1 < argc)
+      g_kernels = std::stoi(argv[++i]);
+    else if (a == "--iterations" && i + 1 < argc)
+      g_iterations = std::stoi(argv[++i]);
+    else if (a == "--patience" && i + 1 < argc)
+      g_patience = std::stoi(argv[++i]);
+    else if (a == "--free-halvings" && i + 1 < argc)
+      g_free_halvings = std::stoi(argv[++i]);
+    else if (a == "--forward-fit" && i + 1 < argc)
+      g_forward_fit = std::stoi(argv[++i]);
+    else if (a == "--damping-prior" && i + 1 < argc)
+      g_damping_prior = std::stod(argv[++i]);
+    else if (a == "--elastic-prior" && i + 1 < argc)
+      g_elastic_prior = std::stod(argv[++i]);
+    else if (a == "--seed" && i + 1 < argc)
+      g_seed = std::stol(argv[++i]);
+    else if (a == "--regularization" && i + 1 < argc)
+      g_regularization = std::stod(argv[++i]);
+    else if (a == "--kernel-smoothing" && i + 1 < argc)
+      g_kernel_smoothing = std::stod(argv[++i]);
+    else if (a == "--damping-regularization" && i + 1 < argc)
+      g_damping_regularization = std::stod(argv[++i]);
+    else if (a == "--linear-tail")
+      g_linear_tail = true;
+    else if (a == "--neo-hookean-tail")
+      g_neo_hookean_tail = true;
+    else if (a == "--damping-quadratic-tail")
+      g_damping_quadratic = true;
+    else if (a == "--full-space")
+      g_full_space = true;
+    else if (a == "--pod-forward-only")
+      g_pod_forward_only = true;
+    else if (a == "--no-damping")
+      g_no_damping = true;
+    else if (a == "--position-weight" && i + 1 < argc)
+      g_position_weight = std::stod(argv[++i]);
+    else if (a == "--unprojected-reconstruction")
+      g_unprojected = true;
+    else if (a == "--full-space-weight" && i + 1 < argc)
+      g_full_space_weight = std::stod(argv[++i]);
+    else if (a == "--data" && i + 1 < argc)
+      data = argv[++i];
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] [--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] [--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] [--linear-tail] [--neo-hookean-tail] [--damping-quadratic-tail] [--full-space] [--pod-forward-only] [--no-damping] [--position-weight W] [--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
-      for (const auto& n : kCases) std::printf(" %s", n.c_str());
-      std::printf(" (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
-                  "data/meshes are (extracted there if missing)\n");
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes "
+                  "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
+                  "[--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] "
+                  "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
+                  "[--linear-tail] [--neo-hookean-tail] [--damping-quadratic-tail] [--full-space] "
+                  "[--pod-forward-only] [--no-damping] [--position-weight W] "
+                  "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
+      for (const auto& n : kCases)
+        std::printf(" %s", n.c_str());
+      std::printf(
+          " (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
+          "data/meshes are (extracted there if missing)\n");
       return 0;
-    } else if (a == "all") names.insert(names.end(), kCases.begin(), kCases.end());
-    else if (a == "sparse-views") names.insert(names.end(), {"turtle", "sparse-13", "sparse-6"});
-    else names.push_back(a);
+    } else if (a == "all")
+      names.insert(names.end(), kCases.begin(), kCases.end());
+    else if (a == "sparse-views")
+      names.insert(names.end(), { "turtle", "sparse-13", "sparse-6" });
+    else
+      names.push_back(a);
   }
-  if (names.empty()) names = kCases;
-  std::printf("bench_learning%s: %zu case(s), %u hardware threads\n", quick ? " --quick" : "", names.size(),
-              std::thread::hardware_concurrency());
+  if (names.empty())
+    names = kCases;
+  std::printf("bench_learning%s: %zu case(s), %u hardware threads\n", quick ? " --quick" : "",
+      names.size(), std::thread::hardware_concurrency());
   std::vector<Row> rows;
   int status = 0;
   for (const auto& name : names) {
     try {
       LearningCase c = make_case(name, data, quick);
       apply_overrides(c.options);
-      std::printf("\n%s: learning with ≤ %d modes, %d kernels, ≤ %d iterations, patience %d\n", name.c_str(),
-                  c.options.pod.max_modes, c.options.centres, c.options.max_iterations, c.options.patience);
+      std::printf("\n%s: learning with ≤ %d modes, %d kernels, ≤ %d iterations, patience %d\n",
+          name.c_str(), c.options.pod.max_modes, c.options.centres, c.options.max_iterations,
+          c.options.patience);
       rows.push_back(run_case(c));
       print_table(rows);
     } catch (const std::exception& e) {

@@ -30,8 +30,8 @@ Mat3 random_rotation(std::mt19937& rng) {
   return q.normalized().toRotationMatrix();
 }
 
-/// 1024 deformation gradients: 60% F = R (I + 0.1·noise) (a simulator's typical element), 15% larger
-/// random stretches in [0.5, 2], 10% near-repeated, 10% compressed, 5% inverted.
+/// 1024 deformation gradients: 60% F = R (I + 0.1·noise) (a simulator's typical element), 15%
+/// larger random stretches in [0.5, 2], 10% near-repeated, 10% compressed, 5% inverted.
 const std::vector<Mat3>& states() {
   static const std::vector<Mat3> out = [] {
     std::mt19937 rng(1234);
@@ -43,7 +43,8 @@ const std::vector<Mat3>& states() {
       Mat3 F;
       if (kind < 12) {
         Mat3 noise;
-        for (int i = 0; i < 9; ++i) noise.data()[i] = 0.1 * u(rng);
+        for (int i = 0; i < 9; ++i)
+          noise.data()[i] = 0.1 * u(rng);
         F = R1 * (Mat3::Identity() + noise);
       } else if (kind < 15) {
         F = R1 * Vec3(s(rng), s(rng), s(rng)).asDiagonal() * R2.transpose();
@@ -51,8 +52,8 @@ const std::vector<Mat3>& states() {
         const double a = s(rng);
         F = R1 * Vec3(a, a * (1 + 1e-9 * u(rng)), s(rng)).asDiagonal() * R2.transpose();
       } else if (kind < 19) {
-        F = R1 * Vec3(0.8 + 0.05 * u(rng), 0.7 + 0.05 * u(rng), 0.6 + 0.05 * u(rng)).asDiagonal() *
-            R2.transpose();
+        F = R1 * Vec3(0.8 + 0.05 * u(rng), 0.7 + 0.05 * u(rng), 0.6 + 0.05 * u(rng)).asDiagonal()
+            * R2.transpose();
       } else {
         F = R1 * Vec3(1.1, 0.9, -0.3 * (1 + 0.5 * u(rng))).asDiagonal() * R2.transpose();
       }
@@ -79,8 +80,9 @@ const std::vector<Prepared>& prepared() {
     std::vector<Prepared> v;
     for (const Mat3& F : states()) {
       const auto frame = material::principal_frame(F);
-      v.push_back({frame, material::corrected_principal_stress(corotated(), nullptr,
-                                                               frame.stretches, Vec3::Zero())});
+      v.push_back({ frame,
+          material::corrected_principal_stress(
+              corotated(), nullptr, frame.stretches, Vec3::Zero()) });
     }
     return v;
   }();
@@ -147,8 +149,8 @@ void BM_FirstPiolaDerivative(benchmark::State& state) {
   const auto& in = prepared();
   int k = 0;
   for (auto _ : state) {
-    Mat9 H = material::first_piola_derivative(in[k].frame, in[k].stress.stress,
-                                              in[k].stress.d_stretches, project);
+    Mat9 H = material::first_piola_derivative(
+        in[k].frame, in[k].stress.stress, in[k].stress.d_stretches, project);
     benchmark::DoNotOptimize(H);
     k = (k + 1) & (kStates - 1);
   }
@@ -162,8 +164,8 @@ void BM_SvdStressTangent(benchmark::State& state) {
   int k = 0;
   for (auto _ : state) {
     const auto frame = material::principal_frame(F[k]);
-    const auto stress =
-        material::corrected_principal_stress(model, nullptr, frame.stretches, Vec3::Zero());
+    const auto stress
+        = material::corrected_principal_stress(model, nullptr, frame.stretches, Vec3::Zero());
     Mat3 P = material::first_piola(frame, stress.stress);
     Mat9 H = material::first_piola_derivative(frame, stress.stress, stress.d_stretches, true);
     benchmark::DoNotOptimize(P);
@@ -188,8 +190,8 @@ void BM_ElementMatrixFromTangent(benchmark::State& state) {
   const fem::TetRestData rest = unit_tet_rest();
   int k = 0;
   for (auto _ : state) {
-    const Mat9 H = material::first_piola_derivative(in[k].frame, in[k].stress.stress,
-                                                    in[k].stress.d_stretches, true);
+    const Mat9 H = material::first_piola_derivative(
+        in[k].frame, in[k].stress.stress, in[k].stress.d_stretches, true);
     benchmark::DoNotOptimize(H);
     Mat12 K = fem::element_matrix_from_tangent(H, rest, true);
     benchmark::DoNotOptimize(K);
@@ -205,8 +207,8 @@ void BM_ElementStiffness(benchmark::State& state) {
   const fem::TetRestData rest = unit_tet_rest();
   int k = 0;
   for (auto _ : state) {
-    const auto tangent =
-        material::principal_tangent(in[k].frame, in[k].stress.stress, in[k].stress.d_stretches, true);
+    const auto tangent = material::principal_tangent(
+        in[k].frame, in[k].stress.stress, in[k].stress.d_stretches, true);
     Mat12 K = fem::element_stiffness(in[k].frame, tangent, rest);
     benchmark::DoNotOptimize(K);
     k = (k + 1) & (kStates - 1);
@@ -215,7 +217,8 @@ void BM_ElementStiffness(benchmark::State& state) {
 BENCHMARK(BM_ElementStiffness);
 
 /// The whole per-element Newton-iteration kernel of fem/elastic_force.cpp (no correction, no
-/// damping): F from the vertex positions, cold SVD, stress, P, force, projected tangent, 12×12 matrix.
+/// damping): F from the vertex positions, cold SVD, stress, P, force, projected tangent, 12×12
+/// matrix.
 void BM_Element(benchmark::State& state) {
   const auto& F = states();
   const auto& model = corotated();
@@ -224,15 +227,17 @@ void BM_Element(benchmark::State& state) {
   std::vector<Eigen::Matrix<double, 3, 4>> x(kStates);
   Eigen::Matrix<double, 3, 4> X;
   X << 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1;
-  for (int k = 0; k < kStates; ++k) x[k] = F[k] * X;
+  for (int k = 0; k < kStates; ++k)
+    x[k] = F[k] * X;
   int k = 0;
   for (auto _ : state) {
     const auto frame = material::principal_frame(fem::deformation_gradient(x[k], rest));
-    const auto stress =
-        material::corrected_principal_stress(model, nullptr, frame.stretches, Vec3::Zero());
+    const auto stress
+        = material::corrected_principal_stress(model, nullptr, frame.stretches, Vec3::Zero());
     const Mat3 P = material::first_piola(frame, stress.stress);
     Eigen::Matrix<double, 3, 4> force = -rest.volume * P * rest.gradients;
-    const auto tangent = material::principal_tangent(frame, stress.stress, stress.d_stretches, true);
+    const auto tangent
+        = material::principal_tangent(frame, stress.stress, stress.d_stretches, true);
     Mat12 K = fem::element_stiffness(frame, tangent, rest);
     benchmark::DoNotOptimize(force);
     benchmark::DoNotOptimize(K);
@@ -267,8 +272,9 @@ void BM_RbfCorrectionWithGradient(benchmark::State& state) {
     benchmark::DoNotOptimize(ds);
     k = (k + 1) & (kStates - 1);
   }
-  state.counters["time/kernel"] = benchmark::Counter(3.0 * m * static_cast<double>(state.iterations()),
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["time/kernel"]
+      = benchmark::Counter(3.0 * m * static_cast<double>(state.iterations()),
+          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_RbfCorrectionWithGradient)->ArgName("centres")->Arg(40)->Arg(160);
 

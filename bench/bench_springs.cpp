@@ -13,7 +13,9 @@ using namespace elastolearn::springs;
 
 namespace {
 
-LearnedSpring spring_for(double k) { return learn_paper_spring(k, ExperimentOptions{}); }
+LearnedSpring spring_for(double k) {
+  return learn_paper_spring(k, ExperimentOptions {});
+}
 
 /// Run the stepper from the case's initial state; restart when the cloth has swung for 2 s so
 /// the measured steps are representative of a swinging (not resting) cloth.
@@ -30,13 +32,15 @@ void run(benchmark::State& bench, SpringStepper& stepper, const StabilityCase& t
       bench.ResumeTiming();
     }
   }
-  bench.counters["steps/s"] = benchmark::Counter(static_cast<double>(bench.iterations()), benchmark::Counter::kIsRate);
+  bench.counters["steps/s"]
+      = benchmark::Counter(static_cast<double>(bench.iterations()), benchmark::Counter::kIsRate);
   bench.counters["springs"] = test.system.spring_count();
 }
 
 void BM_Reference(benchmark::State& bench) {
   const StabilityCase test = hanging_cloth_case(static_cast<int>(bench.range(0)));
-  ReferenceSimulator sim(test.system, SpringLaw{SpringLawKind::linear, 1000.0, 1.0}, 0.01, test.loads);
+  ReferenceSimulator sim(
+      test.system, SpringLaw { SpringLawKind::linear, 1000.0, 1.0 }, 0.01, test.loads);
   run(bench, sim, test);
 }
 
@@ -59,8 +63,8 @@ void BM_LearnedImplicit(benchmark::State& bench) {
   o.mode = LearnedMode::corrected_implicit;
   o.solver = bench.range(2) == 0 ? LinearSolverKind::direct : LinearSolverKind::cg;
   o.cg_tolerance = 1e-6;
-  ImplicitLearnedSimulator sim(test.system, spring_for(std::pow(10.0, static_cast<double>(bench.range(1)))),
-                               0.01, o, test.loads);
+  ImplicitLearnedSimulator sim(test.system,
+      spring_for(std::pow(10.0, static_cast<double>(bench.range(1)))), 0.01, o, test.loads);
   long iterations = 0, steps = 0;
   SpringState s = test.initial;
   for (auto _ : bench) {
@@ -73,7 +77,8 @@ void BM_LearnedImplicit(benchmark::State& bench) {
       bench.ResumeTiming();
     }
   }
-  bench.counters["steps/s"] = benchmark::Counter(static_cast<double>(bench.iterations()), benchmark::Counter::kIsRate);
+  bench.counters["steps/s"]
+      = benchmark::Counter(static_cast<double>(bench.iterations()), benchmark::Counter::kIsRate);
   bench.counters["cg_iters"] = steps ? static_cast<double>(iterations) / steps : 0.0;
   bench.counters["springs"] = test.system.spring_count();
 }
@@ -84,11 +89,11 @@ BENCHMARK(BM_Reference)->Arg(25)->Arg(50)->Arg(100)->Unit(benchmark::kMicrosecon
 BENCHMARK(BM_LearnedExplicit)->Arg(25)->Arg(50)->Arg(100)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_LearnedPaper)->Arg(25)->Arg(50)->Arg(100)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_LearnedImplicit)
-    ->Args({25, 5, 0})
-    ->Args({25, 5, 1})
-    ->Args({100, 3, 1})
-    ->Args({100, 4, 1})
-    ->Args({100, 5, 1})
+    ->Args({ 25, 5, 0 })
+    ->Args({ 25, 5, 1 })
+    ->Args({ 100, 3, 1 })
+    ->Args({ 100, 4, 1 })
+    ->Args({ 100, 5, 1 })
     ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

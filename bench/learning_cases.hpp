@@ -29,12 +29,12 @@ namespace fs = std::filesystem;
 /// One row of the table: everything the runner needs.
 struct LearningCase {
   std::string name;
-  std::string mesh_label;   ///< e.g. "bear.off → 1187 tets"
-  std::string truth_label;  ///< ground-truth material, short
+  std::string mesh_label; ///< e.g. "bear.off → 1187 tets"
+  std::string truth_label; ///< ground-truth material, short
   std::string nominal_label;
   std::string motion_label; ///< training / test motions
-  sim::Scene train;         ///< nominal material
-  sim::Scene test;          ///< nominal material, a different and larger motion
+  sim::Scene train; ///< nominal material
+  sim::Scene test; ///< nominal material, a different and larger motion
   fem::MaterialModel truth;
   material::ElasticModelType nominal_type = material::ElasticModelType::Corotated;
   learn::NominalParameters nominal;
@@ -45,10 +45,11 @@ struct LearningCase {
   LearningCase() { fit.max_iterations = 10; } // the baseline's budget (converges in fewer here)
 };
 
-inline fem::MaterialModel make_material(material::ElasticModelType type, double young, double poisson,
-                                        double alpha0, double alpha1, double density = 1000) {
+inline fem::MaterialModel make_material(material::ElasticModelType type, double young,
+    double poisson, double alpha0, double alpha1, double density = 1000) {
   fem::MaterialModel m;
-  m.elastic = material::make_elastic_model(type, material::Lame::from_young_poisson(young, poisson));
+  m.elastic
+      = material::make_elastic_model(type, material::Lame::from_young_poisson(young, poisson));
   m.damping = std::make_shared<material::RayleighDamping>(alpha0, alpha1);
   m.density = density;
   return m;
@@ -57,25 +58,29 @@ inline fem::MaterialModel make_material(material::ElasticModelType type, double 
 /// `data/meshes/<name>` of Debian's libcgal-demo data archive, extracted (once) under `dir`.
 inline fs::path cgal_mesh(const fs::path& dir, const std::string& name) {
   const fs::path file = dir / "data" / "meshes" / name;
-  if (fs::exists(file)) return file;
+  if (fs::exists(file))
+    return file;
   const fs::path archive = "/usr/share/doc/libcgal-demo/data.tar.gz";
-  if (!fs::exists(archive)) throw InputError(archive.string(), "missing: install Debian's libcgal-demo");
+  if (!fs::exists(archive))
+    throw InputError(archive.string(), "missing: install Debian's libcgal-demo");
   fs::create_directories(dir);
-  const auto result = mesh::run_program("/usr/bin/tar", {"xzf", archive.string(), "-C", dir.string(),
-                                                         "data/meshes/" + name},
-                                        dir / "tar.log");
-  if (!result.ok() || !fs::exists(file)) throw InputError(archive.string(), "could not extract " + name + ": " + result.output);
+  const auto result = mesh::run_program("/usr/bin/tar",
+      { "xzf", archive.string(), "-C", dir.string(), "data/meshes/" + name }, dir / "tar.log");
+  if (!result.ok() || !fs::exists(file))
+    throw InputError(archive.string(), "could not extract " + name + ": " + result.output);
   return file;
 }
 
 /// A real surface, turned so that its axis `up` (0, 1, 2) becomes y (a cyclic permutation of the
 /// coordinates, which keeps the orientation), moved to stand on y = 0 centred in x, z, scaled so
 /// that its largest extent is `size` [m], and tetrahedralized to at most ~`tets` tets.
-inline mesh::TetMesh real_mesh(const fs::path& file, int up, double size, int tets, bool fill_holes, std::string& label) {
+inline mesh::TetMesh real_mesh(
+    const fs::path& file, int up, double size, int tets, bool fill_holes, std::string& label) {
   mesh::SurfaceMesh surface = mesh::read_surface_mesh(file);
   for (int k = 0; k < (up == 1 ? 0 : up == 0 ? 1 : 2); ++k) // (x, y, z) → (z, x, y): x becomes y
     for (Eigen::Index i = 0; i < surface.vertices.rows(); ++i)
-      surface.vertices.row(i) = Eigen::RowVector3d(surface.vertices(i, 2), surface.vertices(i, 0), surface.vertices(i, 1));
+      surface.vertices.row(i) = Eigen::RowVector3d(
+          surface.vertices(i, 2), surface.vertices(i, 0), surface.vertices(i, 1));
   const Vec3 lo = surface.vertices.colwise().minCoeff(), hi = surface.vertices.colwise().maxCoeff();
   const double scale = size / (hi - lo).maxCoeff();
   const Vec3 anchor(0.5 * (lo.x() + hi.x()), lo.y(), 0.5 * (lo.z() + hi.z()));
@@ -87,10 +92,11 @@ inline mesh::TetMesh real_mesh(const fs::path& file, int up, double size, int te
   mesh::TetrahedralizeReport report;
   mesh::TetMesh out = mesh::tetrahedralize(surface, options, &report, file.string());
   char quality[64];
-  std::snprintf(quality, sizeof quality, ", dihedral angles %.1f–%.1f°", out.quality().min_dihedral_deg,
-                out.quality().max_dihedral_deg);
-  label = file.filename().string() + " (" + std::to_string(surface.faces.rows()) + " triangles" +
-          (report.simplified ? ", simplified" : "") + ") → " + std::to_string(out.num_tets()) + " tets" + quality;
+  std::snprintf(quality, sizeof quality, ", dihedral angles %.1f–%.1f°",
+      out.quality().min_dihedral_deg, out.quality().max_dihedral_deg);
+  label = file.filename().string() + " (" + std::to_string(surface.faces.rows()) + " triangles"
+      + (report.simplified ? ", simplified" : "") + ") → " + std::to_string(out.num_tets())
+      + " tets" + quality;
   return out;
 }
 
@@ -100,7 +106,8 @@ inline std::vector<int> base_vertices(const mesh::TetMesh& mesh, double fraction
   return mesh::vertices_with_min_coordinate(mesh, 1, fraction * (box.max().y() - box.min().y()));
 }
 
-inline sim::Scene base_scene(mesh::TetMesh mesh, const fem::MaterialModel& nominal, double dt, int frames) {
+inline sim::Scene base_scene(
+    mesh::TetMesh mesh, const fem::MaterialModel& nominal, double dt, int frames) {
   sim::Scene s;
   s.mesh = std::move(mesh);
   s.material = nominal;
@@ -124,11 +131,13 @@ inline sim::Scene base_scene(mesh::TetMesh mesh, const fem::MaterialModel& nomin
 /// about the base), a larger deformation.
 inline LearningCase turtle(const fs::path& data, bool quick, double fraction) {
   LearningCase c;
-  c.name = fraction >= 1 ? "turtle" : "sparse-" + std::to_string(static_cast<int>(100 * fraction + 0.5));
+  c.name = fraction >= 1 ? "turtle"
+                         : "sparse-" + std::to_string(static_cast<int>(100 * fraction + 0.5));
   const double height = 0.3;
-  auto mesh = real_mesh(cgal_mesh(data, "bear.off"), 1, height, quick ? 600 : 1200, false, c.mesh_label);
+  auto mesh
+      = real_mesh(cgal_mesh(data, "bear.off"), 1, height, quick ? 600 : 1200, false, c.mesh_label);
   c.truth = make_material(material::ElasticModelType::NeoHookean, 2e4, 0.43, 0, 0);
-  c.nominal = {3.5e4, 0.43, 0, 0};
+  c.nominal = { 3.5e4, 0.43, 0, 0 };
   const auto nominal = make_material(material::ElasticModelType::Corotated, 3.5e4, 0.43, 0, 0);
   c.train = base_scene(std::move(mesh), nominal, 4e-3, 200);
   c.train.fixed_vertices = base_vertices(c.train.mesh, 0.08);
@@ -138,7 +147,8 @@ inline LearningCase turtle(const fs::path& data, bool quick, double fraction) {
   c.test.initial.center = Vec3::Zero();
   c.truth_label = "neo-Hookean E 2e4, ν 0.43";
   c.nominal_label = "corotated E 3.5e4, ν 0.43";
-  c.motion_label = "train: droop from rest under gravity; test: gravity + swing ω_z = 1 rad/s about the base";
+  c.motion_label
+      = "train: droop from rest under gravity; test: gravity + swing ω_z = 1 rad/s about the base";
   c.visible_fraction = fraction;
   c.target_err_l = fraction >= 1 ? 1.0 : (fraction < 0.1 ? 1.5 : 1.0);
   return c;
@@ -148,9 +158,10 @@ inline LearningCase turtle(const fs::path& data, bool quick, double fraction) {
 inline LearningCase dragon(const fs::path& data, bool quick) {
   LearningCase c;
   c.name = "dragon";
-  auto mesh = real_mesh(cgal_mesh(data, "ChineseDragon-10kv.off"), 0, 0.12, quick ? 1300 : 2800, true, c.mesh_label);
+  auto mesh = real_mesh(
+      cgal_mesh(data, "ChineseDragon-10kv.off"), 0, 0.12, quick ? 1300 : 2800, true, c.mesh_label);
   c.truth = make_material(material::ElasticModelType::StVK, 1e5, 0.40, 0, 0);
-  c.nominal = {1.2e5, 0.40, 0, 0};
+  c.nominal = { 1.2e5, 0.40, 0, 0 };
   const auto nominal = make_material(material::ElasticModelType::Corotated, 1.2e5, 0.40, 0, 0);
   c.train = base_scene(std::move(mesh), nominal, 3e-3, 200);
   c.train.fixed_vertices = base_vertices(c.train.mesh, 0.08);
@@ -164,7 +175,8 @@ inline LearningCase dragon(const fs::path& data, bool quick) {
   c.test.initial.angular_velocity = Vec3(3.0, 0, 3.0);
   c.truth_label = "StVK E 1e5, ν 0.40";
   c.nominal_label = "corotated E 1.2e5, ν 0.40";
-  c.motion_label = "train: droop from rest under gravity; test: gravity + swing ω = (3, 0, 3) rad/s about the base";
+  c.motion_label = "train: droop from rest under gravity; test: gravity + swing ω = (3, 0, 3) "
+                   "rad/s about the base";
   c.target_err_l = 0.2;
   // 30 POD modes instead of 20: test err_L 0.187 % instead of 0.255 % (186.8 s instead of 201 s
   // of learning at load ~2; 20 kernels 0.248 %, regularisation 1e-7 0.254 %; measured in
@@ -187,14 +199,15 @@ inline LearningCase sphere(bool compression, bool quick) {
   c.mesh_label = "ball r 1.5 m → " + std::to_string(mesh.num_tets()) + " tets";
   const auto lame = material::Lame::from_young_poisson(1e5, 0.43);
   auto spline = compression
-                    ? material::CubicSpline({0.7, 0.85, 1.0}, {0.3, 0.6, 1.0}, "compression edit")
-                    : material::CubicSpline({1.0, 1.1, 1.25}, {1.0, 1.8, 3.0}, "tension edit");
+      ? material::CubicSpline({ 0.7, 0.85, 1.0 }, { 0.3, 0.6, 1.0 }, "compression edit")
+      : material::CubicSpline({ 1.0, 1.1, 1.25 }, { 1.0, 1.8, 3.0 }, "tension edit");
   c.truth.elastic = std::make_shared<material::SplineEditedModel>(
       material::ElasticModelType::NeoHookean, lame,
-      compression ? material::SplineEditRegion::Compression : material::SplineEditRegion::Tension, spline);
+      compression ? material::SplineEditRegion::Compression : material::SplineEditRegion::Tension,
+      spline);
   c.truth.damping = std::make_shared<material::RayleighDamping>(0.0, 0.2);
   c.truth.density = 1000;
-  c.nominal = {1.2e5, 0.43, 0, 0.2};
+  c.nominal = { 1.2e5, 0.43, 0, 0.2 };
   const auto nominal = make_material(material::ElasticModelType::Corotated, 1.2e5, 0.43, 0, 0.2);
   c.train = base_scene(std::move(mesh), nominal, 5e-3, 200);
   c.train.fixed_vertices = mesh::vertices_with_min_coordinate(c.train.mesh, 1, 0.15 * radius);
@@ -204,15 +217,17 @@ inline LearningCase sphere(bool compression, bool quick) {
   c.test = c.train;
   top.amplitude = Vec3(0, 0.2 * radius, 0);
   top.frequency = 1.0;
-  c.train.keyframes = {top};
+  c.train.keyframes = { top };
   top.amplitude = Vec3(0, 0.3 * radius, 0);
   top.frequency = 1.25;
-  c.test.keyframes = {top};
-  c.truth_label = std::string("spline-edited neo-Hookean E 1e5, ν 0.43 (") +
-                  (compression ? "compression: s(0.7, 0.85, 1) = 0.3, 0.6, 1" : "tension: s(1, 1.1, 1.25) = 1, 1.8, 3") +
-                  "), α₁ 0.2";
+  c.test.keyframes = { top };
+  c.truth_label = std::string("spline-edited neo-Hookean E 1e5, ν 0.43 (")
+      + (compression ? "compression: s(0.7, 0.85, 1) = 0.3, 0.6, 1"
+                     : "tension: s(1, 1.1, 1.25) = 1, 1.8, 3")
+      + "), α₁ 0.2";
   c.nominal_label = "corotated E 1.2e5, ν 0.43, α₁ 0.2";
-  c.motion_label = "top cap keyframed y = A sin 2πft; train A 0.2 r, f 1 Hz; test A 0.3 r, f 1.25 Hz";
+  c.motion_label
+      = "top cap keyframed y = A sin 2πft; train A 0.2 r, f 1 Hz; test A 0.3 r, f 1.25 Hz";
   c.target_err_l = 2.0;
   // Learned by the forward fit alone: at 12.7k tets the space-time loop's corrections are wrong
   // near the keyframed cap's rim (its interior is held at the current model's equilibrium) and
@@ -230,7 +245,7 @@ inline LearningCase sphere(bool compression, bool quick) {
   c.options.forward_fit.damping_prior = 1.0;
   // The 12.7k-tet sphere: fit E and ν only (α₁ is right) and with fewer iterations, to keep the
   // baseline within minutes (the first 100 of the 200 frames).
-  c.fit.parameters = {learn::FitParameter::Young, learn::FitParameter::Poisson};
+  c.fit.parameters = { learn::FitParameter::Young, learn::FitParameter::Poisson };
   c.fit.max_iterations = quick ? 10 : 5;
   c.fit.frames = 100;
   return c;
@@ -243,15 +258,17 @@ inline LearningCase sphere(bool compression, bool quick) {
 inline LearningCase bar_damping(int variant, bool quick) {
   LearningCase c;
   c.name = "bar-damping" + std::to_string(variant);
-  auto mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), quick ? std::array<int, 3>{8, 2, 2} : std::array<int, 3>{16, 4, 4});
+  auto mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1),
+      quick ? std::array<int, 3> { 8, 2, 2 } : std::array<int, 3> { 16, 4, 4 });
   c.mesh_label = "box bar 0.4×0.1×0.1 m → " + std::to_string(mesh.num_tets()) + " tets";
   c.truth = make_material(material::ElasticModelType::Corotated, 4e4, 0.43, 0, 0.2);
   // The quadratics in σ₁ − 1 through (1, 0.2), (1.05, 0.3), (1.1, 0.5) and through (1, 0.2),
   // (1.03, 0.6), (1.08, 1.2) [s].
-  const auto alpha1 = variant == 1 ? material::StretchPolynomial({0.2, 1.0, 20.0})
-                                   : material::StretchPolynomial({0.2, 83.0 / 6, -50.0 / 3});
-  c.truth.damping = std::make_shared<material::StretchDependentRayleigh>(material::CubicSpline({1.0}, {0.0}), alpha1);
-  c.nominal = {4e4, 0.43, 0, 0.2};
+  const auto alpha1 = variant == 1 ? material::StretchPolynomial({ 0.2, 1.0, 20.0 })
+                                   : material::StretchPolynomial({ 0.2, 83.0 / 6, -50.0 / 3 });
+  c.truth.damping = std::make_shared<material::StretchDependentRayleigh>(
+      material::CubicSpline({ 1.0 }, { 0.0 }), alpha1);
+  c.nominal = { 4e4, 0.43, 0, 0.2 };
   const auto nominal = make_material(material::ElasticModelType::Corotated, 4e4, 0.43, 0, 0.2);
   c.train = base_scene(std::move(mesh), nominal, 5e-3, 300);
   c.train.gravity = Vec3::Zero();
@@ -259,7 +276,7 @@ inline LearningCase bar_damping(int variant, bool quick) {
   const auto tip = mesh::vertices_with_max_coordinate(c.train.mesh, 0, 1e-9);
   c.test = c.train;
   c.test.initial.kind = sim::InitialCondition::Kind::StaticLoad;
-  c.test.initial.static_loads = {{tip, Vec3(0, -2.5, 0.8)}};
+  c.test.initial.static_loads = { { tip, Vec3(0, -2.5, 0.8) } };
   // Trained from rest with a twisting and bending velocity about the bar's axis at the clamp, not
   // released from a load: released, the heavily damped bar creeps back with its velocity nearly
   // proportional to its displacement, and extra damping looks like an elastic softening; from
@@ -271,12 +288,12 @@ inline LearningCase bar_damping(int variant, bool quick) {
   c.train.initial.kind = sim::InitialCondition::Kind::Velocity;
   c.train.initial.angular_velocity = variant == 1 ? Vec3(30, 0, 0.8) : Vec3(70, 0, 0.6);
   c.train.initial.center = Vec3(0, 0.05, 0.05);
-  c.truth_label = std::string("corotated E 4e4, ν 0.43, α₁(σ₁) the quadratic in σ₁ − 1 through ") +
-                  (variant == 1 ? "(1, 0.2) (1.05, 0.3) (1.1, 0.5)" : "(1, 0.2) (1.03, 0.6) (1.08, 1.2)");
+  c.truth_label = std::string("corotated E 4e4, ν 0.43, α₁(σ₁) the quadratic in σ₁ − 1 through ")
+      + (variant == 1 ? "(1, 0.2) (1.05, 0.3) (1.1, 0.5)" : "(1, 0.2) (1.03, 0.6) (1.08, 1.2)");
   c.nominal_label = "corotated E 4e4, ν 0.43, α₁ 0.2";
-  c.motion_label = std::string("no gravity; train: from rest with ω = ") +
-                   (variant == 1 ? "(30, 0, 0.8)" : "(70, 0, 0.6)") +
-                   " rad/s about the clamp; test: released from a static tip load (0, −2.5, 0.8) N";
+  c.motion_label = std::string("no gravity; train: from rest with ω = ")
+      + (variant == 1 ? "(30, 0, 0.8)" : "(70, 0, 0.6)")
+      + " rad/s about the clamp; test: released from a static tip load (0, −2.5, 0.8) N";
   c.target_err_l = variant == 1 ? 0.1 : 0.4;
   // The truth differs from the nominal in damping only, and the user of this case knows the
   // elasticity is right: the forward fit alone, with a prior holding the elastic correction at 0

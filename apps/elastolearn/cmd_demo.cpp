@@ -25,39 +25,52 @@ using namespace elastolearn;
 namespace fs = std::filesystem;
 
 /// Simulate and write HDF5 + ParaView; returns the frames (flat) read back from the file.
-std::vector<VecX> simulate_and_save(const sim::Scene& scene, const fs::path& out, const std::string& name) {
+std::vector<VecX> simulate_and_save(
+    const sim::Scene& scene, const fs::path& out, const std::string& name) {
   fs::path pvd;
-  const auto report = io::simulate_to_files(scene, {out / (name + ".h5"), out / (name + "_vtu"), 1},
-                                            terminal_progress(name), &pvd);
-  if (!report.completed) throw InputError(name, report.message);
+  const auto report = io::simulate_to_files(
+      scene, { out / (name + ".h5"), out / (name + "_vtu"), 1 }, terminal_progress(name), &pvd);
+  if (!report.completed)
+    throw InputError(name, report.message);
   std::printf("   %-13s %s  (%s)\n", name.c_str(), (out / (name + ".h5")).c_str(), pvd.c_str());
   std::vector<VecX> frames;
-  for (const auto& p : io::read_trajectory_h5(out / (name + ".h5")).positions) frames.emplace_back(flatten(p));
+  for (const auto& p : io::read_trajectory_h5(out / (name + ".h5")).positions)
+    frames.emplace_back(flatten(p));
   return frames;
 }
 
 void run_demo(const fs::path& out, double fraction) {
   const auto start = std::chrono::steady_clock::now();
   fs::create_directories(out);
-  const auto train = io::parse_scene(nlohmann::json::parse(app::kDemoTrainScene), "built-in bar_train.json", out).scene;
-  const auto test = io::parse_scene(nlohmann::json::parse(app::kDemoTestScene), "built-in bar_test.json", out).scene;
-  const auto truth_file = io::parse_material_file(nlohmann::json::parse(app::kDemoTruthMaterial), "built-in truth.json");
+  const auto train
+      = io::parse_scene(nlohmann::json::parse(app::kDemoTrainScene), "built-in bar_train.json", out)
+            .scene;
+  const auto test
+      = io::parse_scene(nlohmann::json::parse(app::kDemoTestScene), "built-in bar_test.json", out)
+            .scene;
+  const auto truth_file = io::parse_material_file(
+      nlohmann::json::parse(app::kDemoTruthMaterial), "built-in truth.json");
   const fem::MaterialModel truth = io::material_model(truth_file, "built-in truth.json");
-  auto with_material = [](sim::Scene s, const fem::MaterialModel& m) { s.material = m; return s; };
-  std::printf("elastolearn demo: learn a bar's material from %g %% of its surface (%d tets, %d frames)\n",
-              100 * fraction, train.mesh.num_tets(), train.frames);
+  auto with_material = [](sim::Scene s, const fem::MaterialModel& m) {
+    s.material = m;
+    return s;
+  };
+  std::printf(
+      "elastolearn demo: learn a bar's material from %g %% of its surface (%d tets, %d frames)\n",
+      100 * fraction, train.mesh.num_tets(), train.frames);
   std::printf("   truth:   %s\n   nominal: %s\n", io::describe_material_model(truth).c_str(),
-              io::describe_material_model(train.material).c_str());
+      io::describe_material_model(train.material).c_str());
 
   std::printf("1. ground-truth training motion (droop under gravity)\n");
   const auto truth_frames = simulate_and_save(with_material(train, truth), out, "train_truth");
   std::vector<Positions> frames;
-  for (const auto& x : truth_frames) frames.emplace_back(unflatten(x));
+  for (const auto& x : truth_frames)
+    frames.emplace_back(unflatten(x));
   const auto ids = observe::select_visible_vertices(train.mesh, fraction, 1);
   const auto observed = observe::observe_vertices(frames, train.dt, ids, 0.0, 1);
   io::write_observation_h5(out / "observations.h5", observed);
   std::printf("2. observed %d of %zu surface vertices: %s\n", observed.num_observed(),
-              train.mesh.surface_vertices().size(), (out / "observations.h5").c_str());
+      train.mesh.surface_vertices().size(), (out / "observations.h5").c_str());
 
   std::printf("3. learning (forward error at the observed vertices, %% of the size)\n");
   const double size = train.mesh.bounding_box_diagonal();
@@ -65,11 +78,15 @@ void run_demo(const fs::path& out, double fraction) {
   learn::LearningCallbacks callbacks;
   callbacks.progress = terminal_progress("learn");
   callbacks.iteration = [&](const learn::IterationRecord& r) {
-    std::printf("   iteration %d: rms %.4f %%, max %.4f %%", r.iteration, 100 * r.forward_error.rms / size,
-                100 * r.forward_error.max / size);
-    if (r.forward_fit) std::printf("  (forward-fit step %s, %.1f s)\n", r.forward_fit_accepted ? "accepted" : "rejected", r.seconds_total());
-    else if (r.modes > 0) std::printf(", control force %.3e N, %.1f s\n", r.control_force_rms, r.seconds_total());
-    else std::printf("  (last forward check)\n");
+    std::printf("   iteration %d: rms %.4f %%, max %.4f %%", r.iteration,
+        100 * r.forward_error.rms / size, 100 * r.forward_error.max / size);
+    if (r.forward_fit)
+      std::printf("  (forward-fit step %s, %.1f s)\n",
+          r.forward_fit_accepted ? "accepted" : "rejected", r.seconds_total());
+    else if (r.modes > 0)
+      std::printf(", control force %.3e N, %.1f s\n", r.control_force_rms, r.seconds_total());
+    else
+      std::printf("  (last forward check)\n");
     std::fflush(stdout);
   };
   learn::LearningOptions options;
@@ -77,36 +94,43 @@ void run_demo(const fs::path& out, double fraction) {
   // (docs/learning_loop.md, "Forward fit"): test err_L 0.026 % → 0.005 % here, ~10 s more.
   options.forward_fit.max_iterations = 2;
   learn::run_learning(train, observed, options, state, callbacks);
-  io::MaterialFile learned{nlohmann::json::parse(app::kDemoTrainScene).at("material"), state.best,
-                           {{"demo", true}, {"best_iteration", state.best_iteration}},
-                           learn::training_stretch_range(train, state.best)};
+  io::MaterialFile learned { nlohmann::json::parse(app::kDemoTrainScene).at("material"), state.best,
+    { { "demo", true }, { "best_iteration", state.best_iteration } },
+    learn::training_stretch_range(train, state.best) };
   io::write_material_file(out / "learned.json", learned);
   std::printf("   learned material: %s\n", (out / "learned.json").c_str());
 
   std::printf("4. a different test motion (thrown upward): truth, nominal, learned\n");
   const auto test_truth = simulate_and_save(with_material(test, truth), out, "test_truth");
   const auto test_nominal = simulate_and_save(test, out, "test_nominal");
-  const auto test_learned = simulate_and_save(learn::with_correction(test, state.best), out, "test_learned");
-  const auto e_nominal = learn::as_percent_of(learn::position_error(test_nominal, test_truth), size);
-  const auto e_learned = learn::as_percent_of(learn::position_error(test_learned, test_truth), size);
+  const auto test_learned
+      = simulate_and_save(learn::with_correction(test, state.best), out, "test_learned");
+  const auto e_nominal
+      = learn::as_percent_of(learn::position_error(test_nominal, test_truth), size);
+  const auto e_learned
+      = learn::as_percent_of(learn::position_error(test_learned, test_truth), size);
   std::printf("\n   %-8s %10s %10s\n", "model", "err_L [%]", "mean [%]");
-  std::printf("   %-8s %10.3f %10.4f\n   %-8s %10.3f %10.4f\n", "nominal", e_nominal.max, e_nominal.mean, "learned",
-              e_learned.max, e_learned.mean);
+  std::printf("   %-8s %10.3f %10.4f\n   %-8s %10.3f %10.4f\n", "nominal", e_nominal.max,
+      e_nominal.mean, "learned", e_learned.max, e_learned.mean);
   if (learned.training_stretches) {
     learn::StretchCoverage coverage(test.mesh, learned.training_stretches);
-    for (const auto& x : test_learned) coverage.add_frame(x);
+    for (const auto& x : test_learned)
+      coverage.add_frame(x);
     std::fputs(learn::coverage_report(coverage, "   ").c_str(), stdout);
   }
-  std::printf("   err_L %.0fx lower with the learned correction; demo took %.0f s\n", e_nominal.max / e_learned.max,
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  std::printf("   err_L %.0fx lower with the learned correction; demo took %.0f s\n",
+      e_nominal.max / e_learned.max,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 
 void add_demo_command(CLI::App& root) {
   auto dir = std::make_shared<std::string>("elastolearn-demo");
   auto fraction = std::make_shared<double>(0.13);
-  auto* cmd = root.add_subcommand("demo", "Learn a material end to end on a built-in example and evaluate it");
+  auto* cmd = root.add_subcommand(
+      "demo", "Learn a material end to end on a built-in example and evaluate it");
   cmd->add_option("-o,--output-dir", *dir, "where to write the results")->capture_default_str();
-  cmd->add_option("--visible-fraction", *fraction, "fraction of surface vertices observed")->capture_default_str();
+  cmd->add_option("--visible-fraction", *fraction, "fraction of surface vertices observed")
+      ->capture_default_str();
   cmd->callback([dir, fraction] { run_demo(*dir, *fraction); });
 }
 

@@ -177,8 +177,8 @@ void run_evaluate(const EvaluateOptions& opts) {
   }
 
   if (!opts.json.empty()) {
-    nlohmann::json report = { { "format", "elastolearn-evaluation/1" },
-      { "scene", opts.scene }, { "material", opts.material }, { "truth", opts.truth },
+    nlohmann::json report = { { "format", "elastolearn-evaluation/1" }, { "scene", opts.scene },
+      { "material", opts.material }, { "truth", opts.truth },
       { "vertices", nominal_scene.mesh.num_vertices() }, { "tets", nominal_scene.mesh.num_tets() },
       { "frames", truth.size() }, { "dt", nominal_scene.dt }, { "size", size },
       { "nominal", run_to_json(nominal) }, { "learned", run_to_json(learned) },

@@ -1,4 +1,5 @@
-// elastolearn info FILE: a summary of a tet mesh, surface mesh, trajectory, scene or learned material.
+// elastolearn info FILE: a summary of a tet mesh, surface mesh, trajectory, scene or learned
+// material.
 #include "command.hpp"
 
 #include <elastolearn/core/error.hpp>
@@ -17,17 +18,20 @@ namespace {
 using namespace elastolearn;
 
 void print_box(const Box3& box) {
-  std::printf("  bounding box: [%g, %g, %g] .. [%g, %g, %g] (diagonal %g m)\n", box.min().x(), box.min().y(),
-              box.min().z(), box.max().x(), box.max().y(), box.max().z(), box.diagonal().norm());
+  std::printf("  bounding box: [%g, %g, %g] .. [%g, %g, %g] (diagonal %g m)\n", box.min().x(),
+      box.min().y(), box.min().z(), box.max().x(), box.max().y(), box.max().z(),
+      box.diagonal().norm());
 }
 
 void print_tet_mesh(const mesh::TetMesh& m) {
   const auto q = m.quality();
-  std::printf("  tet mesh: %d vertices, %d tets, %ld surface faces, %zu surface vertices\n", m.num_vertices(),
-              m.num_tets(), long(m.surface_faces().rows()), m.surface_vertices().size());
+  std::printf("  tet mesh: %d vertices, %d tets, %ld surface faces, %zu surface vertices\n",
+      m.num_vertices(), m.num_tets(), long(m.surface_faces().rows()), m.surface_vertices().size());
   print_box(m.bounding_box());
-  std::printf("  volume %g m^3; tet volumes %g .. %g; dihedral angles %.1f .. %.1f deg; max radius ratio %.2f\n",
-              m.total_volume(), q.min_volume, q.max_volume, q.min_dihedral_deg, q.max_dihedral_deg, q.max_radius_ratio);
+  std::printf("  volume %g m^3; tet volumes %g .. %g; dihedral angles %.1f .. %.1f deg; max radius "
+              "ratio %.2f\n",
+      m.total_volume(), q.min_volume, q.max_volume, q.min_dihedral_deg, q.max_dihedral_deg,
+      q.max_radius_ratio);
 }
 
 void info(const std::filesystem::path& path) {
@@ -35,21 +39,28 @@ void info(const std::filesystem::path& path) {
   std::printf("%s\n", path.c_str());
   if (ext == ".h5" || ext == ".hdf5") {
     const auto t = io::read_trajectory_h5(path);
-    std::printf("  trajectory: %zu frames, t = %g .. %g s, %ld vertices, %ld tets, %ld edges, %ld faces%s\n",
-                t.positions.size(), t.time.empty() ? 0.0 : t.time.front(), t.time.empty() ? 0.0 : t.time.back(),
-                long(t.rest_positions.rows()), long(t.tets.rows()), long(t.edges.rows()), long(t.faces.rows()),
-                t.velocities.empty() ? "" : ", with velocities");
+    std::printf("  trajectory: %zu frames, t = %g .. %g s, %ld vertices, %ld tets, %ld edges, %ld "
+                "faces%s\n",
+        t.positions.size(), t.time.empty() ? 0.0 : t.time.front(),
+        t.time.empty() ? 0.0 : t.time.back(), long(t.rest_positions.rows()), long(t.tets.rows()),
+        long(t.edges.rows()), long(t.faces.rows()),
+        t.velocities.empty() ? "" : ", with velocities");
     double max_disp = 0;
-    for (const auto& p : t.positions) max_disp = std::max(max_disp, (p - t.rest_positions).rowwise().norm().maxCoeff());
-    print_box(Box3(t.rest_positions.colwise().minCoeff().transpose(), t.rest_positions.colwise().maxCoeff().transpose()));
+    for (const auto& p : t.positions)
+      max_disp = std::max(max_disp, (p - t.rest_positions).rowwise().norm().maxCoeff());
+    print_box(Box3(t.rest_positions.colwise().minCoeff().transpose(),
+        t.rest_positions.colwise().maxCoeff().transpose()));
     std::printf("  largest displacement from rest: %g m\n", max_disp);
-    for (const auto& [k, v] : t.metadata) std::printf("  %s: %s\n", k.c_str(), v.c_str());
+    for (const auto& [k, v] : t.metadata)
+      std::printf("  %s: %s\n", k.c_str(), v.c_str());
   } else if (const auto json = ext == ".json" ? io::read_json_file(path) : nlohmann::json();
              json.is_object() && json.value("format", "").starts_with("elastolearn-material")) {
     const auto f = io::parse_material_file(json, path.string());
-    std::printf("  learned material: %s\n", io::describe_material_model(io::material_model(f, path.string())).c_str());
-    for (const char* key : {"scene", "observations", "best_iteration", "seconds"})
-      if (f.training.contains(key)) std::printf("  training %s: %s\n", key, f.training.at(key).dump().c_str());
+    std::printf("  learned material: %s\n",
+        io::describe_material_model(io::material_model(f, path.string())).c_str());
+    for (const char* key : { "scene", "observations", "best_iteration", "seconds" })
+      if (f.training.contains(key))
+        std::printf("  training %s: %s\n", key, f.training.at(key).dump().c_str());
     if (f.training_stretches)
       std::printf("  training stretches: %s\n", learn::describe(*f.training_stretches).c_str());
     else if (f.correction)
@@ -57,17 +68,20 @@ void info(const std::filesystem::path& path) {
   } else if (ext == ".json") {
     const auto f = io::parse_scene(json, path.string(), path.parent_path()); // already read above
     const auto& s = f.scene;
-    std::printf("  scene '%s': %s, density %g, %s mass, %zu fixed and %zu keyframed groups, %zu loads\n", s.name.c_str(),
-                s.material.elastic->name().c_str(), s.material.density, fem::to_string(s.mass), s.fixed_vertices.size(),
-                s.keyframes.size(), s.loads.size());
-    std::printf("  %d frames of dt = %g s (%g s), linear solver %s\n", s.frames, s.dt, s.frames * s.dt,
-                sim::to_string(s.linear_solver).c_str());
+    std::printf(
+        "  scene '%s': %s, density %g, %s mass, %zu fixed and %zu keyframed groups, %zu loads\n",
+        s.name.c_str(), s.material.elastic->name().c_str(), s.material.density,
+        fem::to_string(s.mass), s.fixed_vertices.size(), s.keyframes.size(), s.loads.size());
+    std::printf("  %d frames of dt = %g s (%g s), linear solver %s\n", s.frames, s.dt,
+        s.frames * s.dt, sim::to_string(s.linear_solver).c_str());
     print_tet_mesh(s.mesh);
   } else if (ext == ".obj" || ext == ".off" || ext == ".ply" || ext == ".stl") {
     const auto s = mesh::read_surface_mesh(path);
-    std::printf("  surface mesh: %ld vertices, %ld triangles, %s, enclosed volume %g\n", long(s.vertices.rows()),
-                long(s.faces.rows()), mesh::is_closed(s) ? "closed" : "NOT closed", mesh::enclosed_volume(s));
-    print_box(Box3(s.vertices.colwise().minCoeff().transpose(), s.vertices.colwise().maxCoeff().transpose()));
+    std::printf("  surface mesh: %ld vertices, %ld triangles, %s, enclosed volume %g\n",
+        long(s.vertices.rows()), long(s.faces.rows()), mesh::is_closed(s) ? "closed" : "NOT closed",
+        mesh::enclosed_volume(s));
+    print_box(Box3(
+        s.vertices.colwise().minCoeff().transpose(), s.vertices.colwise().maxCoeff().transpose()));
   } else {
     print_tet_mesh(mesh::read_tet_mesh(path));
   }
@@ -75,10 +89,13 @@ void info(const std::filesystem::path& path) {
 
 void add_info_command(CLI::App& root) {
   auto files = std::make_shared<std::vector<std::string>>();
-  auto* cmd = root.add_subcommand("info", "Summarise a mesh (.node/.ele/.msh/.veg/.obj/.off/.ply/.stl), trajectory (.h5), scene or learned material (.json)");
+  auto* cmd = root.add_subcommand("info",
+      "Summarise a mesh (.node/.ele/.msh/.veg/.obj/.off/.ply/.stl), trajectory (.h5), scene or "
+      "learned material (.json)");
   cmd->add_option("files", *files, "files to describe")->required();
   cmd->callback([files] {
-    for (const auto& f : *files) info(f);
+    for (const auto& f : *files)
+      info(f);
   });
 }
 

@@ -12,8 +12,8 @@
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
-#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
+#include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/material/nn_correction.hpp>
 
 #include <chrono>
@@ -33,7 +33,7 @@ struct LearnOptions {
   elastolearn::learn::LearningOptions learning;
   // --network: distil the best RBF into the network correction (docs/learning.md).
   bool network = false;
-  std::vector<double> network_motion_scales{0.5, 1.0, 2.0};
+  std::vector<double> network_motion_scales { 0.5, 1.0, 2.0 };
   elastolearn::learn::DistillationSampleOptions network_samples;
   elastolearn::learn::NnDistillationOptions network_training;
 };
@@ -41,54 +41,57 @@ struct LearnOptions {
 /// Distil `teacher` into the network correction on states of the training scene at several
 /// motion amplitudes; print the fit; the network's provenance as JSON.
 std::shared_ptr<const elastolearn::material::Correction> distil_network(const LearnOptions& o,
-                                                                         const elastolearn::sim::Scene& scene,
-                                                                         const elastolearn::material::Correction& teacher,
-                                                                         nlohmann::json& provenance) {
+    const elastolearn::sim::Scene& scene, const elastolearn::material::Correction& teacher,
+    nlohmann::json& provenance) {
   using namespace elastolearn;
   const auto start = std::chrono::steady_clock::now();
   learn::DistillationSampleReport sampled;
-  const learn::StressSamples samples =
-      learn::distillation_samples(scene, o.network_motion_scales, teacher, o.network_samples, &sampled);
-  const double seconds_sampling = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (const auto& m : sampled.messages) std::printf("network samples: %s\n", m.c_str());
+  const learn::StressSamples samples = learn::distillation_samples(
+      scene, o.network_motion_scales, teacher, o.network_samples, &sampled);
+  const double seconds_sampling
+      = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const auto& m : sampled.messages)
+    std::printf("network samples: %s\n", m.c_str());
   const learn::NnDistillationResult r = learn::distill_nn_correction(samples, o.network_training);
-  std::printf("network: %d + %d states (%d recorded of %ld, %d jittered; %d/%zu motions completed), %d epochs; "
-              "RMS relative to the RBF teacher: training %.2f %%, validation %.2f %% (teacher RMS %.4g Pa); "
+  std::printf("network: %d + %d states (%d recorded of %ld, %d jittered; %d/%zu motions "
+              "completed), %d epochs; "
+              "RMS relative to the RBF teacher: training %.2f %%, validation %.2f %% (teacher RMS "
+              "%.4g Pa); "
               "sampling %.1f s, training %.1f s\n",
-              r.training_samples, r.validation_samples, sampled.recorded, sampled.states_seen, sampled.jittered,
-              sampled.scenes_completed, o.network_motion_scales.size(), r.training.epochs,
-              100 * r.relative_training_rms(), 100 * r.relative_validation_rms(), r.target_rms, seconds_sampling,
-              r.training.seconds);
-  provenance = {{"teacher", io::correction_to_json(teacher)},
-                {"network",
-                 {{"motion_scales", o.network_motion_scales},
-                  {"recorded_states", sampled.recorded},
-                  {"jittered_states", sampled.jittered},
-                  {"training_states", r.training_samples},
-                  {"validation_states", r.validation_samples},
-                  {"epochs", r.training.epochs},
-                  {"training_rms_pa", r.training_rms},
-                  {"validation_rms_pa", r.validation_rms},
-                  {"teacher_rms_pa", r.target_rms},
-                  {"seconds_sampling", seconds_sampling},
-                  {"seconds_training", r.training.seconds}}}};
-  return std::make_shared<const material::NnCorrection>(learn::with_teacher_damping(r.correction, teacher));
+      r.training_samples, r.validation_samples, sampled.recorded, sampled.states_seen,
+      sampled.jittered, sampled.scenes_completed, o.network_motion_scales.size(), r.training.epochs,
+      100 * r.relative_training_rms(), 100 * r.relative_validation_rms(), r.target_rms,
+      seconds_sampling, r.training.seconds);
+  provenance = { { "teacher", io::correction_to_json(teacher) },
+    { "network",
+        { { "motion_scales", o.network_motion_scales }, { "recorded_states", sampled.recorded },
+            { "jittered_states", sampled.jittered }, { "training_states", r.training_samples },
+            { "validation_states", r.validation_samples }, { "epochs", r.training.epochs },
+            { "training_rms_pa", r.training_rms }, { "validation_rms_pa", r.validation_rms },
+            { "teacher_rms_pa", r.target_rms }, { "seconds_sampling", seconds_sampling },
+            { "seconds_training", r.training.seconds } } } };
+  return std::make_shared<const material::NnCorrection>(
+      learn::with_teacher_damping(r.correction, teacher));
 }
 
 void write_report(const std::filesystem::path& dir, const elastolearn::learn::LearningState& state,
-                  const nlohmann::json& summary) {
+    const nlohmann::json& summary) {
   using namespace elastolearn;
   std::filesystem::create_directories(dir);
   std::ostringstream csv;
-  csv << "iteration,forward_rms_m,forward_max_m,forward_mean_m,control_force_rms_N,space_time_initial,"
-         "space_time_objective,space_time_iterations,modes,centres,correction_misfit_N,correction_target_N,"
-         "seconds_forward,seconds_pod,seconds_constrained,seconds_space_time,seconds_reconstruction\n";
+  csv << "iteration,forward_rms_m,forward_max_m,forward_mean_m,control_force_rms_N,space_time_"
+         "initial,"
+         "space_time_objective,space_time_iterations,modes,centres,correction_misfit_N,correction_"
+         "target_N,"
+         "seconds_forward,seconds_pod,seconds_constrained,seconds_space_time,seconds_"
+         "reconstruction\n";
   for (const auto& r : state.history)
-    csv << r.iteration << ',' << r.forward_error.rms << ',' << r.forward_error.max << ',' << r.forward_error.mean << ','
-        << r.control_force_rms << ',' << r.space_time_initial << ',' << r.space_time_objective << ','
-        << r.space_time_iterations << ',' << r.modes << ',' << r.centres << ',' << r.correction_misfit << ','
-        << r.correction_target << ',' << r.seconds_forward << ',' << r.seconds_pod << ',' << r.seconds_constrained
-        << ',' << r.seconds_space_time << ',' << r.seconds_reconstruction << '\n';
+    csv << r.iteration << ',' << r.forward_error.rms << ',' << r.forward_error.max << ','
+        << r.forward_error.mean << ',' << r.control_force_rms << ',' << r.space_time_initial << ','
+        << r.space_time_objective << ',' << r.space_time_iterations << ',' << r.modes << ','
+        << r.centres << ',' << r.correction_misfit << ',' << r.correction_target << ','
+        << r.seconds_forward << ',' << r.seconds_pod << ',' << r.seconds_constrained << ','
+        << r.seconds_space_time << ',' << r.seconds_reconstruction << '\n';
   write_text_file_atomic(dir / "convergence.csv", csv.str());
   io::write_json_file(dir / "report.json", summary);
 }
@@ -98,65 +101,81 @@ void run_learn(const LearnOptions& o) {
   const auto scene_file = io::read_scene_file(o.scene);
   const sim::Scene& scene = scene_file.scene;
   if (scene.material.correction)
-    throw InputError(o.scene, "material: the scene's material already carries a correction; learn from a nominal one");
+    throw InputError(o.scene,
+        "material: the scene's material already carries a correction; learn from a nominal one");
   observe::Observation observed = io::read_observation_h5(o.observations);
   observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, o.observations);
 
   learn::LearningOptions options = o.learning;
-  options.reconstruction.method = learn::reconstruction_method_from_name(o.reconstruction, "--reconstruction");
+  options.reconstruction.method
+      = learn::reconstruction_method_from_name(o.reconstruction, "--reconstruction");
   options.rbf.fit_damping = !o.no_damping;
   options.rbf.quadratic_tail = !o.linear_tail;
   options.validate();
 
-  const std::filesystem::path checkpoint = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
-  const io::LearningInputs inputs{o.scene, o.observations, io::learning_options_to_json(options)};
+  const std::filesystem::path checkpoint
+      = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
+  const io::LearningInputs inputs { o.scene, o.observations,
+    io::learning_options_to_json(options) };
   learn::LearningState state;
   if (o.resume) {
     if (!std::filesystem::exists(checkpoint))
-      throw InputError(checkpoint.string(), "no checkpoint to resume from (run without --resume first)");
+      throw InputError(
+          checkpoint.string(), "no checkpoint to resume from (run without --resume first)");
     state = io::read_learning_checkpoint(checkpoint, inputs);
-    std::printf("resuming from %s at iteration %d\n", checkpoint.string().c_str(), state.next_iteration);
+    std::printf(
+        "resuming from %s at iteration %d\n", checkpoint.string().c_str(), state.next_iteration);
   }
-  std::printf("learning %s: %d vertices, %d tets, %d frames of dt = %g s, %d observed vertices, nominal %s\n",
-              scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(), scene.frames, scene.dt,
-              observed.num_observed(), scene.material.elastic->name().c_str());
+  std::printf("learning %s: %d vertices, %d tets, %d frames of dt = %g s, %d observed vertices, "
+              "nominal %s\n",
+      scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(), scene.frames, scene.dt,
+      observed.num_observed(), scene.material.elastic->name().c_str());
   const double diagonal = scene.mesh.bounding_box_diagonal();
-  std::printf("%4s %12s %12s %14s %6s %6s %9s\n", "iter", "err rms [%]", "err max [%]", "control [N]", "modes",
-              "kernels", "time [s]");
+  std::printf("%4s %12s %12s %14s %6s %6s %9s\n", "iter", "err rms [%]", "err max [%]",
+      "control [N]", "modes", "kernels", "time [s]");
 
   learn::LearningCallbacks callbacks;
-  if (!o.quiet) callbacks.progress = terminal_progress("learn");
+  if (!o.quiet)
+    callbacks.progress = terminal_progress("learn");
   callbacks.interrupted = [] { return interrupt_requested(); };
   callbacks.iteration = [&](const learn::IterationRecord& r) {
     if (r.forward_fit) {
       if (r.forward_completed)
         std::printf("%4d %12.4f %12.4f %14s %6s %6d %9.2f   (forward fit: %s)\n", r.iteration,
-                    100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal, "-", "-", r.centres,
-                    r.seconds_total(), r.forward_fit_accepted ? "step accepted" : "step rejected, μ × 10");
+            100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal, "-", "-",
+            r.centres, r.seconds_total(),
+            r.forward_fit_accepted ? "step accepted" : "step rejected, μ × 10");
       else
-        std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10)\n", r.iteration);
+        std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10)\n",
+            r.iteration);
       std::fflush(stdout);
       return;
     }
     if (!r.forward_completed) {
-      std::printf(r.damped_update ? "%4d  forward simulation diverged: trying half of this correction's step\n"
-                                  : "%4d  forward simulation diverged: stopping (the best correction so far is kept)\n",
-                  r.iteration);
+      std::printf(r.damped_update
+              ? "%4d  forward simulation diverged: trying half of this correction's step\n"
+              : "%4d  forward simulation diverged: stopping (the best correction so far is kept)\n",
+          r.iteration);
       return;
     }
-    std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, space-time %.1f [%d it], "
+    std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, "
+                "space-time %.1f [%d it], "
                 "reconstruction %.1f)\n",
-                r.iteration, 100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal,
-                r.control_force_rms, r.modes, r.centres, r.seconds_total(), r.seconds_forward, r.seconds_constrained,
-                r.seconds_space_time, r.space_time_iterations, r.seconds_reconstruction);
+        r.iteration, 100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal,
+        r.control_force_rms, r.modes, r.centres, r.seconds_total(), r.seconds_forward,
+        r.seconds_constrained, r.seconds_space_time, r.space_time_iterations,
+        r.seconds_reconstruction);
     std::fflush(stdout);
   };
-  callbacks.checkpoint = [&](const learn::LearningState& s) { io::write_learning_checkpoint(checkpoint, inputs, s); };
+  callbacks.checkpoint = [&](const learn::LearningState& s) {
+    io::write_learning_checkpoint(checkpoint, inputs, s);
+  };
 
   const bool finished = learn::run_learning(scene, observed, options, state, callbacks);
   if (!finished) {
-    std::fprintf(stderr, "elastolearn: interrupted; resume with the same command and --resume (checkpoint %s)\n",
-                 checkpoint.string().c_str());
+    std::fprintf(stderr,
+        "elastolearn: interrupted; resume with the same command and --resume (checkpoint %s)\n",
+        checkpoint.string().c_str());
     throw CLI::RuntimeError(130);
   }
 
@@ -167,17 +186,14 @@ void run_learn(const LearnOptions& o) {
     history.push_back(io::iteration_record_to_json(r));
   }
   const nlohmann::json root = io::read_json_file(o.scene);
-  io::MaterialFile learned = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
+  io::MaterialFile learned
+      = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
   learned.correction = state.best;
   learned.training_stretches = learn::training_stretch_range(scene, state.best);
-  learned.training = {{"scene", o.scene},
-                      {"observations", o.observations},
-                      {"observed_vertices", observed.num_observed()},
-                      {"best_iteration", state.best_iteration},
-                      {"best_rms_error_m", state.best_error},
-                      {"options", inputs.options},
-                      {"seconds", total_seconds},
-                      {"history", history}};
+  learned.training = { { "scene", o.scene }, { "observations", o.observations },
+    { "observed_vertices", observed.num_observed() }, { "best_iteration", state.best_iteration },
+    { "best_rms_error_m", state.best_error }, { "options", inputs.options },
+    { "seconds", total_seconds }, { "history", history } };
   if (o.network && state.best) {
     nlohmann::json provenance;
     learned.correction = distil_network(o, scene, *state.best, provenance);
@@ -185,89 +201,115 @@ void run_learn(const LearnOptions& o) {
     learned.training["network"] = provenance["network"];
   }
   io::write_material_file(o.output, learned);
-  if (!o.report.empty()) write_report(o.report, state, learned.training);
+  if (!o.report.empty())
+    write_report(o.report, state, learned.training);
 
   const auto& first = state.history.front().forward_error;
-  std::printf("best: iteration %d, observation error rms %.4f %% (nominal %.4f %%), max %.4f %% (nominal %.4f %%); "
+  std::printf("best: iteration %d, observation error rms %.4f %% (nominal %.4f %%), max %.4f %% "
+              "(nominal %.4f %%); "
               "%.1f s in total\n",
-              state.best_iteration, 100 * state.best_error / diagonal, 100 * first.rms / diagonal,
-              100 * state.history[static_cast<size_t>(std::max(0, state.best_iteration))].forward_error.max / diagonal,
-              100 * first.max / diagonal, total_seconds);
+      state.best_iteration, 100 * state.best_error / diagonal, 100 * first.rms / diagonal,
+      100 * state.history[static_cast<size_t>(std::max(0, state.best_iteration))].forward_error.max
+          / diagonal,
+      100 * first.max / diagonal, total_seconds);
   std::printf("learned material: %s (%s)\n", o.output.c_str(),
-              learned.correction ? io::describe_correction(*learned.correction).c_str() : "no correction beat the nominal model");
+      learned.correction ? io::describe_correction(*learned.correction).c_str()
+                         : "no correction beat the nominal model");
   if (learned.training_stretches)
     std::printf("training stretches: %s (simulate and evaluate note where a motion leaves them)\n",
-                learn::describe(*learned.training_stretches).c_str());
+        learn::describe(*learned.training_stretches).c_str());
   else if (learned.correction)
-    std::printf("training stretches: not recorded (the learned model's training simulation did not complete)\n");
-  if (!o.report.empty()) std::printf("report: %s/convergence.csv, report.json\n", o.report.c_str());
+    std::printf("training stretches: not recorded (the learned model's training simulation did not "
+                "complete)\n");
+  if (!o.report.empty())
+    std::printf("report: %s/convergence.csv, report.json\n", o.report.c_str());
 }
 
 void add_learn_command(CLI::App& root) {
   auto o = std::make_shared<LearnOptions>();
-  auto* cmd = root.add_subcommand("learn", "Learn a material correction from observed vertex trajectories");
-  cmd->add_option("scene", o->scene, "scene with the nominal material (elastolearn-scene/1 JSON)")->required();
-  cmd->add_option("--observations", o->observations, "observation HDF5 (from observe, or your capture)")->required();
+  auto* cmd = root.add_subcommand(
+      "learn", "Learn a material correction from observed vertex trajectories");
+  cmd->add_option("scene", o->scene, "scene with the nominal material (elastolearn-scene/1 JSON)")
+      ->required();
+  cmd->add_option(
+         "--observations", o->observations, "observation HDF5 (from observe, or your capture)")
+      ->required();
   cmd->add_option("-o,--output", o->output, "learned material JSON to write")->required();
   cmd->add_option("--report", o->report, "folder for convergence.csv and report.json");
-  cmd->add_option("--checkpoint", o->checkpoint, "checkpoint file (default: OUTPUT.checkpoint.json)");
+  cmd->add_option(
+      "--checkpoint", o->checkpoint, "checkpoint file (default: OUTPUT.checkpoint.json)");
   cmd->add_flag("--resume", o->resume, "continue from the checkpoint");
   auto& l = o->learning;
-  cmd->add_option("--max-iterations", l.max_iterations, "corrections computed at most")->capture_default_str();
-  cmd->add_option("--patience", l.patience, "stop after this many iterations without improvement")->capture_default_str();
-  cmd->add_option("--free-halvings", l.free_halvings,
-                  "diverging corrections in a row halved towards the best one before patience counts them")
+  cmd->add_option("--max-iterations", l.max_iterations, "corrections computed at most")
       ->capture_default_str();
-  cmd->add_option("--modes", l.pod.max_modes, "POD modes r of the space-time optimisation")->capture_default_str();
-  cmd->add_option("--pod-stride", l.pod.frame_stride, "use every k-th frame for POD")->capture_default_str();
+  cmd->add_option("--patience", l.patience, "stop after this many iterations without improvement")
+      ->capture_default_str();
+  cmd->add_option("--free-halvings", l.free_halvings,
+         "diverging corrections in a row halved towards the best one before patience counts them")
+      ->capture_default_str();
+  cmd->add_option("--modes", l.pod.max_modes, "POD modes r of the space-time optimisation")
+      ->capture_default_str();
+  cmd->add_option("--pod-stride", l.pod.frame_stride, "use every k-th frame for POD")
+      ->capture_default_str();
   cmd->add_flag("--full-space", l.full_space, "no reduction (Φ = identity): small meshes only");
   cmd->add_flag("!--pod-forward-only", l.pod_with_constrained,
-                "POD of the forward simulation only (default: also of the constrained one)");
+      "POD of the forward simulation only (default: also of the constrained one)");
   cmd->add_option("--kernels", l.centres, "RBF kernels (k-means centres)")->capture_default_str();
-  cmd->add_option("--position-weight", l.space_time.position_weight, "λ of the position term (Eq. 4)")
+  cmd->add_option(
+         "--position-weight", l.space_time.position_weight, "λ of the position term (Eq. 4)")
       ->capture_default_str();
-  cmd->add_option("--space-time-iterations", l.space_time.max_iterations, "Gauss-Newton iterations per space-time solve")
+  cmd->add_option("--space-time-iterations", l.space_time.max_iterations,
+         "Gauss-Newton iterations per space-time solve")
       ->capture_default_str();
-  cmd->add_option("--regularization", l.rbf.regularization, "Tikhonov weight of the RBF fit")->capture_default_str();
-  cmd->add_option("--reconstruction", o->reconstruction, "normal_equations | lsqr (min-norm stresses, paper Fig. 4)")
+  cmd->add_option("--regularization", l.rbf.regularization, "Tikhonov weight of the RBF fit")
       ->capture_default_str();
-  cmd->add_option("--frame-stride", l.reconstruction.frame_stride, "use every k-th frame in the reconstruction")
+  cmd->add_option("--reconstruction", o->reconstruction,
+         "normal_equations | lsqr (min-norm stresses, paper Fig. 4)")
+      ->capture_default_str();
+  cmd->add_option("--frame-stride", l.reconstruction.frame_stride,
+         "use every k-th frame in the reconstruction")
       ->capture_default_str();
   cmd->add_flag("!--unprojected-reconstruction", l.projected_reconstruction,
-                "fit the control forces at every free dof alike (default: mainly within the POD basis)");
+      "fit the control forces at every free dof alike (default: mainly within the POD basis)");
   cmd->add_option("--full-space-weight", l.reconstruction.full_space_weight,
-                  "weight of the misfit outside the POD basis in the projected reconstruction")
+         "weight of the misfit outside the POD basis in the projected reconstruction")
       ->capture_default_str();
   cmd->add_flag("--no-damping", o->no_damping, "do not learn the damping correction");
-  cmd->add_flag("--linear-tail", o->linear_tail, "RBF with a linear polynomial tail only (default: quadratic)");
+  cmd->add_flag("--linear-tail", o->linear_tail,
+      "RBF with a linear polynomial tail only (default: quadratic)");
   cmd->add_option("--damping-regularization", l.rbf.damping_regularization,
-                  "Tikhonov weight of the damping correction's unknowns")->capture_default_str();
+         "Tikhonov weight of the damping correction's unknowns")
+      ->capture_default_str();
   cmd->add_option("--seed", l.seed, "k-means seed")->capture_default_str();
   cmd->add_option("--forward-fit", l.forward_fit.max_iterations,
-                  "Levenberg-Marquardt steps on the forward simulation's error after the loop (0 = none)")
+         "Levenberg-Marquardt steps on the forward simulation's error after the loop (0 = none)")
       ->capture_default_str();
   cmd->add_option("--damping-prior", l.forward_fit.damping_prior,
-                  "forward fit: Tikhonov weight (Jacobi-scaled) pulling the damping correction towards 0")
+         "forward fit: Tikhonov weight (Jacobi-scaled) pulling the damping correction towards 0")
       ->capture_default_str();
   cmd->add_option("--elastic-prior", l.forward_fit.elastic_prior,
-                  "forward fit: the same on the elastic correction (a large value learns the damping only)")
+         "forward fit: the same on the elastic correction (a large value learns the damping only)")
       ->capture_default_str();
-  cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")->capture_default_str();
+  cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")
+      ->capture_default_str();
   cmd->add_flag("--neo-hookean-tail", l.rbf.neo_hookean_tail,
-                "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");
+      "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");
   cmd->add_flag("--damping-quadratic-tail", l.rbf.damping_quadratic_tail,
-                "RBF damping Δα₁ with a quadratic tail too (carries its curvature beyond the training's stretches)");
+      "RBF damping Δα₁ with a quadratic tail too (carries its curvature beyond the training's "
+      "stretches)");
   cmd->add_flag("!--allow-rest-stress", l.rbf.stress_free_rest,
-                "let the correction carry a stress at rest (default: N(1, 1, 1) = 0)");
+      "let the correction carry a stress at rest (default: N(1, 1, 1) = 0)");
   cmd->add_flag("--network", o->network,
-                "distil the learned RBF into the network correction and save that (the RBF goes to training.teacher)");
+      "distil the learned RBF into the network correction and save that (the RBF goes to "
+      "training.teacher)");
   cmd->add_option("--network-motion-scales", o->network_motion_scales,
-                  "motion amplitudes simulated to sample the network's training states")
+         "motion amplitudes simulated to sample the network's training states")
       ->capture_default_str();
-  cmd->add_option("--network-samples", o->network_samples.recorded_samples, "element states recorded for the network")
+  cmd->add_option("--network-samples", o->network_samples.recorded_samples,
+         "element states recorded for the network")
       ->capture_default_str();
   cmd->add_option("--network-rate-jitter", o->network_samples.rate_jitter,
-                  "stretch-rate jitter of the network's samples, relative to the RMS recorded rate")
+         "stretch-rate jitter of the network's samples, relative to the RMS recorded rate")
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "no progress line");
   cmd->callback([o] { run_learn(*o); });

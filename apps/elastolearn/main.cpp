@@ -16,7 +16,7 @@ std::vector<CommandEntry>& command_registry() {
 }
 
 bool register_command(int order, CommandAdder add) {
-  command_registry().push_back({order, std::move(add)});
+  command_registry().push_back({ order, std::move(add) });
   return true;
 }
 
@@ -24,15 +24,16 @@ bool register_command(int order, CommandAdder add) {
 
 int main(int argc, char** argv) {
   using namespace elastolearn;
-  CLI::App root{"elastolearn " ELASTOLEARN_VERSION
-                " - learn how elastic solids move, and simulate them"};
+  CLI::App root { "elastolearn " ELASTOLEARN_VERSION
+                  " - learn how elastic solids move, and simulate them" };
   root.set_version_flag("--version", ELASTOLEARN_VERSION);
   root.require_subcommand(1);
   install_interrupt_handler();
   auto& registry = app::command_registry();
   std::sort(registry.begin(), registry.end(),
-            [](const auto& a, const auto& b) { return a.order < b.order; });
-  for (const auto& entry : registry) entry.add(root);
+      [](const auto& a, const auto& b) { return a.order < b.order; });
+  for (const auto& entry : registry)
+    entry.add(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -36,7 +36,8 @@ const char* kSmallScene = R"({
 TEST_F(CliTest, SimulateWritesATrajectoryAndAParaViewSeries) {
   const auto scene = write("bar.json", kSmallScene);
   const auto out = m_dir / "bar.h5";
-  const auto r = run("simulate " + scene.string() + " -o " + out.string() + " --vtu " + (m_dir / "vtu").string() + " -q");
+  const auto r = run("simulate " + scene.string() + " -o " + out.string() + " --vtu "
+      + (m_dir / "vtu").string() + " -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto t = elastolearn::io::read_trajectory_h5(out);
   EXPECT_EQ(t.positions.size(), 21u);
@@ -61,10 +62,12 @@ TEST_F(CliTest, BadSceneGivesOneLineNamingTheFieldAndNoOutput) {
 TEST_F(CliTest, UnknownKeyAndBrokenJsonAreReportedWithTheirPlace) {
   std::string typo = kSmallScene;
   typo.replace(typo.find("\"poisson\""), 9, "\"poison\"");
-  auto r = run("simulate " + write("typo.json", typo).string() + " -o " + (m_dir / "x.h5").string());
+  auto r
+      = run("simulate " + write("typo.json", typo).string() + " -o " + (m_dir / "x.h5").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("poison"), std::string::npos) << r.output;
-  r = run("simulate " + write("broken.json", "{\"format\": ").string() + " -o " + (m_dir / "x.h5").string());
+  r = run("simulate " + write("broken.json", "{\"format\": ").string() + " -o "
+      + (m_dir / "x.h5").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("broken.json"), std::string::npos) << r.output;
 }
@@ -73,9 +76,11 @@ TEST_F(CliTest, DivergenceNamesTheFrameAndKeepsEarlierFrames) {
   // One Newton iteration to 1e-12 cannot converge once the bar moves: the run must stop, say
   // at which frame, exit non-zero, and keep the frames before it in a readable file.
   std::string text = kSmallScene;
-  text.replace(text.find("\"time\""), 6, "\"solver\": {\"max_newton_iterations\": 1, \"newton_tolerance\": 1e-12}, \"time\"");
+  text.replace(text.find("\"time\""), 6,
+      "\"solver\": {\"max_newton_iterations\": 1, \"newton_tolerance\": 1e-12}, \"time\"");
   const auto out = m_dir / "div.h5";
-  const auto r = run("simulate " + write("div.json", text).string() + " -o " + out.string() + " -q");
+  const auto r
+      = run("simulate " + write("div.json", text).string() + " -o " + out.string() + " -q");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("diverged at frame"), std::string::npos) << r.output;
   const auto t = elastolearn::io::read_trajectory_h5(out);
@@ -85,9 +90,11 @@ TEST_F(CliTest, DivergenceNamesTheFrameAndKeepsEarlierFrames) {
 
 TEST_F(CliTest, InfoDescribesMeshesTrajectoriesAndScenes) {
   const auto scene = write("bar.json", kSmallScene);
-  ASSERT_EQ(run("simulate " + scene.string() + " -o " + (m_dir / "bar.h5").string() + " -q").exit_code, 0);
-  const auto r = run("info " + scene.string() + " " + (m_dir / "bar.h5").string() + " " +
-                     std::string(ELASTOLEARN_EXAMPLES_DIR) + "/03_real_mesh/elephant.node");
+  ASSERT_EQ(
+      run("simulate " + scene.string() + " -o " + (m_dir / "bar.h5").string() + " -q").exit_code,
+      0);
+  const auto r = run("info " + scene.string() + " " + (m_dir / "bar.h5").string() + " "
+      + std::string(ELASTOLEARN_EXAMPLES_DIR) + "/03_real_mesh/elephant.node");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("21 frames"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("2830 tets"), std::string::npos) << r.output;
@@ -95,7 +102,8 @@ TEST_F(CliTest, InfoDescribesMeshesTrajectoriesAndScenes) {
 }
 
 TEST_F(CliTest, ExampleScenesParse) {
-  for (const char* example : {"01_cantilever/cantilever.json", "02_sphere/sphere.json", "03_real_mesh/elephant.json"}) {
+  for (const char* example :
+      { "01_cantilever/cantilever.json", "02_sphere/sphere.json", "03_real_mesh/elephant.json" }) {
     const auto r = run(std::string("info ") + ELASTOLEARN_EXAMPLES_DIR + "/" + example);
     EXPECT_EQ(r.exit_code, 0) << example << ": " << r.output;
   }
@@ -107,11 +115,11 @@ TEST_F(CliTest, InterruptKeepsTheFramesSoFarAndLeavesNoTemporaryFile) {
   const auto out = m_dir / "long.h5", log = m_dir / "long.log";
   // Interrupt only once the first progress line is out: it comes after frame 1 is written, so
   // frames 0 and 1 must survive. A fixed sleep instead failed on a loaded CI machine.
-  const auto script = write("interrupt.sh", std::string(ELASTOLEARN_EXECUTABLE) + " simulate " +
-                                                write("long.json", text).string() + " -o " + out.string() + " > " +
-                                                log.string() + " 2>&1 & pid=$!\n" +
-                                                "for i in $(seq 600); do grep -q 'simulate ' " + log.string() +
-                                                " && break; sleep 0.1; done\nkill -INT $pid; wait $pid\n");
+  const auto script = write("interrupt.sh",
+      std::string(ELASTOLEARN_EXECUTABLE) + " simulate " + write("long.json", text).string()
+          + " -o " + out.string() + " > " + log.string() + " 2>&1 & pid=$!\n"
+          + "for i in $(seq 600); do grep -q 'simulate ' " + log.string()
+          + " && break; sleep 0.1; done\nkill -INT $pid; wait $pid\n");
   const int status = std::system(("bash " + script.string()).c_str());
   EXPECT_NE(status, 0);
   const auto t = elastolearn::io::read_trajectory_h5(out);
@@ -126,18 +134,21 @@ TEST_F(CliTest, ObserveSamplesSurfaceVerticesReproducibly) {
   const auto traj = m_dir / "bar.h5";
   ASSERT_EQ(run("simulate " + scene.string() + " -o " + traj.string() + " -q").exit_code, 0);
   const auto a = m_dir / "a.h5", b = m_dir / "b.h5";
-  for (const auto& out : {a, b}) {
-    const auto r = run("observe " + traj.string() + " --visible-fraction 0.3 --noise 1e-4 --seed 7 -o " + out.string());
+  for (const auto& out : { a, b }) {
+    const auto r = run("observe " + traj.string()
+        + " --visible-fraction 0.3 --noise 1e-4 --seed 7 -o " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
-  const auto oa = elastolearn::io::read_observation_h5(a), ob = elastolearn::io::read_observation_h5(b);
+  const auto oa = elastolearn::io::read_observation_h5(a),
+             ob = elastolearn::io::read_observation_h5(b);
   EXPECT_EQ(oa.positions.size(), 21u);
   EXPECT_EQ(oa.vertex_ids, ob.vertex_ids);
   EXPECT_EQ((oa.positions.back() - ob.positions.back()).norm(), 0.0); // same seed, same noise
   EXPECT_NEAR(oa.dt, 0.002, 1e-12);
   // Ids outside the mesh are refused with the file named.
   std::ofstream(m_dir / "ids.txt") << "0\n99999\n";
-  const auto r = run("observe " + traj.string() + " --vertices " + (m_dir / "ids.txt").string() + " -o " + (m_dir / "c.h5").string());
+  const auto r = run("observe " + traj.string() + " --vertices " + (m_dir / "ids.txt").string()
+      + " -o " + (m_dir / "c.h5").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("ids.txt"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(m_dir / "c.h5"));

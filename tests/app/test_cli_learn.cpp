@@ -32,7 +32,7 @@ const char* k_truth = R"({"format": "elastolearn-material/1", "correction": null
                "damping": {"alpha0": 0.0, "alpha1": 0.01}}})";
 
 class CliLearnTest : public elastolearn::test::CliTestFolder {
-protected:
+  protected:
   void SetUp() override {
     CliTestFolder::SetUp();
     write("scene.json", k_scene);
@@ -44,16 +44,22 @@ protected:
 double number_after(const std::string& text, const std::string& label) {
   std::smatch m;
   const std::regex re(label + R"(\s+([0-9.eE+-]+))");
-  if (!std::regex_search(text, m, re)) return -1;
+  if (!std::regex_search(text, m, re))
+    return -1;
   return std::stod(m[1]);
 }
 
 TEST_F(CliLearnTest, LearnsAndEvaluates) {
-  ASSERT_EQ(run("simulate " + path("scene.json") + " --material " + path("truth.json") + " -o " + path("truth.h5") + " -q").exit_code, 0);
-  ASSERT_EQ(run("observe " + path("truth.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code, 0);
-  const auto learned = run("learn " + path("scene.json") + " --observations " + path("obs.h5") + " -o " +
-                           path("learned.json") + " --max-iterations 3 --kernels 15 --modes 10 --report " +
-                           path("report") + " -q");
+  ASSERT_EQ(run("simulate " + path("scene.json") + " --material " + path("truth.json") + " -o "
+                + path("truth.h5") + " -q")
+                .exit_code,
+      0);
+  ASSERT_EQ(
+      run("observe " + path("truth.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code,
+      0);
+  const auto learned = run("learn " + path("scene.json") + " --observations " + path("obs.h5")
+      + " -o " + path("learned.json") + " --max-iterations 3 --kernels 15 --modes 10 --report "
+      + path("report") + " -q");
   ASSERT_EQ(learned.exit_code, 0) << learned.output;
   EXPECT_NE(learned.output.find("learned material:"), std::string::npos) << learned.output;
   EXPECT_TRUE(fs::exists(path("report/convergence.csv")));
@@ -61,18 +67,22 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   const auto file = elastolearn::io::read_material_file(path("learned.json"));
   ASSERT_NE(file.correction, nullptr) << "a correction beat the nominal model";
   EXPECT_EQ(file.training.at("history").size(), 4u);
-  ASSERT_TRUE(file.training_stretches.has_value()) << "learn records the training motion's stretches";
+  ASSERT_TRUE(file.training_stretches.has_value())
+      << "learn records the training motion's stretches";
   EXPECT_GT(file.training_stretches->max[0], 1.0) << "the droop stretches the bar";
   EXPECT_LT(file.training_stretches->min[2], 1.0) << "and compresses it";
   const auto described = run("info " + path("learned.json"));
   ASSERT_EQ(described.exit_code, 0) << described.output;
-  EXPECT_NE(described.output.find("correction (rbf, 15 centres"), std::string::npos) << described.output;
-  EXPECT_NE(described.output.find("training stretches: s₁ 1.0"), std::string::npos) << described.output;
+  EXPECT_NE(described.output.find("correction (rbf, 15 centres"), std::string::npos)
+      << described.output;
+  EXPECT_NE(described.output.find("training stretches: s₁ 1.0"), std::string::npos)
+      << described.output;
 
-  const auto evaluated = run("evaluate " + path("scene.json") + " --material " + path("learned.json") + " --truth " +
-                             path("truth.h5") + " -q");
+  const auto evaluated = run("evaluate " + path("scene.json") + " --material "
+      + path("learned.json") + " --truth " + path("truth.h5") + " -q");
   ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
-  const double nominal = number_after(evaluated.output, "nominal"), learned_error = number_after(evaluated.output, "learned");
+  const double nominal = number_after(evaluated.output, "nominal"),
+               learned_error = number_after(evaluated.output, "learned");
   ASSERT_GT(nominal, 0) << evaluated.output;
   ASSERT_GE(learned_error, 0) << evaluated.output;
   EXPECT_LT(learned_error, nominal / 5) << evaluated.output;
@@ -85,8 +95,8 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   auto narrow = file;
   narrow.training_stretches->max[0] = 1.0 + 0.5 * (file.training_stretches->max[0] - 1.0);
   elastolearn::io::write_material_file(path("narrow.json"), narrow);
-  const auto noted = run("evaluate " + path("scene.json") + " --material " + path("narrow.json") + " --truth " +
-                         path("truth.h5") + " --json " + path("evaluation.json") + " -q");
+  const auto noted = run("evaluate " + path("scene.json") + " --material " + path("narrow.json")
+      + " --truth " + path("truth.h5") + " --json " + path("evaluation.json") + " -q");
   ASSERT_EQ(noted.exit_code, 0) << noted.output;
   EXPECT_NE(noted.output.find("note:"), std::string::npos) << noted.output;
   EXPECT_NE(noted.output.find("s₁ up to"), std::string::npos) << noted.output;
@@ -94,26 +104,31 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   const double outside = report.at("stretches").at("fraction_outside").get<double>();
   EXPECT_GT(outside, 0.0);
   EXPECT_LT(outside, 1.0);
-  const auto simulated = run("simulate " + path("scene.json") + " --material " + path("narrow.json") + " -o " +
-                             path("narrow.h5") + " -q");
+  const auto simulated = run("simulate " + path("scene.json") + " --material " + path("narrow.json")
+      + " -o " + path("narrow.h5") + " -q");
   ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
   EXPECT_NE(simulated.output.find("note:"), std::string::npos) << simulated.output;
 
   // --resume of a finished run changes nothing and says where it resumed.
-  const auto resumed = run("learn " + path("scene.json") + " --observations " + path("obs.h5") + " -o " +
-                           path("learned2.json") + " --checkpoint " + path("learned.json.checkpoint.json") +
-                           " --max-iterations 3 --kernels 15 --modes 10 --resume -q");
+  const auto resumed = run("learn " + path("scene.json") + " --observations " + path("obs.h5")
+      + " -o " + path("learned2.json") + " --checkpoint " + path("learned.json.checkpoint.json")
+      + " --max-iterations 3 --kernels 15 --modes 10 --resume -q");
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
   EXPECT_NE(resumed.output.find("resuming"), std::string::npos);
   const auto again = elastolearn::io::read_material_file(path("learned2.json"));
-  EXPECT_EQ(elastolearn::io::correction_to_json(*again.correction), elastolearn::io::correction_to_json(*file.correction));
+  EXPECT_EQ(elastolearn::io::correction_to_json(*again.correction),
+      elastolearn::io::correction_to_json(*file.correction));
 }
 
 TEST_F(CliLearnTest, RefusesObservationsOfAnotherLength) {
-  std::ofstream(m_dir / "short.json") << std::regex_replace(k_scene, std::regex("\"frames\": 50"), "\"frames\": 20");
+  std::ofstream(m_dir / "short.json")
+      << std::regex_replace(k_scene, std::regex("\"frames\": 50"), "\"frames\": 20");
   ASSERT_EQ(run("simulate " + path("short.json") + " -o " + path("short.h5") + " -q").exit_code, 0);
-  ASSERT_EQ(run("observe " + path("short.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code, 0);
-  const auto r = run("learn " + path("scene.json") + " --observations " + path("obs.h5") + " -o " + path("l.json"));
+  ASSERT_EQ(
+      run("observe " + path("short.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code,
+      0);
+  const auto r = run("learn " + path("scene.json") + " --observations " + path("obs.h5") + " -o "
+      + path("l.json"));
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("obs.h5"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("frames"), std::string::npos) << r.output;

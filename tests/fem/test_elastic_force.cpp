@@ -17,11 +17,15 @@ namespace {
 
 const material::Lame kLame = material::Lame::from_young_poisson(3e5, 0.4);
 
-mesh::TetMesh small_bar() { return mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), {4, 1, 1}); }
+mesh::TetMesh small_bar() {
+  return mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 4, 1, 1 });
+}
 
 std::shared_ptr<const material::ElasticModel> model(int which) {
-  if (which == 0) return std::make_shared<material::CorotatedModel>(kLame);
-  if (which == 1) return std::make_shared<material::StVKModel>(kLame);
+  if (which == 0)
+    return std::make_shared<material::CorotatedModel>(kLame);
+  if (which == 1)
+    return std::make_shared<material::StVKModel>(kLame);
   return std::make_shared<material::NeoHookeanModel>(kLame);
 }
 
@@ -32,43 +36,46 @@ VecX deformed(const mesh::TetMesh& mesh, double amount) {
   std::uniform_real_distribution<double> u(-1, 1);
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     const Vec3 X = mesh.rest_positions().row(v);
-    x.segment<3>(3 * v) += amount * Vec3(0.3 * X.x() + 0.02 * u(rng), 0.5 * X.x() * X.x() + 0.02 * u(rng),
-                                         0.2 * X.x() * X.y() + 0.02 * u(rng));
+    x.segment<3>(3 * v) += amount
+        * Vec3(0.3 * X.x() + 0.02 * u(rng), 0.5 * X.x() * X.x() + 0.02 * u(rng),
+            0.2 * X.x() * X.y() + 0.02 * u(rng));
   }
   return x;
 }
 
 Mat3 rotation(double a, double b, double c) {
-  return (Eigen::AngleAxisd(a, Vec3::UnitX()) * Eigen::AngleAxisd(b, Vec3::UnitY()) *
-          Eigen::AngleAxisd(c, Vec3::UnitZ())).toRotationMatrix();
+  return (Eigen::AngleAxisd(a, Vec3::UnitX()) * Eigen::AngleAxisd(b, Vec3::UnitY())
+      * Eigen::AngleAxisd(c, Vec3::UnitZ()))
+      .toRotationMatrix();
 }
 
 VecX force_at(fem::ElasticForce& term, const VecX& x, const VecX& v) {
   VecX f = VecX::Zero(x.size());
-  term.add_force({x, v, 0.0}, f);
+  term.add_force({ x, v, 0.0 }, f);
   return f;
 }
 
 } // namespace
 
-class ElasticForceTest : public ::testing::TestWithParam<int> {};
+class ElasticForceTest : public ::testing::TestWithParam<int> { };
 
 TEST_P(ElasticForceTest, ZeroAtRestAndUnderRigidMotion) {
   const auto mesh = small_bar();
-  fem::ElasticForce term(mesh, {model(GetParam()), nullptr, nullptr, 1000});
+  fem::ElasticForce term(mesh, { model(GetParam()), nullptr, nullptr, 1000 });
   const VecX X = flatten(mesh.rest_positions());
   const VecX zero = VecX::Zero(X.size());
   // Force scale of this deformation state: E · area ≈ 3e5 · 0.01 = 3e3 N; 1e-9 relative.
   EXPECT_LT(force_at(term, X, zero).cwiseAbs().maxCoeff(), 1e-6);
   const Mat3 R = rotation(0.7, -1.1, 2.3);
   VecX x = X;
-  for (int v = 0; v < mesh.num_vertices(); ++v) x.segment<3>(3 * v) = R * X.segment<3>(3 * v) + Vec3(1, -2, 3);
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    x.segment<3>(3 * v) = R * X.segment<3>(3 * v) + Vec3(1, -2, 3);
   EXPECT_LT(force_at(term, x, zero).cwiseAbs().maxCoeff(), 1e-6);
 }
 
 TEST_P(ElasticForceTest, ForcesSumToZeroAndAreRotationCovariant) {
   const auto mesh = small_bar();
-  fem::ElasticForce term(mesh, {model(GetParam()), nullptr, nullptr, 1000});
+  fem::ElasticForce term(mesh, { model(GetParam()), nullptr, nullptr, 1000 });
   const VecX x = deformed(mesh, 0.5);
   const VecX f = force_at(term, x, VecX::Zero(x.size()));
   const double scale = f.cwiseAbs().maxCoeff();
@@ -83,7 +90,8 @@ TEST_P(ElasticForceTest, ForcesSumToZeroAndAreRotationCovariant) {
   EXPECT_LT(torque.norm(), 1e-10 * scale * mesh.num_vertices());
   const Mat3 R = rotation(0.3, 0.2, -0.9);
   VecX xr = x;
-  for (int v = 0; v < mesh.num_vertices(); ++v) xr.segment<3>(3 * v) = R * x.segment<3>(3 * v);
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    xr.segment<3>(3 * v) = R * x.segment<3>(3 * v);
   const VecX fr = force_at(term, xr, VecX::Zero(x.size()));
   for (int v = 0; v < mesh.num_vertices(); ++v)
     EXPECT_LT((fr.segment<3>(3 * v) - R * f.segment<3>(3 * v)).norm(), 1e-9 * scale);
@@ -91,7 +99,7 @@ TEST_P(ElasticForceTest, ForcesSumToZeroAndAreRotationCovariant) {
 
 TEST_P(ElasticForceTest, ExactStiffnessIsMinusForceDerivative) {
   const auto mesh = small_bar();
-  fem::ElasticForce term(mesh, {model(GetParam()), nullptr, nullptr, 1000});
+  fem::ElasticForce term(mesh, { model(GetParam()), nullptr, nullptr, 1000 });
   term.set_project_tangent(false);
   fem::DofMap dofs(mesh.num_vertices(), {});
   fem::SystemMatrix A(mesh.tets(), dofs);
@@ -99,9 +107,10 @@ TEST_P(ElasticForceTest, ExactStiffnessIsMinusForceDerivative) {
   const VecX v = VecX::Zero(x.size());
   VecX f = VecX::Zero(x.size());
   A.set_zero();
-  term.add_force_and_jacobian({x, v, 0.0}, 1.0, 0.0, f, A);
+  term.add_force_and_jacobian({ x, v, 0.0 }, 1.0, 0.0, f, A);
   const Eigen::MatrixXd K = Eigen::MatrixXd(A.matrix());
-  test::expect_jacobian_matches(-K, [&](const VecX& y) { return force_at(term, y, v); }, x, 1e-6, 1e-6);
+  test::expect_jacobian_matches(
+      -K, [&](const VecX& y) { return force_at(term, y, v); }, x, 1e-6, 1e-6);
   // Also: the energy's gradient is minus the force.
   const VecX g = test::fd_gradient([&](const VecX& y) { return term.elastic_energy(y); }, x, 1e-6);
   EXPECT_LT((g + f).cwiseAbs().maxCoeff(), 1e-6 * f.cwiseAbs().maxCoeff());
@@ -109,28 +118,28 @@ TEST_P(ElasticForceTest, ExactStiffnessIsMinusForceDerivative) {
 
 TEST_P(ElasticForceTest, ProjectedStiffnessIsPositiveSemiDefinite) {
   const auto mesh = small_bar();
-  fem::ElasticForce term(mesh, {model(GetParam()), nullptr, nullptr, 1000});
+  fem::ElasticForce term(mesh, { model(GetParam()), nullptr, nullptr, 1000 });
   fem::DofMap dofs(mesh.num_vertices(), {});
   fem::SystemMatrix A(mesh.tets(), dofs);
   const VecX x = deformed(mesh, 1.5); // large enough that the exact tangent is indefinite
   VecX f = VecX::Zero(x.size());
   A.set_zero();
-  term.add_force_and_jacobian({x, VecX::Zero(x.size()), 0.0}, 1.0, 0.0, f, A);
+  term.add_force_and_jacobian({ x, VecX::Zero(x.size()), 0.0 }, 1.0, 0.0, f, A);
   const Eigen::MatrixXd K = Eigen::MatrixXd(A.matrix());
   EXPECT_LT((K - K.transpose()).cwiseAbs().maxCoeff(), 1e-9 * K.cwiseAbs().maxCoeff());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(K);
   EXPECT_GT(eig.eigenvalues().minCoeff(), -1e-9 * eig.eigenvalues().maxCoeff());
 }
 
-INSTANTIATE_TEST_SUITE_P(Materials, ElasticForceTest, ::testing::Values(0, 1, 2),
-                         [](const auto& info) {
-                           return std::string(info.param == 0 ? "Corotated" : info.param == 1 ? "StVK" : "NeoHookean");
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Materials, ElasticForceTest, ::testing::Values(0, 1, 2), [](const auto& info) {
+      return std::string(info.param == 0 ? "Corotated" : info.param == 1 ? "StVK" : "NeoHookean");
+    });
 
 TEST(RayleighDampingForce, DampingJacobianIsMinusVelocityDerivative) {
   const auto mesh = small_bar();
   auto damping = std::make_shared<material::RayleighDamping>(0.2, 0.005);
-  fem::ElasticForce term(mesh, {model(0), nullptr, damping, 1000});
+  fem::ElasticForce term(mesh, { model(0), nullptr, damping, 1000 });
   term.set_project_tangent(false);
   fem::DofMap dofs(mesh.num_vertices(), {});
   fem::SystemMatrix A(mesh.tets(), dofs);
@@ -138,12 +147,14 @@ TEST(RayleighDampingForce, DampingJacobianIsMinusVelocityDerivative) {
   VecX v(x.size());
   std::mt19937 rng(3);
   std::normal_distribution<double> n01;
-  for (auto& vi : v) vi = n01(rng);
+  for (auto& vi : v)
+    vi = n01(rng);
   VecX f = VecX::Zero(x.size());
   A.set_zero();
-  term.add_force_and_jacobian({x, v, 0.0}, 0.0, 1.0, f, A); // c_x = 0, c_v = 1: only D
+  term.add_force_and_jacobian({ x, v, 0.0 }, 0.0, 1.0, f, A); // c_x = 0, c_v = 1: only D
   const Eigen::MatrixXd D = Eigen::MatrixXd(A.matrix());
-  test::expect_jacobian_matches(-D, [&](const VecX& w) { return force_at(term, x, w); }, v, 1e-7);
+  test::expect_jacobian_matches(
+      -D, [&](const VecX& w) { return force_at(term, x, w); }, v, 1e-7);
   // Damping dissipates: vᵀ f_d ≤ 0.
   const VecX fd = force_at(term, x, v) - force_at(term, x, VecX::Zero(v.size()));
   EXPECT_LT(v.dot(fd), 0.0);

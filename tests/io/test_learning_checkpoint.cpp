@@ -18,8 +18,9 @@ namespace {
 
 sim::Scene bar(material::ElasticModelType type, double young) {
   sim::Scene s;
-  s.mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), {8, 2, 2});
-  s.material.elastic = material::make_elastic_model(type, material::Lame::from_young_poisson(young, 0.43));
+  s.mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 8, 2, 2 });
+  s.material.elastic
+      = material::make_elastic_model(type, material::Lame::from_young_poisson(young, 0.43));
   s.material.damping = std::make_shared<material::RayleighDamping>(0.0, 0.01);
   s.gravity = Vec3(0, -9.81, 0);
   s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
@@ -33,16 +34,19 @@ struct Fixture {
   observe::Observation observed;
   learn::LearningOptions options;
   LearningInputs inputs;
-  std::filesystem::path file = std::filesystem::temp_directory_path() / "elastolearn_test_checkpoint.json";
+  std::filesystem::path file
+      = std::filesystem::temp_directory_path() / "elastolearn_test_checkpoint.json";
   Fixture() {
     const auto run = learn::simulate_positions(bar(material::ElasticModelType::NeoHookean, 1e6));
     std::vector<Positions> frames;
-    for (const auto& x : run.positions) frames.emplace_back(unflatten(x));
-    observed = observe::observe_vertices(frames, nominal.dt, observe::select_visible_vertices(nominal.mesh, 0.3, 1), 0, 1);
+    for (const auto& x : run.positions)
+      frames.emplace_back(unflatten(x));
+    observed = observe::observe_vertices(
+        frames, nominal.dt, observe::select_visible_vertices(nominal.mesh, 0.3, 1), 0, 1);
     options.max_iterations = 2;
     options.centres = 10;
     options.pod.max_modes = 8;
-    inputs = {"scene.json", "obs.h5", learning_options_to_json(options)};
+    inputs = { "scene.json", "obs.h5", learning_options_to_json(options) };
   }
   ~Fixture() { std::filesystem::remove(file); }
 };
@@ -82,7 +86,8 @@ void expect_resume_equals_whole(Fixture& f, int stop_after) {
   EXPECT_EQ(resumed.forward_fit_steps, whole.forward_fit_steps);
   ASSERT_EQ(resumed.history.size(), whole.history.size());
   for (size_t i = 0; i < whole.history.size(); ++i)
-    EXPECT_EQ(resumed.history[i].forward_error.rms, whole.history[i].forward_error.rms) << "iteration " << i;
+    EXPECT_EQ(resumed.history[i].forward_error.rms, whole.history[i].forward_error.rms)
+        << "iteration " << i;
   ASSERT_TRUE(resumed.best);
   expect_same(*resumed.best, *whole.best); // bit-identical: every stage is deterministic
 }

@@ -49,8 +49,10 @@ material::RbfCorrection::Parameters rbf_parameters(int centres, unsigned seed) {
   p.own_slope = awkward(rng);
   p.other_slope = awkward(rng);
   p.constant = awkward(rng);
-  for (auto& q : p.quadratic) q = awkward(rng);
-  for (auto& r : p.neo_hookean) r = awkward(rng);
+  for (auto& q : p.quadratic)
+    q = awkward(rng);
+  for (auto& r : p.neo_hookean)
+    r = awkward(rng);
   p.damping_weights.resize(centres);
   fill(p.damping_weights, rng);
   p.damping_slopes = Vec3(awkward(rng), awkward(rng), awkward(rng));

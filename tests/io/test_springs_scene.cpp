@@ -56,18 +56,13 @@ TEST(SpringsScene, BadFieldsGiveErrorsNamingTheField) {
     const char* expected; // substring of the message
   };
   const Case cases[] = {
-      {"/format", "elastolearn-scene/1", "format"},
-      {"/system/type", "net", "system.type"},
-      {"/system/columns", 1, "system.columns"},
-      {"/spring/k", -5, "spring.k"},
-      {"/spring/law", "quartic", "spring.law"},
-      {"/simulation/mode", "magic", "simulation.mode"},
-      {"/simulation/dt", 0, "simulation.dt"},
-      {"/simulation/steps", 0, "simulation.steps"},
-      {"/loads/0/nodes", json::array({99}), "loads[0].nodes"},
-      {"/gravity", json::array({0, 1}), "gravity"},
-      {"/output/every", 0, "output.every"},
-      {"/spring/kk", 3, "spring"}, // unknown key (typo)
+    { "/format", "elastolearn-scene/1", "format" }, { "/system/type", "net", "system.type" },
+    { "/system/columns", 1, "system.columns" }, { "/spring/k", -5, "spring.k" },
+    { "/spring/law", "quartic", "spring.law" }, { "/simulation/mode", "magic", "simulation.mode" },
+    { "/simulation/dt", 0, "simulation.dt" }, { "/simulation/steps", 0, "simulation.steps" },
+    { "/loads/0/nodes", json::array({ 99 }), "loads[0].nodes" },
+    { "/gravity", json::array({ 0, 1 }), "gravity" }, { "/output/every", 0, "output.every" },
+    { "/spring/kk", 3, "spring" }, // unknown key (typo)
   };
   for (const Case& c : cases) {
     json j = cloth_scene();
@@ -105,23 +100,25 @@ TEST(SpringsScene, LearnedSpringRoundTrips) {
 }
 
 TEST(SpringsScene, BadLearnedSpringFileNamesTheField) {
-  json j = io::learned_spring_to_json(springs::learn_spring(springs::TrainingOptions{}));
+  json j = io::learned_spring_to_json(springs::learn_spring(springs::TrainingOptions {}));
   j["coefficients"].erase(1);
   try {
     io::learned_spring_from_json(j, "spring.json");
     FAIL() << "expected an InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("spring.json: coefficients"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("spring.json: coefficients"), std::string::npos)
+        << e.what();
   }
 }
 
 TEST(SpringsScene, ExampleScenesParseAndRun) {
-  for (const char* name : {"rope.json", "cloth.json"}) {
+  for (const char* name : { "rope.json", "cloth.json" }) {
     const auto path = std::filesystem::path(ELASTOLEARN_EXAMPLES_DIR) / "05_springs" / name;
     io::SpringsScene scene = io::read_springs_scene(path);
     scene.steps = 5; // smoke run; the examples' full length is for the command line
     auto stepper = io::make_scene_stepper(scene);
-    const auto record = springs::run_simulation(*stepper, springs::rest_state(scene.system), scene.steps);
+    const auto record
+        = springs::run_simulation(*stepper, springs::rest_state(scene.system), scene.steps);
     EXPECT_FALSE(record.diverged) << name << ": " << record.message;
     const io::TrajectoryData data = io::springs_trajectory(scene.system, record);
     EXPECT_EQ(data.positions.size(), 6u);

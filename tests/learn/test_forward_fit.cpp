@@ -24,9 +24,9 @@ namespace {
 /// Mass damping only (α₁ = 0), so that the step Jacobian is the force's exact derivative.
 sim::Scene small_bar() {
   sim::Scene s;
-  s.mesh = mesh::make_box_bar(Vec3(0.3, 0.06, 0.06), {4, 1, 1});
-  s.material.elastic = material::make_elastic_model(material::ElasticModelType::Corotated,
-      material::Lame::from_young_poisson(2e4, 0.4));
+  s.mesh = mesh::make_box_bar(Vec3(0.3, 0.06, 0.06), { 4, 1, 1 });
+  s.material.elastic = material::make_elastic_model(
+      material::ElasticModelType::Corotated, material::Lame::from_young_poisson(2e4, 0.4));
   s.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.0);
   s.material.density = 1000;
   s.gravity = Vec3(0, -9.81, 0);
@@ -40,8 +40,10 @@ observe::Observation observe_run(const sim::Scene& scene) {
   const ForwardRun run = simulate_positions(scene);
   EXPECT_TRUE(run.completed) << run.message;
   std::vector<Positions> frames;
-  for (const auto& x : run.positions) frames.emplace_back(unflatten(x));
-  return observe::observe_vertices(frames, scene.dt, observe::select_visible_vertices(scene.mesh, 0.5, 3), 0.0, 1);
+  for (const auto& x : run.positions)
+    frames.emplace_back(unflatten(x));
+  return observe::observe_vertices(
+      frames, scene.dt, observe::select_visible_vertices(scene.mesh, 0.5, 3), 0.0, 1);
 }
 
 MatX centres() {
@@ -60,8 +62,8 @@ TEST(ForwardFit, SensitivityGradientMatchesFiniteDifferencesOfTheError) {
   // row of ∂f/∂w is O(1); the projected Jacobian (the fit's default) is off by 4 % here.
   const sim::Scene nominal = small_bar();
   sim::Scene truth = nominal;
-  truth.material.elastic = material::make_elastic_model(material::ElasticModelType::NeoHookean,
-      material::Lame::from_young_poisson(1.4e4, 0.4));
+  truth.material.elastic = material::make_elastic_model(
+      material::ElasticModelType::NeoHookean, material::Lame::from_young_poisson(1.4e4, 0.4));
   const observe::Observation observed = observe_run(truth);
   const ReconstructionMesh mesh(nominal.mesh, nominal.material);
   // Elastic unknowns only: with α₁ = 0 the clamp α₁ + Δα₁ ≥ 0 makes the force kink at Δα₁ = 0.
@@ -69,25 +71,29 @@ TEST(ForwardFit, SensitivityGradientMatchesFiniteDifferencesOfTheError) {
   rbf.fit_damping = false;
   const RbfDesign design(centres(), rbf);
   const VecX start = VecX::Zero(design.num_unknowns());
-  const ForwardSensitivityPass pass = simulate_with_sensitivities(nominal, observed, mesh, design, start, Sensitivities::exact);
+  const ForwardSensitivityPass pass
+      = simulate_with_sensitivities(nominal, observed, mesh, design, start, Sensitivities::exact);
   ASSERT_TRUE(pass.completed) << pass.message;
   EXPECT_GT(pass.squared_error, 0);
   // A direction in the Jacobi-scaled unknowns (entries of comparable effect).
   std::mt19937 rng(4);
   std::normal_distribution<double> g(0.0, 1.0);
   VecX direction(start.size());
-  for (Eigen::Index i = 0; i < direction.size(); ++i) direction[i] = g(rng) / std::sqrt(pass.normal(i, i) + 1e-300);
+  for (Eigen::Index i = 0; i < direction.size(); ++i)
+    direction[i] = g(rng) / std::sqrt(pass.normal(i, i) + 1e-300);
   const double h = 1e-3 * std::sqrt(pass.squared_error / (direction.dot(pass.normal * direction)));
   const auto error_at = [&](double step) {
-    const ForwardSensitivityPass p
-        = simulate_with_sensitivities(nominal, observed, mesh, design, start + step * direction, Sensitivities::none);
+    const ForwardSensitivityPass p = simulate_with_sensitivities(
+        nominal, observed, mesh, design, start + step * direction, Sensitivities::none);
     EXPECT_TRUE(p.completed) << p.message;
     return p.squared_error;
   };
   const double numeric = (error_at(h) - error_at(-h)) / (2 * h);
   const double analytic = 2 * pass.gradient.dot(direction);
-  std::cout << "[ gradient ] relative difference " << std::abs(numeric - analytic) / std::abs(analytic) << "\n";
-  EXPECT_NEAR(numeric, analytic, 1e-4 * std::abs(analytic)) << "numeric " << numeric << ", analytic " << analytic;
+  std::cout << "[ gradient ] relative difference "
+            << std::abs(numeric - analytic) / std::abs(analytic) << "\n";
+  EXPECT_NEAR(numeric, analytic, 1e-4 * std::abs(analytic))
+      << "numeric " << numeric << ", analytic " << analytic;
   // The Gauss–Newton matrix is symmetric positive semi-definite.
   EXPECT_LE((pass.normal - pass.normal.transpose()).norm(), 1e-12 * pass.normal.norm());
 }
@@ -104,15 +110,16 @@ TEST(ForwardFit, RecoversACorrectionTheDesignCanExpressFromHalfTheVertices) {
   const RbfDesign design(centres(), rbf);
   VecX truth_unknowns = VecX::Zero(design.num_unknowns());
   truth_unknowns[0] = -2e3; // a kernel weight [Pa]
-  truth_unknowns[4] = 8e3;  // own slope a = 2Δμ + Δλ [Pa]
-  truth_unknowns[5] = 2e3;  // other slope b = Δλ [Pa]
-  const observe::Observation observed = observe_run(
-      with_correction(nominal, std::make_shared<material::RbfCorrection>(design.correction(truth_unknowns))));
+  truth_unknowns[4] = 8e3; // own slope a = 2Δμ + Δλ [Pa]
+  truth_unknowns[5] = 2e3; // other slope b = Δλ [Pa]
+  const observe::Observation observed = observe_run(with_correction(
+      nominal, std::make_shared<material::RbfCorrection>(design.correction(truth_unknowns))));
   ForwardFitOptions options;
   options.max_iterations = 4;
   int steps = 0;
-  const ForwardFitResult fit = fit_to_observations(nominal, observed, mesh, design, VecX::Zero(design.num_unknowns()),
-      options, {}, [&](const ForwardSensitivityPass&, bool, const VecX&, double) { return ++steps < 10; });
+  const ForwardFitResult fit = fit_to_observations(nominal, observed, mesh, design,
+      VecX::Zero(design.num_unknowns()), options, {},
+      [&](const ForwardSensitivityPass&, bool, const VecX&, double) { return ++steps < 10; });
   ASSERT_EQ(fit.rms_history.size(), 5u);
   EXPECT_EQ(steps, 4);
   EXPECT_GE(fit.accepted, 3);
@@ -122,16 +129,18 @@ TEST(ForwardFit, RecoversACorrectionTheDesignCanExpressFromHalfTheVertices) {
   const Vec3 probe(1.03, 0.99, 0.985);
   const Vec3 want = design.correction(truth_unknowns).correction(probe, Vec3::Zero());
   const Vec3 got = design.correction(fit.unknowns).correction(probe, Vec3::Zero());
-  EXPECT_LE((got - want).norm(), 0.05 * want.norm()) << "got " << got.transpose() << ", want " << want.transpose();
+  EXPECT_LE((got - want).norm(), 0.05 * want.norm())
+      << "got " << got.transpose() << ", want " << want.transpose();
 }
 
 /// A bar whose truth damps more (α₁ 0.02 → 0.1) and is stiffer (E 2e4 → 2.6e4) than its
-/// nominal, and a fit of either correction with priors (ρ_d, ρ_e) on the damping / elastic unknowns.
+/// nominal, and a fit of either correction with priors (ρ_d, ρ_e) on the damping / elastic
+/// unknowns.
 struct StifferAndMoreDamped {
   sim::Scene nominal = nominal_scene();
   observe::Observation observed = observe_truth();
-  ReconstructionMesh mesh{nominal.mesh, nominal.material};
-  RbfDesign design{centres(), RbfFitOptions{}};
+  ReconstructionMesh mesh { nominal.mesh, nominal.material };
+  RbfDesign design { centres(), RbfFitOptions {} };
   static sim::Scene nominal_scene() {
     sim::Scene s = small_bar();
     s.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.02);
@@ -139,8 +148,8 @@ struct StifferAndMoreDamped {
   }
   static observe::Observation observe_truth() {
     sim::Scene truth = small_bar();
-    truth.material.elastic = material::make_elastic_model(material::ElasticModelType::Corotated,
-        material::Lame::from_young_poisson(2.6e4, 0.4));
+    truth.material.elastic = material::make_elastic_model(
+        material::ElasticModelType::Corotated, material::Lame::from_young_poisson(2.6e4, 0.4));
     truth.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.1);
     return observe_run(truth);
   }
@@ -149,7 +158,8 @@ struct StifferAndMoreDamped {
     options.max_iterations = 4;
     options.damping_prior = damping_prior;
     options.elastic_prior = elastic_prior;
-    return fit_to_observations(nominal, observed, mesh, design, VecX::Zero(design.num_unknowns()), options);
+    return fit_to_observations(
+        nominal, observed, mesh, design, VecX::Zero(design.num_unknowns()), options);
   }
 };
 
@@ -165,7 +175,8 @@ TEST(ForwardFit, DampingPriorHoldsTheDampingCorrectionNearZero) {
   const double free_alpha = c.design.correction(free.unknowns).stiffness_damping(probe);
   const double held_alpha = c.design.correction(held.unknowns).stiffness_damping(probe);
   std::cout << "[ prior ] Δα₁ " << free_alpha << " (free) vs " << held_alpha << " (held); rms "
-            << free.rms_history.back() << " vs " << held.rms_history.back() << " from " << held.rms_history.front() << "\n";
+            << free.rms_history.back() << " vs " << held.rms_history.back() << " from "
+            << held.rms_history.front() << "\n";
   EXPECT_NEAR(free_alpha, 0.08, 0.04); // the free fit finds the extra damping (truth +0.08)
   EXPECT_LT(std::abs(held_alpha), 1e-2 * free_alpha);
   EXPECT_LT(held.rms_history.back(), 0.5 * held.rms_history.front()); // the elastic part still fits
@@ -181,12 +192,12 @@ TEST(ForwardFit, ElasticPriorHoldsTheElasticCorrectionNearZero) {
   const double free_n = c.design.correction(free.unknowns).correction(probe, Vec3::Zero()).norm();
   const double held_n = c.design.correction(held.unknowns).correction(probe, Vec3::Zero()).norm();
   const double held_alpha = c.design.correction(held.unknowns).stiffness_damping(probe);
-  std::cout << "[ prior ] |N| " << free_n << " Pa (free) vs " << held_n << " Pa (held), held Δα₁ " << held_alpha
-            << "; rms " << free.rms_history.back() << " vs " << held.rms_history.back() << " from "
-            << held.rms_history.front() << "\n";
+  std::cout << "[ prior ] |N| " << free_n << " Pa (free) vs " << held_n << " Pa (held), held Δα₁ "
+            << held_alpha << "; rms " << free.rms_history.back() << " vs "
+            << held.rms_history.back() << " from " << held.rms_history.front() << "\n";
   EXPECT_GT(free_n, 10.0);
   EXPECT_LT(held_n, 1e-2 * free_n);
-  EXPECT_GT(held_alpha, 0.0);                                         // the damping takes up what it can
+  EXPECT_GT(held_alpha, 0.0); // the damping takes up what it can
   EXPECT_LT(held.rms_history.back(), 0.9 * held.rms_history.front()); // and lowers the error
   EXPECT_LT(free.rms_history.back(), held.rms_history.back());
 }

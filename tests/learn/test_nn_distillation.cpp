@@ -78,7 +78,8 @@ MatX random_inputs(int n, unsigned seed) {
 
 /// max over the columns of |g(x_j) − reference_j|, g the folded network, relative to the RMS
 /// of the reference (a single output near 0 would make a per-sample ratio meaningless).
-double max_relative_difference(const material::NnCorrection& folded, const MatX& x, const MatX& reference) {
+double max_relative_difference(
+    const material::NnCorrection& folded, const MatX& x, const MatX& reference) {
   double worst = 0;
   for (Eigen::Index j = 0; j < x.cols(); ++j)
     worst = std::max(worst, std::abs(folded.evaluate(x.col(j)) - reference(0, j)));
@@ -108,7 +109,8 @@ TEST(BatchNormFolding, FoldedNetworkEqualsTheInferenceModeNetwork) {
   const auto folded = identity_wrapped(fold_batch_norm(net));
   EXPECT_LT(max_relative_difference(folded, x, inference), 1e-12);
   // The fold really uses the running statistics: training mode (batch statistics) differs.
-  EXPECT_GT((evaluate(net, x, BatchNormMode::Training) - inference).norm(), 1e-3 * inference.norm());
+  EXPECT_GT(
+      (evaluate(net, x, BatchNormMode::Training) - inference).norm(), 1e-3 * inference.norm());
 }
 
 TEST(BatchNormFolding, TrainingModeEqualsFoldedWhenRunningStatisticsAreTheBatchStatistics) {
@@ -191,7 +193,8 @@ TEST(NnDistillation, DistilledNetworkIsIsotropic) {
   const auto r = distill_nn_correction(random_samples(teacher, 2000, 5), o);
   const material::NnCorrection& n = r.correction;
   for (const Vec3& s : { Vec3::Ones().eval(), Vec3(1.1, 1.1, 0.9), Vec3(0.9, 1.05, 0.9) }) {
-    for (const Vec3& f : { Vec3::Zero().eval(), Vec3(0.5, 0.5, 0.5), Vec3(0.3, 0.3, -0.4), Vec3(0.3, -0.4, 0.3) }) {
+    for (const Vec3& f :
+        { Vec3::Zero().eval(), Vec3(0.5, 0.5, 0.5), Vec3(0.3, 0.3, -0.4), Vec3(0.3, -0.4, 0.3) }) {
       const Vec3 out = n.correction(s, f);
       for (int i = 0; i < 3; ++i) {
         for (int j = i + 1; j < 3; ++j) {
@@ -238,8 +241,8 @@ sim::Scene swinging_bar() {
   sim::Scene s;
   s.name = "bar";
   s.mesh = mesh::make_box_bar({ 0.4, 0.1, 0.1 }, { 8, 2, 2 });
-  s.material.elastic = std::make_shared<material::CorotatedModel>(
-      material::Lame::from_young_poisson(5e4, 0.4));
+  s.material.elastic
+      = std::make_shared<material::CorotatedModel>(material::Lame::from_young_poisson(5e4, 0.4));
   s.material.density = 1000;
   s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
   s.initial.kind = sim::InitialCondition::Kind::Velocity;
@@ -260,7 +263,8 @@ TEST(DistillationSamples, RecordsTheTeachersStatesFromSimulations) {
   EXPECT_EQ(scenes[1].initial.velocity, Vec3(0, 1.0, 0));
   sim::Scene drooping = bar;
   drooping.gravity = Vec3(0, -9.81, 0);
-  EXPECT_EQ(scaled_motions(drooping, factors)[1].gravity, Vec3(0, -2 * 9.81, 0)); // gravity-driven motions scale too
+  EXPECT_EQ(scaled_motions(drooping, factors)[1].gravity,
+      Vec3(0, -2 * 9.81, 0)); // gravity-driven motions scale too
   EXPECT_EQ(scenes[1].name, "bar_x2");
 
   DistillationSampleOptions o;
@@ -268,7 +272,8 @@ TEST(DistillationSamples, RecordsTheTeachersStatesFromSimulations) {
   o.frame_stride = 2;
   o.jitter_copies = 2;
   DistillationSampleReport report;
-  const StressSamples s = distillation_samples(std::span<const sim::Scene>(scenes), teacher, o, &report);
+  const StressSamples s
+      = distillation_samples(std::span<const sim::Scene>(scenes), teacher, o, &report);
   // 2 scenes × 16 recorded frames (0, 2, …, 30) × 192 tets = 6144 states seen.
   EXPECT_EQ(report.states_seen, 2L * 16 * 192);
   EXPECT_EQ(report.scenes_completed, 2);
@@ -305,7 +310,8 @@ TEST(DistillationSamples, DistilledNetworkFollowsTheTeacherOnSimulatedStates) {
   so.recorded_samples = 4000;
   const StressSamples s = distillation_samples(swinging_bar(), factors, teacher, so);
   const NnDistillationResult r = distill_nn_correction(s, {});
-  std::cout << "simulated: epochs " << r.training.epochs << " (best " << r.training.best_epoch << "), relative RMS train " << r.relative_training_rms() << " validation "
+  std::cout << "simulated: epochs " << r.training.epochs << " (best " << r.training.best_epoch
+            << "), relative RMS train " << r.relative_training_rms() << " validation "
             << r.relative_validation_rms() << ", " << r.training.seconds << " s\n";
   EXPECT_LT(r.relative_validation_rms(), 0.05);
 }
@@ -329,8 +335,12 @@ TEST(NnDistillation, TeacherDampingIsCarriedOverExactly) {
   }
   EXPECT_NE(teacher.stiffness_damping(Vec3(1.1, 1, 0.9)), 0);
   // A network teacher passes its damping on; a teacher without damping gives none.
-  EXPECT_EQ(with_teacher_damping(r.correction, damped).parameters().damping, damped.parameters().damping);
-  EXPECT_EQ(with_teacher_damping(damped, material::AnalyticCorrection({ 1e3, 0, 0 })).parameters().damping, nullptr);
+  EXPECT_EQ(
+      with_teacher_damping(r.correction, damped).parameters().damping, damped.parameters().damping);
+  EXPECT_EQ(with_teacher_damping(damped, material::AnalyticCorrection({ 1e3, 0, 0 }))
+                .parameters()
+                .damping,
+      nullptr);
   // The network's damping must not carry an elastic part.
   material::NnCorrection::Parameters bad = r.correction.parameters();
   bad.damping = std::make_shared<const material::RbfCorrection>(teacher);

@@ -113,7 +113,8 @@ TEST(ParameterFit, DivergingTrialsAreRejectedNotFatal) {
   const auto obs = observe_truth(scene, { 1.5e5, 0.3, 0.0, 2e-3 });
   scene.newton.max_iterations = 3;
   scene.newton.relative_tolerance = 1e-10;
-  scene.newton.jacobian_reuse_contraction = 0; // the thresholds above were measured with full Newton
+  scene.newton.jacobian_reuse_contraction
+      = 0; // the thresholds above were measured with full Newton
   learn::ParameterFitOptions options;
   options.parameters = { FitParameter::Young };
   const NominalParameters start { 4e5, 0.3, 0.0, 2e-3 };

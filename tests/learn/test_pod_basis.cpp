@@ -131,12 +131,14 @@ TEST(PodBasis, SeveralTrajectoriesShareOneBasis) {
     shape[d] = g(rng);
   LowRankMotion other = m;
   for (std::size_t t = 0; t < other.frames.size(); ++t)
-    other.frames[t] = unflatten(VecX(flatten(m.frames[t]) + 0.02 * std::cos(0.5 * double(t)) * shape));
+    other.frames[t]
+        = unflatten(VecX(flatten(m.frames[t]) + 0.02 * std::cos(0.5 * double(t)) * shape));
   PodOptions options;
   options.max_modes = 10;
   options.frame_stride = 2;
-  const std::vector<std::vector<Positions>> both{m.frames, other.frames};
-  const PodBasis basis = pod_basis(std::span<const std::vector<Positions>>(both), m.rest, m.free_vertices, options);
+  const std::vector<std::vector<Positions>> both { m.frames, other.frames };
+  const PodBasis basis
+      = pod_basis(std::span<const std::vector<Positions>>(both), m.rest, m.free_vertices, options);
   EXPECT_EQ(basis.num_modes(), 4);
   EXPECT_EQ(basis.frames.size(), 30u);
   const VecX ones = VecX::Ones(basis.modes.rows());
@@ -146,8 +148,11 @@ TEST(PodBasis, SeveralTrajectoriesShareOneBasis) {
   const PodBasis first = pod_basis(m.frames, m.rest, m.free_vertices, options);
   EXPECT_GT(max_projection_error(other, first.modes, ones), 1e-3);
   // Trajectories of different lengths are refused.
-  const std::vector<std::vector<Positions>> uneven{m.frames, std::vector<Positions>(m.frames.begin(), m.frames.end() - 1)};
-  EXPECT_THROW(pod_basis(std::span<const std::vector<Positions>>(uneven), m.rest, m.free_vertices, options), InputError);
+  const std::vector<std::vector<Positions>> uneven { m.frames,
+    std::vector<Positions>(m.frames.begin(), m.frames.end() - 1) };
+  EXPECT_THROW(
+      pod_basis(std::span<const std::vector<Positions>>(uneven), m.rest, m.free_vertices, options),
+      InputError);
 }
 
 TEST(PodBasis, RejectsBadInput) {

@@ -117,11 +117,13 @@ TEST(RbfFit, QuadraticTailExtrapolatesAQuadraticDifference) {
   const double mu = 1.8e4, lambda = 7e4;
   const Truth truth = [&](const Vec3& s, const Vec3&) {
     const Vec3 e = s.array() - 1.0;
-    return Vec3(3 * mu * e.cwiseAbs2() + lambda * e.sum() * e + Vec3::Constant(0.5 * lambda * e.squaredNorm()));
+    return Vec3(3 * mu * e.cwiseAbs2() + lambda * e.sum() * e
+        + Vec3::Constant(0.5 * lambda * e.squaredNorm()));
   };
   StressSamples train = make_samples(3000, 31, truth);
   for (Eigen::Index j = 0; j < train.stretches.rows(); ++j) { // squeeze [0.8, 1.25] into [0.9, 1.1]
-    const Vec3 s = Vec3::Ones() + (train.stretches.row(j).transpose() - Vec3::Constant(1.025)) * (0.2 / 0.45);
+    const Vec3 s = Vec3::Ones()
+        + (train.stretches.row(j).transpose() - Vec3::Constant(1.025)) * (0.2 / 0.45);
     train.stretches.row(j) = s.transpose();
     train.targets.row(j) = truth(s, Vec3::Zero()).transpose();
   }
@@ -132,9 +134,12 @@ TEST(RbfFit, QuadraticTailExtrapolatesAQuadraticDifference) {
   const MatX centres = centres_for(train, 20);
   const RbfFitResult q = fit_rbf_correction(RbfDesign(centres, quadratic), train);
   const RbfFitResult l = fit_rbf_correction(RbfDesign(centres, linear), train);
-  const double q_error = (q.correction.correction(far, Vec3::Zero()) - truth(far, Vec3::Zero())).norm() / target;
-  const double l_error = (l.correction.correction(far, Vec3::Zero()) - truth(far, Vec3::Zero())).norm() / target;
-  std::cout << "[ extrap.  ] relative error at (1.3, 1.0, 0.8): quadratic tail " << q_error << ", linear tail " << l_error << "\n";
+  const double q_error
+      = (q.correction.correction(far, Vec3::Zero()) - truth(far, Vec3::Zero())).norm() / target;
+  const double l_error
+      = (l.correction.correction(far, Vec3::Zero()) - truth(far, Vec3::Zero())).norm() / target;
+  std::cout << "[ extrap.  ] relative error at (1.3, 1.0, 0.8): quadratic tail " << q_error
+            << ", linear tail " << l_error << "\n";
   // The truth lies in the quadratic tail's span: only the Tikhonov bias (λ = 1e-9) remains.
   EXPECT_LT(q_error, 1e-4);
   EXPECT_GT(l_error, 0.05);
@@ -180,7 +185,8 @@ TEST(RbfFit, ElasticOnlyFitIgnoresRatesAndSortsSamples) {
   options.neo_hookean_tail = true;
   options.stress_free_rest = false; // the truth has a pressure at rest: the tail's c carries it
   const RbfDesign design(centres_for(train, 20), options);
-  EXPECT_EQ(design.num_unknowns(), 20 + 3 + 4 + 2); // kernels, linear, quadratic and neo-Hookean tails
+  EXPECT_EQ(
+      design.num_unknowns(), 20 + 3 + 4 + 2); // kernels, linear, quadratic and neo-Hookean tails
   const RbfFitResult a = fit_rbf_correction(design, train),
                      b = fit_rbf_correction(design, shuffled);
   EXPECT_LE((a.unknowns - b.unknowns).norm(), 1e-9 * a.unknowns.norm());
@@ -222,7 +228,8 @@ TEST(RbfFit, RejectsBadInput) {
   RbfFitOptions exact;
   exact.regularization = 0;
   const RbfDesign unregularised(MatX::Identity(3, 3) + MatX::Ones(3, 3), exact);
-  for (Eigen::Index j = 0; j < s.stretches.rows(); ++j) s.stretches.row(j) = Eigen::RowVector3d(1.1, 1.0, 0.9);
+  for (Eigen::Index j = 0; j < s.stretches.rows(); ++j)
+    s.stretches.row(j) = Eigen::RowVector3d(1.1, 1.0, 0.9);
   EXPECT_THROW(fit_rbf_correction(unregularised, s), InputError);
 }
 
@@ -253,7 +260,8 @@ TEST(RbfDesign, OutputGradientMatchesFiniteDifferences) {
       for (int k = 0; k < 3; ++k)
         for (int i = 0; i < u; ++i)
           EXPECT_NEAR(gradient(3 * j + k, i), (plus(k, i) - minus(k, i)) / (2 * h), 1e-7)
-              << "σ = " << s.transpose() << ", ∂/∂σ_" << j << " of output " << k << ", unknown " << i;
+              << "σ = " << s.transpose() << ", ∂/∂σ_" << j << " of output " << k << ", unknown "
+              << i;
     }
   }
 }
@@ -273,15 +281,18 @@ TEST(RbfDesign, StressFreeRestKeepsTheRestShapeUnstressed) {
     const RbfDesign design(centres, options);
     RbfFitOptions other = options;
     other.stress_free_rest = !stress_free;
-    EXPECT_EQ(design.elastic_unknowns(), RbfDesign(centres, other).elastic_unknowns() + (stress_free ? -1 : 1));
+    EXPECT_EQ(design.elastic_unknowns(),
+        RbfDesign(centres, other).elastic_unknowns() + (stress_free ? -1 : 1));
     VecX x(design.num_unknowns());
-    for (auto& v : x) v = g(rng);
+    for (auto& v : x)
+      v = g(rng);
     const material::RbfCorrection n = design.correction(x);
     RbfDesign::OutputMatrix a(3, design.elastic_unknowns());
     for (const Vec3& s : { Vec3(1.05, 0.93, 0.97), Vec3(0.8, 1.2, 1.0), Vec3(1, 1, 1) }) {
       design.output_matrix(s, a);
       const Vec3 fitted = a * x.head(design.elastic_unknowns());
-      EXPECT_LE((fitted - n.correction(s, Vec3::Zero())).norm(), 1e-9 * x.norm()) << "σ = " << s.transpose();
+      EXPECT_LE((fitted - n.correction(s, Vec3::Zero())).norm(), 1e-9 * x.norm())
+          << "σ = " << s.transpose();
     }
     const double at_rest = n.correction(Vec3::Ones(), Vec3::Zero()).norm();
     if (stress_free)
@@ -296,22 +307,29 @@ TEST(RbfFit, NeoHookeanTailExtrapolatesNeoHookeanMinusCorotatedIntoStrongCompres
   // −μ g₁ + λ g₂ exactly. Fitted on stretches in [0.8, 1.25], the correction must reproduce it
   // at σ₃ = 0.45, where the neo-Hookean barrier dominates: measured relative error 1.5e-6 (exact
   // data; the Tikhonov 1e-9 bias), allowed 1e-5; without the tail 50–60 %.
-  const auto neo = material::make_elastic_model(material::ElasticModelType::NeoHookean, material::Lame::from_young_poisson(1e5, 0.43));
-  const auto corotated = material::make_elastic_model(material::ElasticModelType::Corotated, material::Lame::from_young_poisson(1.2e5, 0.43));
-  const Truth truth = [&](const Vec3& s, const Vec3&) { return Vec3(neo->principal_stress(s) - corotated->principal_stress(s)); };
+  const auto neo = material::make_elastic_model(
+      material::ElasticModelType::NeoHookean, material::Lame::from_young_poisson(1e5, 0.43));
+  const auto corotated = material::make_elastic_model(
+      material::ElasticModelType::Corotated, material::Lame::from_young_poisson(1.2e5, 0.43));
+  const Truth truth = [&](const Vec3& s, const Vec3&) {
+    return Vec3(neo->principal_stress(s) - corotated->principal_stress(s));
+  };
   const StressSamples train = make_samples(3000, 40, truth);
   RbfFitOptions options;
   options.fit_damping = false;
   options.neo_hookean_tail = true;
   const MatX centres = centres_for(train, 20);
-  const material::RbfCorrection with = fit_rbf_correction(RbfDesign(centres, options), train).correction;
+  const material::RbfCorrection with
+      = fit_rbf_correction(RbfDesign(centres, options), train).correction;
   options.neo_hookean_tail = false;
-  const material::RbfCorrection without = fit_rbf_correction(RbfDesign(centres, options), train).correction;
+  const material::RbfCorrection without
+      = fit_rbf_correction(RbfDesign(centres, options), train).correction;
   for (const Vec3& s : { Vec3(1.1, 1.0, 0.45), Vec3(0.9, 0.7, 0.5) }) {
     const Vec3 want = truth(s, Vec3::Zero());
     const double e_with = (with.correction(s, Vec3::Zero()) - want).norm() / want.norm();
     const double e_without = (without.correction(s, Vec3::Zero()) - want).norm() / want.norm();
-    std::cout << "[ barrier  ] σ = " << s.transpose() << ": relative error " << e_with << " with the tail, " << e_without << " without\n";
+    std::cout << "[ barrier  ] σ = " << s.transpose() << ": relative error " << e_with
+              << " with the tail, " << e_without << " without\n";
     EXPECT_LT(e_with, 1e-5);
     EXPECT_GT(e_without, 0.1);
   }

@@ -21,9 +21,9 @@ namespace {
 /// the Gauss–Newton Jacobian exact, so it can be compared with finite differences.
 sim::Scene small_bar(int frames) {
   sim::Scene s;
-  s.mesh = mesh::make_box_bar(Vec3(0.2, 0.05, 0.05), {4, 1, 1});
-  s.material.elastic = material::make_elastic_model(material::ElasticModelType::Corotated,
-                                                    material::Lame::from_young_poisson(2e5, 0.35));
+  s.mesh = mesh::make_box_bar(Vec3(0.2, 0.05, 0.05), { 4, 1, 1 });
+  s.material.elastic = material::make_elastic_model(
+      material::ElasticModelType::Corotated, material::Lame::from_young_poisson(2e5, 0.35));
   s.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.0);
   s.material.density = 1000;
   s.gravity = Vec3(0, -9.81, 0);
@@ -41,21 +41,26 @@ MatX random_basis(const sim::Scene& scene, int modes, unsigned seed) {
   const int n3 = 3 * scene.mesh.num_vertices();
   MatX basis(n3, modes);
   for (int i = 0; i < n3; ++i)
-    for (int j = 0; j < modes; ++j) basis(i, j) = normal(rng);
-  for (int v : scene.prescribed_vertices()) basis.middleRows(3 * v, 3).setZero();
+    for (int j = 0; j < modes; ++j)
+      basis(i, j) = normal(rng);
+  for (int v : scene.prescribed_vertices())
+    basis.middleRows(3 * v, 3).setZero();
   return basis.householderQr().householderQ() * MatX::Identity(n3, modes);
 }
 
 observe::Observation observe_all_surface(const sim::Scene& scene, const std::vector<VecX>& frames) {
   std::vector<Positions> p;
-  for (const auto& x : frames) p.emplace_back(unflatten(x));
-  return observe::observe_vertices(p, scene.dt, observe::select_visible_vertices(scene.mesh, 1.0, 1), 0.0, 1);
+  for (const auto& x : frames)
+    p.emplace_back(unflatten(x));
+  return observe::observe_vertices(
+      p, scene.dt, observe::select_visible_vertices(scene.mesh, 1.0, 1), 0.0, 1);
 }
 
 std::vector<VecX> displaced(const std::vector<VecX>& x, const MatX& basis, const VecX& z) {
   std::vector<VecX> out = x;
   const int r = static_cast<int>(basis.cols());
-  for (size_t i = 0; i < x.size(); ++i) out[i] += basis * z.segment(static_cast<Eigen::Index>(i) * r, r);
+  for (size_t i = 0; i < x.size(); ++i)
+    out[i] += basis * z.segment(static_cast<Eigen::Index>(i) * r, r);
   return out;
 }
 
@@ -66,11 +71,13 @@ TEST(SpaceTime, GradientMatchesFiniteDifferences) {
   const MatX basis = random_basis(scene, 4, 3);
   // Data a little off the simulation, and a trajectory off both: all residuals non-zero.
   observe::Observation observed = observe_all_surface(scene, run.positions);
-  for (auto& frame : observed.positions) frame.array() += 1e-3;
+  for (auto& frame : observed.positions)
+    frame.array() += 1e-3;
   std::mt19937 rng(5);
   std::normal_distribution<double> normal;
   VecX z0(static_cast<Eigen::Index>(run.positions.size()) * 4);
-  for (auto& v : z0) v = 1e-3 * normal(rng);
+  for (auto& v : z0)
+    v = 1e-3 * normal(rng);
   const auto origin = displaced(run.positions, basis, z0);
 
   TrajectoryPhysics physics(scene);
@@ -79,7 +86,8 @@ TEST(SpaceTime, GradientMatchesFiniteDifferences) {
   BlockBandedMatrix normal_matrix(scene.frames + 1, 4);
   VecX gradient;
   problem.assemble(origin, normal_matrix, gradient);
-  auto objective = [&](const VecX& z) { return problem.evaluate(displaced(origin, basis, z)).total(); };
+  auto objective
+      = [&](const VecX& z) { return problem.evaluate(displaced(origin, basis, z)).total(); };
   const VecX zero = VecX::Zero(z0.size());
   const VecX fd = test::fd_gradient(objective, zero, 1e-5);
   // 4th-order differences with step 1e-5 m on an objective of curvature ~s²K²: relative
@@ -120,22 +128,27 @@ TEST(SpaceTime, RecoversAnObservedSimulationFromAPerturbedStart) {
   std::mt19937 rng(2);
   std::normal_distribution<double> normal;
   VecX z0(static_cast<Eigen::Index>(run.positions.size()) * 6);
-  for (auto& v : z0) v = 2e-3 * normal(rng);
+  for (auto& v : z0)
+    v = 2e-3 * normal(rng);
   const auto start = displaced(run.positions, basis, z0);
 
   TrajectoryPhysics physics(scene);
   SpaceTimeOptions options;
   options.max_iterations = 20;
   options.tolerance = 1e-12;
-  const auto result = optimize_space_time(physics, basis, start, run.initial_velocity, observed, options);
+  const auto result
+      = optimize_space_time(physics, basis, start, run.initial_velocity, observed, options);
   EXPECT_LT(result.objective, 1e-8 * result.initial_objective);
   double worst = 0;
-  for (size_t i = 0; i < start.size(); ++i) worst = std::max(worst, (result.positions[i] - run.positions[i]).cwiseAbs().maxCoeff());
-  EXPECT_LT(worst, 1e-6) << "the optimum is the simulated trajectory (2 mm perturbations removed to 1 µm)";
+  for (size_t i = 0; i < start.size(); ++i)
+    worst = std::max(worst, (result.positions[i] - run.positions[i]).cwiseAbs().maxCoeff());
+  EXPECT_LT(worst, 1e-6)
+      << "the optimum is the simulated trajectory (2 mm perturbations removed to 1 µm)";
   // Eq. (5): the control forces of a physical trajectory vanish (to the simulation's tolerance).
   const auto forces = trajectory_residuals(physics, run.positions, run.initial_velocity);
   double force_scale = 0, worst_force = 0;
-  for (const auto& f : forces) worst_force = std::max(worst_force, f.cwiseAbs().maxCoeff());
+  for (const auto& f : forces)
+    worst_force = std::max(worst_force, f.cwiseAbs().maxCoeff());
   const auto gravity = physics.dof_masses() * 9.81;
   force_scale = gravity.maxCoeff();
   EXPECT_LT(worst_force, 1e-6 * force_scale);

@@ -36,7 +36,9 @@ std::shared_ptr<const material::RayleighDamping> rayleigh(double alpha1 = 0.1) {
 }
 
 /// The nominal material of the reconstruction (elastic model and Rayleigh damping).
-fem::MaterialModel nominal_material(double alpha1 = 0.1) { return { nominal(), nullptr, rayleigh(alpha1), 1000 }; }
+fem::MaterialModel nominal_material(double alpha1 = 0.1) {
+  return { nominal(), nullptr, rayleigh(alpha1), 1000 };
+}
 
 /// Smoothly deformed, rotated and moving frames of `mesh`: x = R (X + A X + s(X)) + c with a
 /// random affine part (|A_ij| ≤ 0.12) and a sine bend along x, v = W X + cos bend (|W_ij| ≤ 1/s).
@@ -133,7 +135,8 @@ struct KnownAnswer {
       , geometry(mesh, nominal_material(alpha1))
       , design(centres(), design_options(regularization)) {
     truth = random_unknowns(design, 11, elastic);
-    if (!damped) truth.tail(design.damping_unknowns()).setZero();
+    if (!damped)
+      truth.tail(design.damping_unknowns()).setZero();
     const material::RbfCorrection n = design.correction(truth);
     for (size_t t = 0; t < frames.positions.size(); ++t)
       targets.push_back(
@@ -232,7 +235,7 @@ TEST(StressReconstruction, RecoversACurvedDampingCurveWithTheQuadraticDampingTai
   const int m = static_cast<int>(centres.rows()), qe = design.elastic_unknowns();
   ASSERT_EQ(design.damping_unknowns(), m + 7);
   VecX truth = VecX::Zero(design.num_unknowns());
-  truth[qe + m] = 1.0;      // slope along s₁
+  truth[qe + m] = 1.0; // slope along s₁
   truth[qe + m + 4] = 20.0; // curvature along s₁
   const material::RbfCorrection n = design.correction(truth);
   EXPECT_EQ(design.unknowns(n), truth);
@@ -241,18 +244,23 @@ TEST(StressReconstruction, RecoversACurvedDampingCurveWithTheQuadraticDampingTai
   ASSERT_NEAR(n.stiffness_damping(far), 0.12 + 20 * 0.0144, 1e-14);
   std::vector<VecX> targets;
   for (size_t t = 0; t < frames.positions.size(); ++t)
-    targets.push_back(elastic_force_difference(mesh, n, frames.positions[t], frames.velocities[t], known.alpha1));
+    targets.push_back(
+        elastic_force_difference(mesh, n, frames.positions[t], frames.velocities[t], known.alpha1));
   const auto reconstructed = [&](const RbfDesign& d) {
-    return d.correction(
-        reconstruct_rbf_correction(known.geometry, known.dofs, d, frames.positions, frames.velocities, targets).unknowns);
+    return d.correction(reconstruct_rbf_correction(
+        known.geometry, known.dofs, d, frames.positions, frames.velocities, targets)
+                            .unknowns);
   };
-  const material::RbfCorrection with_tail = reconstructed(design), without_tail = reconstructed(linear_design);
+  const material::RbfCorrection with_tail = reconstructed(design),
+                                without_tail = reconstructed(linear_design);
   // Exact targets in the design's span: round-off and the 1e-13 Tikhonov bias only (measured
   // below 1e-9); a missing or misplaced column gives O(1).
   EXPECT_NEAR(with_tail.parameters().damping_quadratic[0], 20.0, 1e-6);
   EXPECT_NEAR(with_tail.stiffness_damping(far), n.stiffness_damping(far), 1e-8);
-  const double off = std::abs(without_tail.stiffness_damping(far) - n.stiffness_damping(far)) / n.stiffness_damping(far);
-  std::cout << "[ damping  ] Δα₁ at s₁ = 1.12 without the quadratic tail: " << off * 100 << " % off\n";
+  const double off = std::abs(without_tail.stiffness_damping(far) - n.stiffness_damping(far))
+      / n.stiffness_damping(far);
+  std::cout << "[ damping  ] Δα₁ at s₁ = 1.12 without the quadratic tail: " << off * 100
+            << " % off\n";
   EXPECT_GT(off, 0.05); // measured 17 %
 }
 
@@ -266,33 +274,40 @@ TEST(StressReconstruction, ProjectedFitIgnoresTargetForcesOutsideTheProjection) 
   std::mt19937 random(5);
   std::normal_distribution<double> normal;
   MatX basis(free, 24); // 24 × 10 frames = 240 equations for 35 unknowns
-  for (Eigen::Index i = 0; i < basis.size(); ++i) basis.data()[i] = normal(random);
-  const MatX projection = Eigen::HouseholderQR<MatX>(basis).householderQ() * MatX::Identity(free, 24);
+  for (Eigen::Index i = 0; i < basis.size(); ++i)
+    basis.data()[i] = normal(random);
+  const MatX projection
+      = Eigen::HouseholderQR<MatX>(basis).householderQ() * MatX::Identity(free, 24);
   std::vector<VecX> perturbed = k.targets;
   for (VecX& target : perturbed) {
     VecX noise(free);
-    for (Eigen::Index i = 0; i < free; ++i) noise[i] = normal(random);
+    for (Eigen::Index i = 0; i < free; ++i)
+      noise[i] = normal(random);
     noise -= projection * (projection.transpose() * noise); // ⟂ span P
     VecX full = VecX::Zero(k.dofs.num_dofs());
     for (int d = 0; d < k.dofs.num_dofs(); ++d)
-      if (k.dofs.free_index(d) >= 0) full[d] = noise[k.dofs.free_index(d)];
+      if (k.dofs.free_index(d) >= 0)
+        full[d] = noise[k.dofs.free_index(d)];
     target += 0.5 * target.norm() / full.norm() * full;
   }
-  const auto error = [&](const StressReconstructionResult& r) { return (r.unknowns - k.truth).norm() / k.truth.norm(); };
+  const auto error = [&](const StressReconstructionResult& r) {
+    return (r.unknowns - k.truth).norm() / k.truth.norm();
+  };
   StressReconstructionOptions o;
   o.full_space_weight = 0;
-  const auto projected = reconstruct_rbf_correction(
-      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, perturbed, o, projection);
+  const auto projected = reconstruct_rbf_correction(k.geometry, k.dofs, k.design,
+      k.frames.positions, k.frames.velocities, perturbed, o, projection);
   // Exact data within span P: round-off only (measured 3e-11; μ = 0.1: 0.49, unprojected: 0.99).
   EXPECT_LT(error(projected), 1e-6);
   const auto unprojected = reconstruct_rbf_correction(
       k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, perturbed);
   EXPECT_GT(error(unprojected), 1e-3);
   o.full_space_weight = 0.1;
-  const auto mixed = reconstruct_rbf_correction(
-      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, perturbed, o, projection);
-  std::printf("[ measured ] relative unknowns error: projected %.2e, μ = 0.1 %.2e, unprojected %.2e\n",
-              error(projected), error(mixed), error(unprojected));
+  const auto mixed = reconstruct_rbf_correction(k.geometry, k.dofs, k.design, k.frames.positions,
+      k.frames.velocities, perturbed, o, projection);
+  std::printf(
+      "[ measured ] relative unknowns error: projected %.2e, μ = 0.1 %.2e, unprojected %.2e\n",
+      error(projected), error(mixed), error(unprojected));
   EXPECT_GT(error(mixed), error(projected));
   EXPECT_LT(error(mixed), error(unprojected));
   // The reported misfit is the unprojected one (the perturbation is in it).

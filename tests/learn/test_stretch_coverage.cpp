@@ -15,7 +15,8 @@ namespace {
 /// The bar's vertices mapped by x = F X (flat 3n): every element's deformation gradient is F.
 VecX deformed(const mesh::TetMesh& mesh, const Mat3& F) {
   VecX x(3 * mesh.num_vertices());
-  for (int v = 0; v < mesh.num_vertices(); ++v) x.segment<3>(3 * v) = F * mesh.rest_positions().row(v).transpose();
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    x.segment<3>(3 * v) = F * mesh.rest_positions().row(v).transpose();
   return x;
 }
 
@@ -25,7 +26,7 @@ Mat3 rotated_stretch(const Vec3& s) {
 }
 
 const mesh::TetMesh& bar() {
-  static const mesh::TetMesh m = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), {4, 1, 1});
+  static const mesh::TetMesh m = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 4, 1, 1 });
   return m;
 }
 
@@ -33,7 +34,8 @@ const mesh::TetMesh& bar() {
 
 TEST(StretchCoverage, RangeOfHomogeneousDeformationsIsTheirSortedStretches) {
   // Stretches given unsorted: the range is over sorted s₁ ≥ s₂ ≥ s₃.
-  const std::vector<VecX> frames = {deformed(bar(), Mat3::Identity()), deformed(bar(), rotated_stretch(Vec3(0.97, 1.1, 1.0)))};
+  const std::vector<VecX> frames = { deformed(bar(), Mat3::Identity()),
+    deformed(bar(), rotated_stretch(Vec3(0.97, 1.1, 1.0))) };
   const material::StretchRange r = trajectory_stretch_range(bar(), frames);
   EXPECT_NEAR((r.min - Vec3(1.0, 1.0, 0.97)).cwiseAbs().maxCoeff(), 0, 1e-12);
   EXPECT_NEAR((r.max - Vec3(1.1, 1.0, 1.0)).cwiseAbs().maxCoeff(), 0, 1e-12);
@@ -45,14 +47,15 @@ TEST(StretchCoverage, CountsSamplesOutsideTheTrainingRangeBeyondTheTolerance) {
   trained.include(Vec3(1.0, 0.99, 0.95));
   StretchCoverage coverage(bar(), trained, 1e-3);
   const long m = bar().num_tets();
-  coverage.add_frame(deformed(bar(), rotated_stretch(Vec3(1.02, 1.0, 0.97))));    // inside
-  coverage.add_frame(deformed(bar(), rotated_stretch(Vec3(1.0505, 0.995, 0.96)))); // s₁ 0.0005 over: within tolerance
+  coverage.add_frame(deformed(bar(), rotated_stretch(Vec3(1.02, 1.0, 0.97)))); // inside
+  coverage.add_frame(deformed(
+      bar(), rotated_stretch(Vec3(1.0505, 0.995, 0.96)))); // s₁ 0.0005 over: within tolerance
   EXPECT_EQ(coverage.samples(), 2 * m);
   EXPECT_EQ(coverage.samples_outside(), 0);
   EXPECT_EQ(extrapolation_note(coverage), "");
 
   coverage.add_frame(deformed(bar(), rotated_stretch(Vec3(1.0, 0.99, 0.94)))); // s₃ 0.01 below
-  coverage.add_frame(deformed(bar(), rotated_stretch(Vec3(1.1, 0.99, 0.96))));  // s₁ 0.05 above
+  coverage.add_frame(deformed(bar(), rotated_stretch(Vec3(1.1, 0.99, 0.96)))); // s₁ 0.05 above
   EXPECT_EQ(coverage.samples(), 4 * m);
   EXPECT_EQ(coverage.samples_outside(), 2 * m);
   EXPECT_DOUBLE_EQ(coverage.fraction_outside(), 0.5);
@@ -69,7 +72,8 @@ TEST(StretchCoverage, RefusesAFrameOfAnotherMesh) {
 }
 
 TEST(StretchCoverage, NoCorrectionHasNoTrainingRange) {
-  // The nominal model extrapolates nothing learned. (With a correction: tests/app/test_cli_learn.cpp.)
+  // The nominal model extrapolates nothing learned. (With a correction:
+  // tests/app/test_cli_learn.cpp.)
   sim::Scene scene;
   scene.mesh = bar();
   EXPECT_FALSE(training_stretch_range(scene, nullptr).has_value());

@@ -30,19 +30,21 @@ Mat9 reference_derivative(const PrincipalFrame& f, const Vec3& P, const Mat3& dP
   if (project) {
     const Mat3 S = 0.5 * (dP + dP.transpose());
     Eigen::SelfAdjointEigenSolver<Mat3> eig(S);
-    A = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
-        eig.eigenvectors().transpose();
+    A = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal()
+        * eig.eigenvectors().transpose();
   }
   Mat9 K = Mat9::Zero();
   for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i) K(4 * i, 4 * j) = A(i, j);
+    for (int i = 0; i < 3; ++i)
+      K(4 * i, 4 * j) = A(i, j);
   for (const auto& [i, j] : { std::pair { 0, 1 }, std::pair { 0, 2 }, std::pair { 1, 2 } }) {
     const double scale = std::max({ 1.0, std::abs(s[i]), std::abs(s[j]) });
     double twist = std::abs(s[i] - s[j]) > gap * scale
         ? (P[i] - P[j]) / (s[i] - s[j])
         : 0.5 * ((dP(i, i) - dP(i, j)) + (dP(j, j) - dP(j, i)));
     double sum = s[i] + s[j];
-    if (std::abs(sum) < gap * scale) sum = std::copysign(gap * scale, sum);
+    if (std::abs(sum) < gap * scale)
+      sum = std::copysign(gap * scale, sum);
     double flip = (P[i] + P[j]) / sum;
     if (project) {
       twist = std::max(twist, 0.0);
@@ -56,7 +58,8 @@ Mat9 reference_derivative(const PrincipalFrame& f, const Vec3& P, const Mat3& dP
   for (int l = 0; l < 3; ++l)
     for (int k = 0; k < 3; ++k)
       for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 3; ++i) W(i + 3 * j, k + 3 * l) = f.U(i, k) * f.V(j, l);
+        for (int i = 0; i < 3; ++i)
+          W(i + 3 * j, k + 3 * l) = f.U(i, k) * f.V(j, l);
   return W * K * W.transpose();
 }
 
@@ -68,7 +71,7 @@ void expect_same(const Mat9& fast, const Mat9& reference) {
 }
 
 template <typename Factory> class FirstPiolaDerivativeStructure : public ::testing::Test {
-protected:
+  protected:
   std::unique_ptr<ElasticModel> model = Factory::make();
 };
 TYPED_TEST_SUITE(FirstPiolaDerivativeStructure, AllModelFactories);
@@ -86,7 +89,8 @@ TYPED_TEST(FirstPiolaDerivativeStructure, MatchesDenseKroneckerFormula) {
     const Mat3 dP = m.principal_stress_derivative(f.stretches);
     for (bool project : { false, true }) {
       SCOPED_TRACE(project ? "projected" : "exact");
-      expect_same(first_piola_derivative(f, P, dP, project), reference_derivative(f, P, dP, project));
+      expect_same(
+          first_piola_derivative(f, P, dP, project), reference_derivative(f, P, dP, project));
     }
   }
 }
@@ -105,7 +109,8 @@ TEST(FirstPiolaDerivativeGeneral, NonSymmetricAndIndefiniteStressDerivatives) {
     const Vec3 P(u(rng), u(rng), u(rng));
     const PrincipalFrame f = principal_frame(F);
     for (bool project : { false, true })
-      expect_same(first_piola_derivative(f, P, dP, project), reference_derivative(f, P, dP, project));
+      expect_same(
+          first_piola_derivative(f, P, dP, project), reference_derivative(f, P, dP, project));
   }
 }
 

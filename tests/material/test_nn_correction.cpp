@@ -56,7 +56,8 @@ Vec3 reference_output(const NnCorrection::Parameters& p, const Vec3& s, const Ve
   for (int k = 0; k < 3; ++k) {
     const int a = (k + 1) % 3, b = (k + 2) % 3;
     VecX x(6);
-    x << s[k], s[a] + s[b], std::pow(s[a] - s[b], 2) / 2, f[k], f[a] + f[b], (s[a] - s[b]) * (f[a] - f[b]);
+    x << s[k], s[a] + s[b], std::pow(s[a] - s[b], 2) / 2, f[k], f[a] + f[b],
+        (s[a] - s[b]) * (f[a] - f[b]);
     x = (x - p.input_mean).cwiseQuotient(p.input_scale);
     for (std::size_t l = 0; l < p.layers.size(); ++l) {
       x = p.layers[l].weight * x + p.layers[l].bias;
@@ -102,8 +103,8 @@ TEST(NnCorrection, MatchesTheDocumentedFormula) {
 TEST(NnCorrection, GradientMatchesFiniteDifference) {
   // The network is smooth except where a pre-activation crosses 0 (ELU's second derivative
   // jumps there, the first does not). At these fixed states no crossing lies within the FD
-  // stencil (4·1e-5), so the O(h⁴) truncation error is ~1e-12 relative and round-off in the quotient of values ~1e3 Pa is ~1e-16·1e3/1e-5 ≈ 1e-8 Pa
-  // against gradients ~1e4: 1e-7 tolerance.
+  // stencil (4·1e-5), so the O(h⁴) truncation error is ~1e-12 relative and round-off in the
+  // quotient of values ~1e3 Pa is ~1e-16·1e3/1e-5 ≈ 1e-8 Pa against gradients ~1e4: 1e-7 tolerance.
   for (const auto& hidden : { std::vector<int> { 6, 6 }, std::vector<int> { 12 },
            std::vector<int> { 32, 8, 5 }, std::vector<int> {} }) {
     const NnCorrection n(test_parameters(hidden));
@@ -154,15 +155,16 @@ TEST(NnCorrection, EqualStretchesGiveExactlyEqualOutputs) {
   // Both directions of a repeated stretch evaluate the same network on bit-identical inputs —
   // at zero rate (the elastic part) and at equal rates — whatever the other rate is.
   const NnCorrection n(test_parameters());
-  for (const Vec3& s : { Vec3(1.1, 1.1, 0.9), Vec3(0.8, 1.2, 1.2), Vec3(1.05, 0.7, 1.05),
-           Vec3::Ones().eval() }) {
+  for (const Vec3& s :
+      { Vec3(1.1, 1.1, 0.9), Vec3(0.8, 1.2, 1.2), Vec3(1.05, 0.7, 1.05), Vec3::Ones().eval() }) {
     for (const Vec3& rates : { Vec3::Zero().eval(), Vec3(0.2, 0.2, 0.2), Vec3(0.4, 0.4, -0.3),
              Vec3(0.4, -0.3, 0.4), Vec3(-0.3, 0.4, 0.4) }) {
       const Vec3 out = n.correction(s, rates);
       for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
           if (s[i] == s[j] && rates[i] == rates[j]) {
-            EXPECT_EQ(out[i], out[j]) << "stretches " << s.transpose() << " rates " << rates.transpose();
+            EXPECT_EQ(out[i], out[j])
+                << "stretches " << s.transpose() << " rates " << rates.transpose();
           }
         }
       }
@@ -196,7 +198,8 @@ TEST(NnCorrection, StressIsContinuousAcrossARepeatedStretch) {
   const NnCorrection n(test_parameters());
   const Mat3 R = rotation(0.7, Vec3(1, 2, 3)), Q = rotation(-0.4, Vec3(-2, 1, 1));
   const Mat3 F_rate = (Mat3() << 0.3, -0.8, 0.2, 0.5, 0.1, -0.6, -0.4, 0.7, 0.9).finished();
-  const auto F_at = [&](double t) { return Mat3(R * Vec3(1.1, 1 + t, 1 - t).asDiagonal() * Q.transpose()); };
+  const auto F_at
+      = [&](double t) { return Mat3(R * Vec3(1.1, 1 + t, 1 - t).asDiagonal() * Q.transpose()); };
   const double scale = 1.5e3; // |N| ~ output_scale
 
   // At the tie (σ₂ = σ₃ = 1) U and V are unique only up to a common rotation in the degenerate
@@ -208,8 +211,10 @@ TEST(NnCorrection, StressIsContinuousAcrossARepeatedStretch) {
     const Mat3 G = rotation(angle, Vec3::UnitX());
     turned.U = frame.U * G;
     turned.V = frame.V * G;
-    ASSERT_LT((turned.U * turned.stretches.asDiagonal() * turned.V.transpose() - F_at(0)).norm(), 1e-12);
-    EXPECT_LT((corrected_piola(n, turned, Mat3::Zero()) - corrected_piola(n, frame, Mat3::Zero())).norm(),
+    ASSERT_LT(
+        (turned.U * turned.stretches.asDiagonal() * turned.V.transpose() - F_at(0)).norm(), 1e-12);
+    EXPECT_LT(
+        (corrected_piola(n, turned, Mat3::Zero()) - corrected_piola(n, frame, Mat3::Zero())).norm(),
         1e-12 * scale)
         << "angle " << angle;
   }
@@ -225,7 +230,8 @@ TEST(NnCorrection, StressIsContinuousAcrossARepeatedStretch) {
 
   struct RatesOrderedByStretch final : Correction {
     const NnCorrection& net;
-    explicit RatesOrderedByStretch(const NnCorrection& n) : net(n) {}
+    explicit RatesOrderedByStretch(const NnCorrection& n)
+        : net(n) { }
     std::string name() const override { return "sorted-rates"; }
     Vec3 correction(const Vec3& s, const Vec3& f) const override {
       Vec3 out;
@@ -237,7 +243,7 @@ TEST(NnCorrection, StressIsContinuousAcrossARepeatedStretch) {
       }
       return out;
     }
-    void correction_gradient(const Vec3&, const Vec3&, Mat3&, Mat3&) const override {}
+    void correction_gradient(const Vec3&, const Vec3&, Mat3&, Mat3&) const override { }
     std::unique_ptr<Correction> clone() const override { return nullptr; }
   } sorted_rates(n);
   const Mat3 jump = corrected_piola(sorted_rates, principal_frame(F_at(h)), F_rate)

@@ -135,7 +135,8 @@ TEST(RbfCorrection, EqualStretchesGiveEqualStresses) {
   // P = U diag(P̂ + N) Vᵀ is a function of F only if N_i = N_j whenever σ_i = σ_j (U, V are not
   // unique there). Exact equality: both directions evaluate the same view of the stretches.
   const RbfCorrection n(test_parameters(1e-3));
-  for (const Vec3& s : { Vec3(1.1, 1.1, 0.9), Vec3(0.8, 1.2, 1.2), Vec3(1.05, 0.7, 1.05), Vec3::Ones().eval() }) {
+  for (const Vec3& s :
+      { Vec3(1.1, 1.1, 0.9), Vec3(0.8, 1.2, 1.2), Vec3(1.05, 0.7, 1.05), Vec3::Ones().eval() }) {
     const Vec3 rates = Vec3(0.2, 0.2, 0.2);
     const Vec3 out = n.correction(s, rates);
     for (int i = 0; i < 3; ++i) {
@@ -159,21 +160,23 @@ TEST(RbfCorrection, ElasticAndDampingPartsAreTheDocumentedRbfs) {
   // N(σ) and Δα₁(σ) are the documented RBF + linear tail; N does not see the stretch rates (the
   // damping acts through Δα₁ on the nominal stiffness, fem::ElasticForce).
   double expected_alpha = p.damping_slopes.dot(s - Vec3::Ones()) + p.damping_constant; // s sorted ↓
-  for (int k = 0; k < 3; ++k) expected_alpha += p.damping_quadratic[k] * (s[k] - 1) * (s[k] - 1);
+  for (int k = 0; k < 3; ++k)
+    expected_alpha += p.damping_quadratic[k] * (s[k] - 1) * (s[k] - 1);
   Vec3 expected_elastic;
   for (int k = 0; k < 3; ++k) {
     const Vec3 y = stretch_view(s, k);
-    expected_elastic[k] = p.own_slope * (y[0] - 1) + p.other_slope * (y[1] + y[2] - 2) + p.constant +
-                          p.quadratic[0] * (y[0] - 1) * (y[0] - 1) + p.quadratic[1] * (y[0] - 1) * (y[1] + y[2] - 2) +
-                          p.quadratic[2] * (y[1] + y[2] - 2) * (y[1] + y[2] - 2) +
-                          p.quadratic[3] * (y[1] - 1) * (y[2] - 1) +
-                          p.neo_hookean[0] * (y[0] + 1 / y[0] - 2) +
-                          p.neo_hookean[1] * (std::log(y[0] * y[1] * y[2]) / y[0] - (y[0] + y[1] + y[2] - 3));
+    expected_elastic[k] = p.own_slope * (y[0] - 1) + p.other_slope * (y[1] + y[2] - 2) + p.constant
+        + p.quadratic[0] * (y[0] - 1) * (y[0] - 1) + p.quadratic[1] * (y[0] - 1) * (y[1] + y[2] - 2)
+        + p.quadratic[2] * (y[1] + y[2] - 2) * (y[1] + y[2] - 2)
+        + p.quadratic[3] * (y[1] - 1) * (y[2] - 1) + p.neo_hookean[0] * (y[0] + 1 / y[0] - 2)
+        + p.neo_hookean[1] * (std::log(y[0] * y[1] * y[2]) / y[0] - (y[0] + y[1] + y[2] - 3));
     for (int i = 0; i < 6; ++i)
-      expected_elastic[k] += p.weights[i] * rbf_kernel((y - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
+      expected_elastic[k]
+          += p.weights[i] * rbf_kernel((y - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
   }
   for (int i = 0; i < 6; ++i) // s is sorted descending already
-    expected_alpha += p.damping_weights[i] * rbf_kernel((s - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
+    expected_alpha += p.damping_weights[i]
+        * rbf_kernel((s - p.centres.row(i).transpose()).squaredNorm(), p.epsilon);
   EXPECT_EQ(stretch_view(Vec3(1.0, 2.0, 3.0), 0), Vec3(1.0, 3.0, 2.0));
   EXPECT_NEAR(n.stiffness_damping(s), expected_alpha, 1e-14);
   // Δα₁ is a symmetric function of the stretches.
@@ -194,7 +197,8 @@ TEST(RbfCorrection, DampingFloorBoundsTheDampingCorrection) {
   p.damping_quadratic.setZero();
   p.damping_floor = -0.05;
   const RbfCorrection n(p);
-  EXPECT_NEAR(n.stiffness_damping(Vec3(1.0, 1.1, 0.95)), 0.1, 1e-14); // the largest stretch, wherever it is
+  EXPECT_NEAR(
+      n.stiffness_damping(Vec3(1.0, 1.1, 0.95)), 0.1, 1e-14); // the largest stretch, wherever it is
   EXPECT_EQ(n.stiffness_damping(Vec3(0.9, 0.8, 0.85)), -0.05); // −0.1 clamped
 }
 
@@ -263,10 +267,14 @@ TEST(RbfCorrection, BlendIsTheWeightedSumOfTwoCorrections) {
   const RbfCorrection half = blend(a, &b, 0.25), none = blend(a, nullptr, 0.5);
   EXPECT_EQ(half.num_centres(), 12);
   for (const Vec3& s : { Vec3(1.2, 1.0, 0.9), Vec3(0.95, 0.9, 0.8), Vec3(1.1, 1.1, 1.0) }) {
-    EXPECT_LE((half.correction(s, Vec3::Zero()) - (0.75 * a.correction(s, Vec3::Zero()) + 0.25 * b.correction(s, Vec3::Zero()))).norm(),
-              1e-9 * a.correction(s, Vec3::Zero()).norm());
-    EXPECT_NEAR(half.stiffness_damping(s), 0.75 * a.stiffness_damping(s) + 0.25 * b.stiffness_damping(s), 1e-14);
-    EXPECT_LE((none.correction(s, Vec3::Zero()) - 0.5 * a.correction(s, Vec3::Zero())).norm(), 1e-9 * a.correction(s, Vec3::Zero()).norm());
+    EXPECT_LE((half.correction(s, Vec3::Zero())
+                  - (0.75 * a.correction(s, Vec3::Zero()) + 0.25 * b.correction(s, Vec3::Zero())))
+                  .norm(),
+        1e-9 * a.correction(s, Vec3::Zero()).norm());
+    EXPECT_NEAR(half.stiffness_damping(s),
+        0.75 * a.stiffness_damping(s) + 0.25 * b.stiffness_damping(s), 1e-14);
+    EXPECT_LE((none.correction(s, Vec3::Zero()) - 0.5 * a.correction(s, Vec3::Zero())).norm(),
+        1e-9 * a.correction(s, Vec3::Zero()).norm());
   }
   pb.epsilon = 0.1;
   const RbfCorrection smoother(pb);
@@ -283,8 +291,10 @@ TEST(RbfCorrection, RepeatedBlendsWithTheSameCorrectionKeepSharedCentresOnce) {
   const RbfCorrection quarter = blend(blend(c, &best, 0.5), &best, 0.5);
   EXPECT_EQ(quarter.num_centres(), c.num_centres() + best.num_centres());
   for (const Vec3& s : { Vec3(1.2, 1.0, 0.9), Vec3(0.95, 0.9, 0.8), Vec3(1.1, 1.1, 1.0) }) {
-    const Vec3 want = 0.25 * c.correction(s, Vec3::Zero()) + 0.75 * best.correction(s, Vec3::Zero());
+    const Vec3 want
+        = 0.25 * c.correction(s, Vec3::Zero()) + 0.75 * best.correction(s, Vec3::Zero());
     EXPECT_LE((quarter.correction(s, Vec3::Zero()) - want).norm(), 1e-12 * want.norm());
-    EXPECT_NEAR(quarter.stiffness_damping(s), 0.25 * c.stiffness_damping(s) + 0.75 * best.stiffness_damping(s), 1e-14);
+    EXPECT_NEAR(quarter.stiffness_damping(s),
+        0.25 * c.stiffness_damping(s) + 0.75 * best.stiffness_damping(s), 1e-14);
   }
 }

@@ -51,7 +51,8 @@ void expect_matches_jacobi(const Mat3& F, const PrincipalFrame& f) {
 Mat3 random_matrix(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1, 1);
   Mat3 F;
-  for (int k = 0; k < 9; ++k) F.data()[k] = u(rng);
+  for (int k = 0; k < 9; ++k)
+    F.data()[k] = u(rng);
   return F;
 }
 
@@ -89,8 +90,9 @@ TEST(Svd3, RepeatedAndNearRepeatedSingularValues) {
   std::mt19937 rng(13);
   const double gaps[] = { 0.0, 1e-15, 1e-12, 1e-9, 1e-6, 1e-3 };
   for (double gap : gaps) {
-    for (const Vec3& s : { Vec3(1 + gap, 1, 0.5), Vec3(1, 0.5 + gap, 0.5), Vec3(1 + 2 * gap, 1 + gap, 1),
-             Vec3(1 + gap, 1, -1), Vec3(2, 1 + gap, -1), Vec3(1 + gap, 1, 0) }) {
+    for (const Vec3& s :
+        { Vec3(1 + gap, 1, 0.5), Vec3(1, 0.5 + gap, 0.5), Vec3(1 + 2 * gap, 1 + gap, 1),
+            Vec3(1 + gap, 1, -1), Vec3(2, 1 + gap, -1), Vec3(1 + gap, 1, 0) }) {
       for (int trial = 0; trial < 20; ++trial) {
         const Mat3 F = random_rotation(rng) * s.asDiagonal() * random_rotation(rng).transpose();
         SCOPED_TRACE(::testing::Message() << "gap " << gap << " s " << s.transpose());
@@ -131,7 +133,8 @@ TEST(Svd3, GradedColumnsKeepRelativeAccuracyOfTinySingularValues) {
     const Mat3 F = random_rotation(rng) * d.asDiagonal();
     const PrincipalFrame f = svd3(F);
     expect_valid_frame(F, f);
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(f.stretches[k], d[k], 1e-13 * d[k]) << k;
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(f.stretches[k], d[k], 1e-13 * d[k]) << k;
   }
 }
 
@@ -144,8 +147,8 @@ TEST(Svd3, DegenerateAndSpecialMatrices) {
   Mat3 rank_two = rank_one + Vec3(0, 1, -1) * Vec3(1, 1, 1).transpose();
   Mat3 single_entry = Mat3::Zero();
   single_entry(2, 1) = -3;
-  for (const Mat3& F : { Mat3(Mat3::Identity()), Mat3(-Mat3::Identity()), permutation, odd_permutation,
-           rank_one, rank_two, single_entry, Mat3(Vec3(3, -2, 1).asDiagonal()),
+  for (const Mat3& F : { Mat3(Mat3::Identity()), Mat3(-Mat3::Identity()), permutation,
+           odd_permutation, rank_one, rank_two, single_entry, Mat3(Vec3(3, -2, 1).asDiagonal()),
            Mat3(Vec3(-1, -1, 1).asDiagonal()), Mat3(Mat3::Constant(1.0)) }) {
     SCOPED_TRACE(::testing::Message() << "F\n" << F);
     const PrincipalFrame f = svd3(F);
@@ -192,8 +195,8 @@ TEST(Svd3, SingularVectorsMatchJacobiForDistinctValues) {
   // Where singular values are well separated the singular vectors are unique up to sign.
   std::mt19937 rng(17);
   for (int trial = 0; trial < 200; ++trial) {
-    const Mat3 F = random_rotation(rng) * Vec3(2.0, 1.0, 0.4).asDiagonal() *
-                   random_rotation(rng).transpose();
+    const Mat3 F = random_rotation(rng) * Vec3(2.0, 1.0, 0.4).asDiagonal()
+        * random_rotation(rng).transpose();
     const Eigen::JacobiSVD<Mat3> ref(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const PrincipalFrame f = svd3(F);
     for (int k = 0; k < 3; ++k) {

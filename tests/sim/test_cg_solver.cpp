@@ -30,26 +30,32 @@ struct TestSystem {
 };
 
 TestSystem make_system(bool shuffle, double shift) {
-  const auto mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), {40, 10, 10});
+  const auto mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 40, 10, 10 });
   std::vector<int> order(mesh.num_vertices());
   std::iota(order.begin(), order.end(), 0);
-  if (shuffle) std::shuffle(order.begin(), order.end(), std::mt19937(7));
+  if (shuffle)
+    std::shuffle(order.begin(), order.end(), std::mt19937(7));
   Tets tets = mesh.tets();
-  for (int i = 0; i < tets.size(); ++i) tets.data()[i] = order[tets.data()[i]];
+  for (int i = 0; i < tets.size(); ++i)
+    tets.data()[i] = order[tets.data()[i]];
   std::vector<int> fixed = mesh::vertices_with_min_coordinate(mesh, 0, 1e-9);
-  for (int& v : fixed) v = order[v];
-  TestSystem s{fem::SystemMatrix(tets, fem::DofMap(mesh.num_vertices(), fixed)), shift};
+  for (int& v : fixed)
+    v = order[v];
+  TestSystem s { fem::SystemMatrix(tets, fem::DofMap(mesh.num_vertices(), fixed)), shift };
   s.system.add_elements([](int e, Mat12& K) {
     std::minstd_rand rng(e + 1); // cheap to seed per element
     std::uniform_real_distribution<double> u(-1, 1);
     Mat3 C;
     Eigen::Matrix<double, 3, 12> B;
-    for (int i = 0; i < 9; ++i) C.data()[i] = u(rng);
-    for (int i = 0; i < 36; ++i) B.data()[i] = 0.2 * u(rng);
+    for (int i = 0; i < 9; ++i)
+      C.data()[i] = u(rng);
+    for (int i = 0; i < 36; ++i)
+      B.data()[i] = 0.2 * u(rng);
     const Mat3 S = C * C.transpose() + 0.5 * Mat3::Identity();
     K = B.transpose() * B;
     for (int a = 0; a < 4; ++a)
-      for (int c = 0; c < 4; ++c) K.block<3, 3>(3 * a, 3 * c) += (a == c ? 3.0 : -1.0) * S;
+      for (int c = 0; c < 4; ++c)
+        K.block<3, 3>(3 * a, 3 * c) += (a == c ? 3.0 : -1.0) * S;
   });
   s.system.add_diagonal(VecX::Ones(s.system.size()), shift);
   return s;
@@ -59,7 +65,8 @@ VecX random_vector(Eigen::Index n, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal;
   VecX b(n);
-  for (double& v : b) v = normal(rng);
+  for (double& v : b)
+    v = normal(rng);
   return b;
 }
 
@@ -71,17 +78,18 @@ double condition_bound(const TestSystem& s) {
 
 } // namespace
 
-class CgSolver : public ::testing::TestWithParam<bool> {};
+class CgSolver : public ::testing::TestWithParam<bool> { };
 
 TEST_P(CgSolver, MatchesTheDirectSolveToTheRequestedTolerance) {
   // One analysed CG solver for two matrices of the same pattern (factorize refreshes the values).
   const double tol = 1e-10;
   auto cg = sim::make_linear_solver(sim::LinearSolverType::ConjugateGradient);
   bool analyzed = false;
-  for (double shift : {1e-2, 1.0}) {
+  for (double shift : { 1e-2, 1.0 }) {
     const TestSystem s = make_system(GetParam(), shift);
     const auto& A = s.system.matrix();
-    if (!analyzed) cg->analyze(A), analyzed = true;
+    if (!analyzed)
+      cg->analyze(A), analyzed = true;
     ASSERT_TRUE(cg->factorize(A));
     const VecX b = random_vector(A.rows(), 1);
     VecX x;
@@ -109,7 +117,7 @@ TEST_P(CgSolver, FloatProductSteersAsWellAsADoubleOne) {
   // recurrence (measured: 1 more of 59–79). A wrong float product converges to a wrong x,
   // fails the true-residual test and restarts, ending in the double product: many more.
   const double tol = 1e-6;
-  for (double shift : {1e-2, 1.0}) {
+  for (double shift : { 1e-2, 1.0 }) {
     const TestSystem s = make_system(GetParam(), shift);
     const auto& A = s.system.matrix();
     auto cg = sim::make_linear_solver(sim::LinearSolverType::ConjugateGradient);
@@ -118,7 +126,8 @@ TEST_P(CgSolver, FloatProductSteersAsWellAsADoubleOne) {
     const VecX b = random_vector(A.rows(), 1);
     VecX x;
     ASSERT_TRUE(cg->solve(b, x, tol));
-    Eigen::ConjugateGradient<fem::SparseMatrix, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<double>>
+    Eigen::ConjugateGradient<fem::SparseMatrix, Eigen::Lower | Eigen::Upper,
+        Eigen::DiagonalPreconditioner<double>>
         eigen_cg(A);
     eigen_cg.setTolerance(tol);
     const VecX eigen_x = eigen_cg.solve(b);
@@ -148,12 +157,13 @@ TEST_P(CgSolver, BitIdenticalForAnyThreadCount) {
   };
   const auto [x1, iterations1] = solve_with(1);
   ASSERT_GT(x1.norm(), 0);
-  for (int threads : {1, 2, 2}) {
+  for (int threads : { 1, 2, 2 }) {
     const auto [x, iterations] = solve_with(threads);
     EXPECT_EQ(iterations, iterations1) << threads << " threads";
-    EXPECT_TRUE(x == x1) << threads << " threads: max difference " << (x - x1).cwiseAbs().maxCoeff();
+    EXPECT_TRUE(x == x1) << threads << " threads: max difference "
+                         << (x - x1).cwiseAbs().maxCoeff();
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, CgSolver, ::testing::Values(false, true),
-                         [](const auto& info) { return info.param ? "ShuffledVertices" : "LatticeOrder"; });
+    [](const auto& info) { return info.param ? "ShuffledVertices" : "LatticeOrder"; });

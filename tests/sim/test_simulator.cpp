@@ -17,12 +17,14 @@ using namespace elastolearn;
 namespace {
 
 /// A clamped bar (x = 0 fixed) of 6-tet cubes, lumped mass, gravity −y.
-sim::Scene bar_scene(const Vec3& size, const std::array<int, 3>& cells, double young, double poisson,
-                     double alpha0 = 0, double alpha1 = 0) {
+sim::Scene bar_scene(const Vec3& size, const std::array<int, 3>& cells, double young,
+    double poisson, double alpha0 = 0, double alpha1 = 0) {
   sim::Scene s;
   s.mesh = mesh::make_box_bar(size, cells);
-  s.material.elastic = std::make_shared<material::CorotatedModel>(material::Lame::from_young_poisson(young, poisson));
-  if (alpha0 != 0 || alpha1 != 0) s.material.damping = std::make_shared<material::RayleighDamping>(alpha0, alpha1);
+  s.material.elastic = std::make_shared<material::CorotatedModel>(
+      material::Lame::from_young_poisson(young, poisson));
+  if (alpha0 != 0 || alpha1 != 0)
+    s.material.damping = std::make_shared<material::RayleighDamping>(alpha0, alpha1);
   s.material.density = 1000;
   s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
   s.gravity = Vec3(0, -9.81, 0);
@@ -33,23 +35,25 @@ sim::Scene bar_scene(const Vec3& size, const std::array<int, 3>& cells, double y
 double mean_tip_y(const mesh::TetMesh& mesh, const VecX& x) {
   const auto tip = mesh::vertices_with_max_coordinate(mesh, 0, 1e-9);
   double sum = 0;
-  for (int v : tip) sum += x[3 * v + 1] - mesh.rest_positions()(v, 1);
+  for (int v : tip)
+    sum += x[3 * v + 1] - mesh.rest_positions()(v, 1);
   return sum / tip.size();
 }
 
 } // namespace
 
-class SolverBackends : public ::testing::TestWithParam<sim::LinearSolverType> {};
+class SolverBackends : public ::testing::TestWithParam<sim::LinearSolverType> { };
 
 TEST_P(SolverBackends, AllBackendsGiveTheSameDynamicSteps) {
   // Reference: CHOLMOD. Each backend converges Newton to 1e-10 relative, so states agree to
   // ~1e-9 of the displacement.
   auto run = [](sim::LinearSolverType type) {
-    auto s = bar_scene({0.4, 0.1, 0.1}, {8, 2, 2}, 3e5, 0.4, 0.2, 0.005);
+    auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
     s.linear_solver = type;
     s.newton.relative_tolerance = 1e-10;
     sim::Simulator sim(s);
-    for (int i = 0; i < 20; ++i) EXPECT_TRUE(sim.step().converged);
+    for (int i = 0; i < 20; ++i)
+      EXPECT_TRUE(sim.step().converged);
     return VecX(sim.positions() - flatten(s.mesh.rest_positions()));
   };
   const VecX reference = run(sim::LinearSolverType::Cholmod);
@@ -59,12 +63,12 @@ TEST_P(SolverBackends, AllBackendsGiveTheSameDynamicSteps) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sim, SolverBackends,
-                         ::testing::Values(sim::LinearSolverType::Cholmod, sim::LinearSolverType::ConjugateGradient,
-                                           sim::LinearSolverType::EigenLdlt),
-                         [](const auto& info) {
-                           auto n = sim::to_string(info.param);
-                           return n == "eigen-ldlt" ? std::string("EigenLdlt") : n;
-                         });
+    ::testing::Values(sim::LinearSolverType::Cholmod, sim::LinearSolverType::ConjugateGradient,
+        sim::LinearSolverType::EigenLdlt),
+    [](const auto& info) {
+      auto n = sim::to_string(info.param);
+      return n == "eigen-ldlt" ? std::string("EigenLdlt") : n;
+    });
 
 TEST(Newton, JacobianReuseMeetsTheSameToleranceWithFewerAssemblies) {
   // Dynamics: after Newton's first step leaves ~1e-3 of the residual, the chord step with the
@@ -75,7 +79,7 @@ TEST(Newton, JacobianReuseMeetsTheSameToleranceWithFewerAssemblies) {
     int iterations = 0, jacobians = 0;
   };
   auto run = [](double reuse_contraction) {
-    auto s = bar_scene({0.4, 0.1, 0.1}, {8, 2, 2}, 3e5, 0.4, 0.2, 0.005);
+    auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
     s.newton.relative_tolerance = 1e-10;
     s.newton.jacobian_reuse_contraction = reuse_contraction;
     sim::Simulator sim(s);
@@ -102,7 +106,7 @@ TEST(Newton, JacobianIsRefreshedWhenAChordStepContractsLittle) {
   // the solution contract little, so they must assemble afresh; reusing every Jacobian would
   // leave Newton crawling linearly. Reuse may cost an iteration here and there, not many.
   auto run = [](double reuse_contraction) {
-    auto s = bar_scene({0.4, 0.1, 0.1}, {8, 2, 2}, 2e4, 0.3);
+    auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 2e4, 0.3);
     s.newton.jacobian_reuse_contraction = reuse_contraction;
     sim::Simulator sim(s);
     const auto report = sim.solve_static(1);
@@ -126,15 +130,16 @@ TEST(Statics, CantileverTipDeflectionConvergesToBeamTheory) {
   const double q = rho * g * a * a, I = std::pow(a, 4) / 12, G = E / 2, kappa = 5.0 / 6.0;
   const double theory = q * std::pow(L, 4) / (8 * E * I) + q * L * L / (2 * kappa * G * a * a);
   double previous_error = INFINITY;
-  for (int n : {2, 4, 10}) {
-    auto s = bar_scene({L, a, a}, {10 * n, n, n}, E, 0.0);
+  for (int n : { 2, 4, 10 }) {
+    auto s = bar_scene({ L, a, a }, { 10 * n, n, n }, E, 0.0);
     sim::Simulator sim(s);
     const auto report = sim.solve_static(1);
     ASSERT_TRUE(report.converged) << report.message;
     const double deflection = -mean_tip_y(s.mesh, sim.positions());
     const double error = std::abs(deflection - theory) / theory;
-    std::printf("  cantilever, %d cells through (%d tets): tip %.5e m, theory %.5e m, error %.2f %%, %d Newton iterations\n", n,
-                s.mesh.num_tets(), deflection, theory, 100 * error, report.iterations);
+    std::printf("  cantilever, %d cells through (%d tets): tip %.5e m, theory %.5e m, error %.2f "
+                "%%, %d Newton iterations\n",
+        n, s.mesh.num_tets(), deflection, theory, 100 * error, report.iterations);
     EXPECT_LT(error, previous_error);
     previous_error = error;
   }
@@ -150,11 +155,12 @@ TEST(Dynamics, DampedModeDecaysAtRayleighRate) {
   // The section is rectangular (0.05 × 0.1) so the y- and z-bending modes do not share a
   // frequency and cannot trade energy; E = 3e7 puts ω near 100 rad/s.
   const double alpha0 = 1.0, alpha1 = 0.002, h = 2e-4;
-  auto s = bar_scene({0.4, 0.05, 0.1}, {8, 1, 2}, 3e7, 0.3, alpha0, alpha1);
+  auto s = bar_scene({ 0.4, 0.05, 0.1 }, { 8, 1, 2 }, 3e7, 0.3, alpha0, alpha1);
   s.gravity.setZero();
   s.dt = h;
   s.initial.kind = sim::InitialCondition::Kind::StaticLoad;
-  s.initial.static_loads.push_back({mesh::vertices_with_max_coordinate(s.mesh, 0, 1e-9), Vec3(0, -1.0, 0)});
+  s.initial.static_loads.push_back(
+      { mesh::vertices_with_max_coordinate(s.mesh, 0, 1e-9), Vec3(0, -1.0, 0) });
   sim::Simulator sim(s);
   const auto initial = sim.apply_initial_condition();
   ASSERT_TRUE(initial.converged) << initial.message;
@@ -179,8 +185,9 @@ TEST(Dynamics, DampedModeDecaysAtRayleighRate) {
   const double hc = 2 * std::cos(theta) / r - 2;
   const double omega = std::sqrt(1 / (r * r) - 1 - hc) / h;
   const double measured = hc / h, predicted = alpha0 + alpha1 * omega * omega;
-  std::printf("  mode ω = %.2f rad/s: damping coefficient measured %.4f 1/s, Rayleigh α₀ + α₁ω² = %.4f 1/s\n",
-              omega, measured, predicted);
+  std::printf("  mode ω = %.2f rad/s: damping coefficient measured %.4f 1/s, Rayleigh α₀ + α₁ω² = "
+              "%.4f 1/s\n",
+      omega, measured, predicted);
   // 2 %: peak interpolation and the weak coupling to other modes of a coarse, asymmetric mesh.
   EXPECT_NEAR(measured, predicted, 0.02 * predicted);
 }
@@ -188,9 +195,10 @@ TEST(Dynamics, DampedModeDecaysAtRayleighRate) {
 TEST(Dynamics, UndampedMotionNeverGainsEnergy) {
   // Backward Euler is dissipative: kinetic + elastic energy never increases without damping or
   // external work (gravity off, fixed base). Tolerance: Newton residual 1e-10 relative.
-  auto s = bar_scene({0.4, 0.1, 0.1}, {8, 2, 2}, 3e5, 0.4);
+  auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4);
   s.gravity.setZero();
-  s.material.elastic = std::make_shared<material::NeoHookeanModel>(material::Lame::from_young_poisson(3e5, 0.4));
+  s.material.elastic
+      = std::make_shared<material::NeoHookeanModel>(material::Lame::from_young_poisson(3e5, 0.4));
   s.newton.relative_tolerance = 1e-10;
   s.initial.kind = sim::InitialCondition::Kind::Velocity;
   s.initial.angular_velocity = Vec3(0, 0, 3.0);
@@ -208,24 +216,30 @@ TEST(Dynamics, UndampedMotionNeverGainsEnergy) {
 }
 
 TEST(Dynamics, KeyframedVerticesFollowTheirMotionAndFixedOnesStay) {
-  auto s = bar_scene({0.4, 0.1, 0.1}, {8, 2, 2}, 3e5, 0.4, 0.2, 0.005);
+  auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
   sim::KeyframeMotion k;
   k.vertices = mesh::vertices_with_max_coordinate(s.mesh, 0, 1e-9);
   k.amplitude = Vec3(0, 0.02, 0);
   k.frequency = 2;
   s.keyframes.push_back(k);
   sim::Simulator sim(s);
-  for (int i = 0; i < 100; ++i) ASSERT_TRUE(sim.step().converged);
+  for (int i = 0; i < 100; ++i)
+    ASSERT_TRUE(sim.step().converged);
   const Vec3 offset = k.offset_at(sim.time());
   for (int v : k.vertices)
-    EXPECT_LT((sim.positions().segment<3>(3 * v) - s.mesh.rest_positions().row(v).transpose() - offset).norm(), 1e-12);
+    EXPECT_LT(
+        (sim.positions().segment<3>(3 * v) - s.mesh.rest_positions().row(v).transpose() - offset)
+            .norm(),
+        1e-12);
   for (int v : s.fixed_vertices)
-    EXPECT_EQ((sim.positions().segment<3>(3 * v) - s.mesh.rest_positions().row(v).transpose()).norm(), 0.0);
+    EXPECT_EQ(
+        (sim.positions().segment<3>(3 * v) - s.mesh.rest_positions().row(v).transpose()).norm(),
+        0.0);
 }
 
 TEST(Dynamics, ConsistentMassAgreesWithLumpedOnSmoothMotion) {
   // Same physics, different mass discretisation: tip sag after 0.1 s agrees within a few percent.
-  auto lumped = bar_scene({0.4, 0.1, 0.1}, {8, 2, 2}, 3e5, 0.4, 0.2, 0.005);
+  auto lumped = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
   auto consistent = lumped;
   consistent.mass = fem::MassType::Consistent;
   sim::Simulator a(lumped), b(consistent);
@@ -233,18 +247,19 @@ TEST(Dynamics, ConsistentMassAgreesWithLumpedOnSmoothMotion) {
     ASSERT_TRUE(a.step().converged);
     ASSERT_TRUE(b.step().converged);
   }
-  const double ya = mean_tip_y(lumped.mesh, a.positions()), yb = mean_tip_y(lumped.mesh, b.positions());
+  const double ya = mean_tip_y(lumped.mesh, a.positions()),
+               yb = mean_tip_y(lumped.mesh, b.positions());
   ASSERT_LT(ya, -1e-3);
   EXPECT_NEAR(yb, ya, 0.05 * std::abs(ya));
 }
 
 TEST(Dynamics, CorrectionHookChangesTheMotionAndNewtonStillConverges) {
   // A stiffening correction must reduce the sag; the integrator uses its force and tangent.
-  auto base = bar_scene({0.4, 0.1, 0.1}, {8, 2, 2}, 3e5, 0.4, 0.2, 0.005);
+  auto base = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
   auto corrected = base;
   material::AnalyticCorrection::Parameters p;
   p.a = 1e8; // (σ−1)³ stiffening: ~100 Pa at 1 % strain vs E·ε ≈ 3e3 Pa
-  p.b = 1;   // viscous term [Pa·s]
+  p.b = 1; // viscous term [Pa·s]
   p.c = 10;
   corrected.material.correction = std::make_shared<material::AnalyticCorrection>(p);
   sim::Simulator a(base), b(corrected);
@@ -253,19 +268,22 @@ TEST(Dynamics, CorrectionHookChangesTheMotionAndNewtonStillConverges) {
     const auto r = b.step();
     ASSERT_TRUE(r.converged) << r.message;
     EXPECT_LE(r.iterations, 10);
-    if (i % 20 == 0) std::printf("  step %d: %d Newton iterations\n", i, r.iterations);
+    if (i % 20 == 0)
+      std::printf("  step %d: %d Newton iterations\n", i, r.iterations);
   }
-  EXPECT_GT(std::abs(mean_tip_y(base.mesh, a.positions()) - mean_tip_y(base.mesh, b.positions())), 1e-6);
+  EXPECT_GT(
+      std::abs(mean_tip_y(base.mesh, a.positions()) - mean_tip_y(base.mesh, b.positions())), 1e-6);
 }
 
 TEST(Divergence, StopsWithAMessageNamingTheFrameAndKeepsEarlierFrames) {
   // An absurd time step on a stiff bar with a single Newton iteration allowed cannot converge.
-  auto s = bar_scene({0.4, 0.1, 0.1}, {8, 2, 2}, 3e5, 0.4);
+  auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4);
   s.newton.max_iterations = 1;
   s.newton.relative_tolerance = 1e-12;
   s.frames = 50;
   int frames_seen = 0;
-  const auto report = sim::run_simulation(s, [&](int, double, const VecX&, const VecX&) { ++frames_seen; });
+  const auto report
+      = sim::run_simulation(s, [&](int, double, const VecX&, const VecX&) { ++frames_seen; });
   EXPECT_FALSE(report.completed);
   EXPECT_NE(report.message.find("frame 1"), std::string::npos) << report.message;
   EXPECT_EQ(frames_seen, report.frames_written);

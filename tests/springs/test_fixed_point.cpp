@@ -13,11 +13,12 @@ TEST(FixedPoint, ReferenceRopeEquilibriumIsTheForceBalance) {
   Loads loads;
   loads.forces = Positions::Zero(5, 3);
   loads.forces(4, 0) = force;
-  ReferenceSimulator sim(rope, SpringLaw{SpringLawKind::linear, k}, 0.01, loads);
+  ReferenceSimulator sim(rope, SpringLaw { SpringLawKind::linear, k }, 0.01, loads);
   SpringState s = rest_state(rope);
   const FixedPointResult r = solve_fixed_point(sim, s);
   ASSERT_TRUE(r.converged) << r.message;
-  for (int a = 0; a < 5; ++a) EXPECT_NEAR(s.x(a, 0), a * (1.0 + force / k), 1e-12);
+  for (int a = 0; a < 5; ++a)
+    EXPECT_NEAR(s.x(a, 0), a * (1.0 + force / k), 1e-12);
   EXPECT_LT(s.v.cwiseAbs().maxCoeff(), 1e-12);
 }
 
@@ -34,7 +35,7 @@ TEST(FixedPoint, PaperSingleSpringHasTheDerivedNonzeroVelocity) {
   PaperSimulator sim(spring, learn_spring(t), dt, loads);
   SpringState s = rest_state(spring);
   FixedPointOptions o;
-  o.components = {true, false, false};
+  o.components = { true, false, false };
   const FixedPointResult r = solve_fixed_point(sim, s, o);
   ASSERT_TRUE(r.converged) << r.message;
   EXPECT_NEAR(s.v(1, 0), -dt * force / 2.0, 1e-12);
@@ -48,10 +49,10 @@ TEST(FixedPoint, ColouredJacobianWorksOnCloth) {
   const SpringSystem cloth = make_cloth(o);
   Loads loads;
   loads.gravity = Vec3(0, -1.0, 0);
-  ReferenceSimulator sim(cloth, SpringLaw{SpringLawKind::linear, 200.0}, 0.01, loads);
+  ReferenceSimulator sim(cloth, SpringLaw { SpringLawKind::linear, 200.0 }, 0.01, loads);
   SpringState s = rest_state(cloth);
   FixedPointOptions fp;
-  fp.components = {true, true, false};
+  fp.components = { true, true, false };
   const FixedPointResult r = solve_fixed_point(sim, s, fp);
   ASSERT_TRUE(r.converged) << r.message;
   EXPECT_LE(r.iterations, 12);

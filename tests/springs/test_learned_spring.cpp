@@ -21,8 +21,8 @@ TrainingOptions linear_training(double k, double c, double dt = 0.01) {
 // The regression must recover the analytic one-step map of semi-implicit Euler (paper Eq. 3,
 // with its damping entry corrected: Δe = −k dt² e + dt (1 − c dt) v, Δv = −k dt e − c dt v).
 TEST(LearnedSpring, CoefficientsEqualTheAnalyticOneStepMap) {
-  for (double k : {100.0, 1000.0}) {
-    for (double c : {0.0, 2.0}) {
+  for (double k : { 100.0, 1000.0 }) {
+    for (double c : { 0.0, 2.0 }) {
       const double dt = 0.01;
       const LearnedSpring spring = learn_spring(linear_training(k, c, dt));
       const MatX& b = spring.coefficients();
@@ -58,8 +58,8 @@ TEST(LearnedSpring, CubicSpringIsLearnedExactlyByCubicFeatures) {
   LearnOptions o;
   o.features.degree = 3;
   const LearnedSpring spring = learn_spring(t, o);
-  for (double e : {-0.4, -0.1, 0.0, 0.2, 0.45})
-    for (double v : {-1.0, 0.0, 2.0})
+  for (double e : { -0.4, -0.1, 0.0, 0.2, 0.45 })
+    for (double v : { -1.0, 0.0, 2.0 })
       // Δv of a cubic law is a cubic polynomial in (e, v): the fit is exact up to round-off.
       EXPECT_NEAR(spring.force(e, v), t.law.force(e, v), 1e-8);
   // The linear paper model cannot represent it.
@@ -77,7 +77,7 @@ TEST(LearnedSpring, BilinearSpringIsLearnedBySplineFeatures) {
   o.features.kind = FeatureKind::spline;
   o.features.knots = uniform_knots(-0.5, 0.5, 11); // 0 is a knot
   const LearnedSpring spring = learn_spring(t, o);
-  for (double e : {-0.45, -0.2, -0.01, 0.01, 0.3})
+  for (double e : { -0.45, -0.2, -0.01, 0.01, 0.3 })
     EXPECT_NEAR(spring.force(e, 0.5), t.law.force(e, 0.5), 1e-8); // piecewise linear: exact
 }
 
@@ -85,15 +85,14 @@ TEST(LearnedSpring, ForceSlopesMatchFiniteDifferences) {
   TrainingOptions t = linear_training(100.0, 1.0);
   t.law.kind = SpringLawKind::cubic;
   t.law.k3 = 300.0;
-  for (FeatureKind kind : {FeatureKind::polynomial, FeatureKind::spline}) {
+  for (FeatureKind kind : { FeatureKind::polynomial, FeatureKind::spline }) {
     LearnOptions o;
     o.features.kind = kind;
     o.features.degree = 4;
     o.features.knots = uniform_knots(-0.5, 0.5, 8);
     const LearnedSpring spring = learn_spring(t, o);
-    const test::FdFunction f = [&](const VecX& s) {
-      return VecX::Constant(1, spring.force(s[0], s[1]));
-    };
+    const test::FdFunction f
+        = [&](const VecX& s) { return VecX::Constant(1, spring.force(s[0], s[1])); };
     const VecX s0 = Eigen::Vector2d(0.13, -0.4); // inside a spline interval
     double force = 0, de = 0, dv = 0;
     spring.force_slopes(s0[0], s0[1], force, de, dv);

@@ -14,7 +14,8 @@ MatX random_matrix(int rows, int cols, unsigned seed) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   MatX m(rows, cols);
   for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < cols; ++j) m(i, j) = u(rng);
+    for (int j = 0; j < cols; ++j)
+      m(i, j) = u(rng);
   return m;
 }
 } // namespace
@@ -39,7 +40,8 @@ TEST(LinearRegression, NoisyFitReportsResidualsAndRSquared) {
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 0.1);
   MatX y(2000, 1);
-  for (int i = 0; i < 2000; ++i) y(i, 0) = 1.0 + 2.0 * x(i, 0) + noise(rng);
+  for (int i = 0; i < 2000; ++i)
+    y(i, 0) = 1.0 + 2.0 * x(i, 0) + noise(rng);
   const LinearRegression fit = fit_linear_regression(x, y);
   // 2000 samples with σ = 0.1: slope standard error ≈ 0.1/sqrt(2000·1/3) ≈ 0.004.
   EXPECT_NEAR(fit.coefficients(1, 0), 2.0, 0.02);
@@ -56,7 +58,7 @@ TEST(LinearRegression, RidgeShrinksTowardsZeroButNotTheIntercept) {
   const MatX x = random_matrix(100, 2, 4);
   MatX y = 5.0 + (x * Eigen::Vector2d(1.0, -1.0)).array();
   const LinearRegression plain = fit_linear_regression(x, y);
-  const LinearRegression ridge = fit_linear_regression(x, y, {true, 100.0});
+  const LinearRegression ridge = fit_linear_regression(x, y, { true, 100.0 });
   EXPECT_LT(ridge.coefficients.bottomRows(2).norm(), plain.coefficients.bottomRows(2).norm());
   EXPECT_NEAR(ridge.coefficients(0, 0), 5.0, 0.2); // intercept not penalised (x has ~zero mean)
 }
@@ -71,5 +73,5 @@ TEST(LinearRegression, RejectsBadData) {
   MatX with_nan = x;
   with_nan(3, 1) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(fit_linear_regression(with_nan, MatX::Zero(10, 1)), InputError);
-  EXPECT_THROW(fit_linear_regression(x, MatX::Zero(10, 1), {true, -1.0}), InputError);
+  EXPECT_THROW(fit_linear_regression(x, MatX::Zero(10, 1), { true, -1.0 }), InputError);
 }

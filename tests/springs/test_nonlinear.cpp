@@ -16,13 +16,14 @@ TEST(NonlinearSprings, CubicRopeAndClothStaticsMatchTheReference) {
   o.features.degree = 3;
   const LearnedSpring spring = learn_spring(t, o);
   StiffnessOptions so;
-  so.forces = {5, 20, 50};
-  for (const LoadCase& load : {rope_load_case(5), cloth_load_case()}) {
+  so.forces = { 5, 20, 50 };
+  for (const LoadCase& load : { rope_load_case(5), cloth_load_case() }) {
     const StiffnessMeasurement ref = measure_stiffness(reference_factory(t.law, 0.01), load, so);
     LearnedSimulatorOptions sim;
-    for (LearnedMode mode : {LearnedMode::corrected_explicit, LearnedMode::corrected_implicit}) {
+    for (LearnedMode mode : { LearnedMode::corrected_explicit, LearnedMode::corrected_implicit }) {
       sim.mode = mode;
-      const StiffnessMeasurement learned = measure_stiffness(learned_factory(spring, sim), load, so);
+      const StiffnessMeasurement learned
+          = measure_stiffness(learned_factory(spring, sim), load, so);
       ASSERT_TRUE(learned.converged && ref.converged) << learned.message << ref.message;
       for (std::size_t i = 0; i < ref.displacements.size(); ++i)
         // The cubic fit is exact to round-off (~1e-12 relative on Δv).

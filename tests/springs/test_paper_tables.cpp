@@ -28,12 +28,13 @@ TEST(PaperTables, PaperModeReproducesTable1) {
 
 TEST(PaperTables, PaperModeTable2LongerRopesDeviateLess) {
   ExperimentOptions o = options_for(LearnedMode::paper);
-  o.stiffnesses = {500, 1000};
+  o.stiffnesses = { 500, 1000 };
   const auto rows = reproduce_table2(o);
   for (double k : o.stiffnesses) {
     double error2 = 0, error5 = 0, error10 = 0;
     for (const Table2Row& row : rows) {
-      if (row.k != k) continue;
+      if (row.k != k)
+        continue;
       ASSERT_TRUE(row.learned.converged);
       const double err = row.learned.mean - k;
       EXPECT_GT(err, 0.0); // the learned rope is stiffer than the reference
@@ -55,9 +56,9 @@ TEST(PaperTables, PaperModeReproducesTable3Ratio) {
 }
 
 TEST(PaperTables, CorrectedModesAreExact) {
-  for (LearnedMode mode : {LearnedMode::corrected_explicit, LearnedMode::corrected_implicit}) {
+  for (LearnedMode mode : { LearnedMode::corrected_explicit, LearnedMode::corrected_implicit }) {
     ExperimentOptions o = options_for(mode);
-    o.stiffnesses = {100, 1000};
+    o.stiffnesses = { 100, 1000 };
     for (const Table1Row& row : reproduce_table1(o))
       EXPECT_NEAR(row.learned.mean / row.k, 1.0, 1e-9) << to_string(mode);
     for (const Table2Row& row : reproduce_table2(o))

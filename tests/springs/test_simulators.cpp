@@ -22,8 +22,8 @@ LearnedSpring linear_spring(double k, double c) {
 }
 
 /// Max over `steps` steps of the position difference between two steppers from one state.
-double max_trajectory_difference(SpringStepper& a, SpringStepper& b, const SpringState& start,
-                                 int steps) {
+double max_trajectory_difference(
+    SpringStepper& a, SpringStepper& b, const SpringState& start, int steps) {
   SpringState sa = start, sb = start;
   double worst = 0.0;
   for (int s = 0; s < steps; ++s) {
@@ -36,11 +36,12 @@ double max_trajectory_difference(SpringStepper& a, SpringStepper& b, const Sprin
 } // namespace
 
 TEST(ExplicitLearned, TrajectoriesEqualTheReferenceSystem) {
-  const StabilityCase cases[] = {single_spring_case(0.3), rope_case(10), hanging_cloth_case(8)};
+  const StabilityCase cases[] = { single_spring_case(0.3), rope_case(10), hanging_cloth_case(8) };
   for (const StabilityCase& test : cases) {
-    for (double c : {0.0, 3.0}) {
+    for (double c : { 0.0, 3.0 }) {
       const double k = 500.0;
-      ReferenceSimulator reference(test.system, SpringLaw{SpringLawKind::linear, k, c}, 0.01, test.loads);
+      ReferenceSimulator reference(
+          test.system, SpringLaw { SpringLawKind::linear, k, c }, 0.01, test.loads);
       ExplicitLearnedSimulator learned(test.system, linear_spring(k, c), 0.01, test.loads);
       // The regression is exact to ~1e-16 relative; over 300 steps of a chaotic-free but
       // oscillating system that round-off stays far below 1e-10 of the unit rest length.
@@ -63,13 +64,15 @@ TEST(PaperMode, SingleSpringOscillatesSqrtTwoTooFast) {
   for (int i = 0; i < steps; ++i) {
     paper.step(s);
     const double e = s.x(1, 0) - 1.0;
-    if ((e > 0) != (previous > 0)) ++crossings;
+    if ((e > 0) != (previous > 0))
+      ++crossings;
     previous = e;
   }
   const double omega_paper = crossings * M_PI / (steps * dt);
   const double omega_ref = std::acos(1.0 - k * dt * dt / 2.0) / dt;
   // Counting zero crossings over 200 s resolves ω to ~π/200 s ≈ 0.016 rad/s.
-  EXPECT_NEAR(omega_paper / omega_ref, std::acos(1.0 - k * dt * dt) / std::acos(1.0 - k * dt * dt / 2.0), 0.005);
+  EXPECT_NEAR(omega_paper / omega_ref,
+      std::acos(1.0 - k * dt * dt) / std::acos(1.0 - k * dt * dt / 2.0), 0.005);
   EXPECT_NEAR(omega_paper / omega_ref, std::sqrt(2.0), 0.01);
 }
 
@@ -85,15 +88,17 @@ TEST(ImplicitLearned, RestsExactlyAtTheReferenceEquilibrium) {
   Loads loads;
   loads.forces = Positions::Zero(6, 3);
   loads.forces(5, 0) = force;
-  for (LinearSolverKind solver : {LinearSolverKind::direct, LinearSolverKind::cg}) {
+  for (LinearSolverKind solver : { LinearSolverKind::direct, LinearSolverKind::cg }) {
     LearnedSimulatorOptions o;
     o.mode = LearnedMode::corrected_implicit;
     o.solver = solver;
     ImplicitLearnedSimulator sim(rope, linear_spring(k, 0.0), 0.01, o, loads);
     SpringState s = rest_state(rope);
-    for (int a = 0; a < 6; ++a) s.x(a, 0) = a * (1.0 + force / k);
+    for (int a = 0; a < 6; ++a)
+      s.x(a, 0) = a * (1.0 + force / k);
     const SpringState before = s;
-    for (int i = 0; i < 10; ++i) sim.step(s);
+    for (int i = 0; i < 10; ++i)
+      sim.step(s);
     EXPECT_LT((s.x - before.x).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT(s.v.cwiseAbs().maxCoeff(), 1e-10);
   }
@@ -111,7 +116,8 @@ TEST(ImplicitLearned, FreeFallIsExact) {
   ImplicitLearnedSimulator sim(cloth, linear_spring(1e5, 1.0), 0.01, options, loads);
   SpringState s = rest_state(cloth);
   const int steps = 100;
-  for (int i = 0; i < steps; ++i) sim.step(s);
+  for (int i = 0; i < steps; ++i)
+    sim.step(s);
   // Discrete free fall of backward (and semi-implicit) Euler: y_n = −g h² n(n+1)/2.
   const double expected = -9.81 * 0.01 * 0.01 * steps * (steps + 1) / 2.0;
   EXPECT_LT(((s.x.col(1) - cloth.rest.col(1)).array() - expected).abs().maxCoeff(), 1e-11);
@@ -124,7 +130,7 @@ TEST(ImplicitLearned, StableForVeryStiffCloth) {
     double k;
     int steps;
   };
-  for (const Case& c : {Case{5, 1e6, 300}, Case{25, 1e5, 60}}) {
+  for (const Case& c : { Case { 5, 1e6, 300 }, Case { 25, 1e5, 60 } }) {
     const StabilityCase test = hanging_cloth_case(c.n);
     LearnedSimulatorOptions o;
     o.mode = LearnedMode::corrected_implicit;
@@ -132,10 +138,12 @@ TEST(ImplicitLearned, StableForVeryStiffCloth) {
     EXPECT_TRUE(run_is_stable(sim, test, c.steps)) << c.n;
     // Stiff springs barely stretch: the maximum strain stays small (gravity load / k).
     SpringState s = test.initial;
-    for (int i = 0; i < c.steps; ++i) sim.step(s);
+    for (int i = 0; i < c.steps; ++i)
+      sim.step(s);
     double max_strain = 0.0;
     for (int sp = 0; sp < test.system.spring_count(); ++sp) {
-      const double length = (s.x.row(test.system.springs(sp, 0)) - s.x.row(test.system.springs(sp, 1))).norm();
+      const double length
+          = (s.x.row(test.system.springs(sp, 0)) - s.x.row(test.system.springs(sp, 1))).norm();
       max_strain = std::max(max_strain, std::abs(length / test.system.rest_lengths[sp] - 1.0));
     }
     EXPECT_LT(max_strain, 0.05) << c.n;

@@ -11,10 +11,11 @@ std::function<StepperFactory(double)> model(int which) {
   return [which](double k) -> StepperFactory {
     SpringLaw law;
     law.k = k;
-    if (which < 0) return reference_factory(law, 0.01);
+    if (which < 0)
+      return reference_factory(law, 0.01);
     LearnedSimulatorOptions o;
     o.mode = static_cast<LearnedMode>(which);
-    return learned_factory(learn_paper_spring(k, ExperimentOptions{}), o);
+    return learned_factory(learn_paper_spring(k, ExperimentOptions {}), o);
   };
 }
 } // namespace
@@ -31,11 +32,13 @@ TEST(Stability, SingleSpringLimitsMatchTheAnalysis) {
   // Near the limit the growth per step is tiny, so a finite run brackets it within a few %.
   EXPECT_LE(ref.largest_stable, 4e4 * 1.05);
   EXPECT_GE(ref.smallest_unstable, 4e4 / 1.05);
-  const StabilityResult paper = find_stability_limit(model(static_cast<int>(LearnedMode::paper)), test, o);
+  const StabilityResult paper
+      = find_stability_limit(model(static_cast<int>(LearnedMode::paper)), test, o);
   EXPECT_LE(paper.largest_stable, 2e4 * 1.05);
   EXPECT_GE(paper.smallest_unstable, 2e4 / 1.05);
   // The corrected explicit mode inherits the reference limit exactly.
-  const StabilityResult expl = find_stability_limit(model(static_cast<int>(LearnedMode::corrected_explicit)), test, o);
+  const StabilityResult expl
+      = find_stability_limit(model(static_cast<int>(LearnedMode::corrected_explicit)), test, o);
   EXPECT_DOUBLE_EQ(expl.largest_stable, ref.largest_stable);
 }
 
@@ -46,6 +49,7 @@ TEST(Stability, PaperClothIsMoreStableOnlyBecauseItIsSofter) {
   o.resolution = 1.1;
   const StabilityCase cloth = hanging_cloth_case(5);
   const StabilityResult ref = find_stability_limit(model(-1), cloth, o);
-  const StabilityResult paper = find_stability_limit(model(static_cast<int>(LearnedMode::paper)), cloth, o);
+  const StabilityResult paper
+      = find_stability_limit(model(static_cast<int>(LearnedMode::paper)), cloth, o);
   EXPECT_GT(paper.largest_stable, 2.0 * ref.largest_stable);
 }

@@ -21,9 +21,10 @@ struct Run {
 inline Run run(const std::string& arguments) {
   const std::string command = std::string(ELASTOLEARN_EXECUTABLE) + " " + arguments + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
-  Run r{-1, ""};
-  std::array<char, 4096> buffer{};
-  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) r.output.append(buffer.data(), n);
+  Run r { -1, "" };
+  std::array<char, 4096> buffer {};
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe))
+    r.output.append(buffer.data(), n);
   const int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
@@ -32,11 +33,12 @@ inline Run run(const std::string& arguments) {
 /// Fixture base: a fresh temporary folder per test (suite, test and process in its name, so
 /// parallel ctest runs never share one), removed afterwards.
 class CliTestFolder : public ::testing::Test {
-protected:
+  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    m_dir = std::filesystem::temp_directory_path() / ("elastolearn_" + std::string(info->test_suite_name()) + "_" +
-                                                      info->name() + "_" + std::to_string(::getpid()));
+    m_dir = std::filesystem::temp_directory_path()
+        / ("elastolearn_" + std::string(info->test_suite_name()) + "_" + info->name() + "_"
+            + std::to_string(::getpid()));
     std::filesystem::remove_all(m_dir);
     std::filesystem::create_directories(m_dir);
   }

@@ -33,15 +33,15 @@ inline Eigen::MatrixXd fd_jacobian(const FdFunction& f, const Eigen::VectorXd& x
 
 /// Gradient of a scalar function, as a column vector.
 inline Eigen::VectorXd fd_gradient(const std::function<double(const Eigen::VectorXd&)>& f,
-                                   const Eigen::VectorXd& x, double h = 1e-4) {
+    const Eigen::VectorXd& x, double h = 1e-4) {
   FdFunction wrapped = [&](const Eigen::VectorXd& y) { return Eigen::VectorXd::Constant(1, f(y)); };
   return fd_jacobian(wrapped, x, h).transpose();
 }
 
-/// Assert that `analytic` matches the FD Jacobian of f at x: max |A - FD| ≤ rel_tol · max(|FD|, floor).
+/// Assert that `analytic` matches the FD Jacobian of f at x: max |A - FD| ≤ rel_tol · max(|FD|,
+/// floor).
 inline void expect_jacobian_matches(const Eigen::MatrixXd& analytic, const FdFunction& f,
-                                    const Eigen::VectorXd& x, double rel_tol = 1e-6,
-                                    double h = 1e-4, double floor = 1e-8) {
+    const Eigen::VectorXd& x, double rel_tol = 1e-6, double h = 1e-4, double floor = 1e-8) {
   const Eigen::MatrixXd fd = fd_jacobian(f, x, h);
   ASSERT_EQ(analytic.rows(), fd.rows());
   ASSERT_EQ(analytic.cols(), fd.cols());

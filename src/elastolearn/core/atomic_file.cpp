@@ -8,11 +8,13 @@
 
 namespace elastolearn {
 
-AtomicFile::AtomicFile(std::filesystem::path target) : m_target(std::move(target)) {
+AtomicFile::AtomicFile(std::filesystem::path target)
+    : m_target(std::move(target)) {
   if (m_target.has_parent_path()) {
     std::error_code ec;
     std::filesystem::create_directories(m_target.parent_path(), ec);
-    if (ec) throw InputError(m_target.parent_path().string(), "cannot create directory: " + ec.message());
+    if (ec)
+      throw InputError(m_target.parent_path().string(), "cannot create directory: " + ec.message());
   }
   m_temp = m_target;
   m_temp += ".tmp-" + std::to_string(::getpid());
@@ -28,7 +30,8 @@ AtomicFile::~AtomicFile() {
 void AtomicFile::commit() {
   std::error_code ec;
   std::filesystem::rename(m_temp, m_target, ec);
-  if (ec) throw InputError(m_target.string(), "cannot write output: " + ec.message());
+  if (ec)
+    throw InputError(m_target.string(), "cannot write output: " + ec.message());
   m_committed = true;
 }
 
@@ -38,14 +41,16 @@ void write_text_file_atomic(const std::filesystem::path& path, const std::string
     std::ofstream out(file.temp_path(), std::ios::binary);
     out << contents;
     out.close();
-    if (!out) throw InputError(path.string(), "cannot write file");
+    if (!out)
+      throw InputError(path.string(), "cannot write file");
   }
   file.commit();
 }
 
 std::string read_text_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "cannot open file for reading");
+  if (!in)
+    throw InputError(path.string(), "cannot open file for reading");
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();

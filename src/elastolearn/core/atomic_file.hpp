@@ -9,7 +9,7 @@ namespace elastolearn {
 /// Owns a temporary path `<target>.tmp-<pid>`; `commit()` renames it onto the target.
 /// If destroyed without commit (e.g. during stack unwinding) the temporary file is removed.
 class AtomicFile {
-public:
+  public:
   explicit AtomicFile(std::filesystem::path target);
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
@@ -22,7 +22,7 @@ public:
   /// Atomically move the temporary file onto the target. Throws InputError if it cannot.
   void commit();
 
-private:
+  private:
   std::filesystem::path m_target;
   std::filesystem::path m_temp;
   bool m_committed = false;

@@ -3,12 +3,13 @@
 namespace elastolearn {
 
 InputError::InputError(std::string where, const std::string& what)
-    : std::runtime_error(where.empty() ? what : where + ": " + what), m_where(std::move(where)) {}
+    : std::runtime_error(where.empty() ? what : where + ": " + what)
+    , m_where(std::move(where)) { }
 
-void throw_internal_error(const char* condition, const char* file, int line,
-                          const std::string& message) {
-  throw InternalError(std::string(file) + ":" + std::to_string(line) + ": check '" + condition +
-                      "' failed: " + message);
+void throw_internal_error(
+    const char* condition, const char* file, int line, const std::string& message) {
+  throw InternalError(std::string(file) + ":" + std::to_string(line) + ": check '" + condition
+      + "' failed: " + message);
 }
 
 } // namespace elastolearn

@@ -10,28 +10,29 @@ namespace elastolearn {
 /// Bad user input: unreadable file, wrong format, NaN, out-of-range index, invalid field.
 /// `where` is the file (optionally with ":line") or the JSON field path; `what` says what is wrong.
 class InputError : public std::runtime_error {
-public:
+  public:
   InputError(std::string where, const std::string& what);
   /// The file/field/line the error refers to.
   const std::string& where() const noexcept { return m_where; }
 
-private:
+  private:
   std::string m_where;
 };
 
 /// Internal logic error: an invariant that can only fail through a bug.
 class InternalError : public std::logic_error {
-public:
+  public:
   using std::logic_error::logic_error;
 };
 
-[[noreturn]] void throw_internal_error(const char* condition, const char* file, int line,
-                                       const std::string& message);
+[[noreturn]] void throw_internal_error(
+    const char* condition, const char* file, int line, const std::string& message);
 
 } // namespace elastolearn
 
 /// Always-on check for states that should be impossible.
 #define ELASTOLEARN_CHECK(cond, msg)                                                               \
   do {                                                                                             \
-    if (!(cond)) ::elastolearn::throw_internal_error(#cond, __FILE__, __LINE__, (msg));            \
+    if (!(cond))                                                                                   \
+      ::elastolearn::throw_internal_error(#cond, __FILE__, __LINE__, (msg));                       \
   } while (false)

@@ -6,7 +6,7 @@
 namespace elastolearn {
 
 namespace {
-std::atomic<bool> g_interrupted{false};
+std::atomic<bool> g_interrupted { false };
 
 extern "C" void on_signal(int signal) {
   if (g_interrupted.exchange(true)) {
@@ -21,8 +21,12 @@ void install_interrupt_handler() {
   std::signal(SIGTERM, on_signal);
 }
 
-bool interrupt_requested() { return g_interrupted.load(std::memory_order_relaxed); }
+bool interrupt_requested() {
+  return g_interrupted.load(std::memory_order_relaxed);
+}
 
-void set_interrupt_requested(bool value) { g_interrupted.store(value); }
+void set_interrupt_requested(bool value) {
+  g_interrupted.store(value);
+}
 
 } // namespace elastolearn

@@ -35,10 +35,18 @@ using Box3 = Eigen::AlignedBox3d;
 template <typename T> using ConstRef = const Eigen::Ref<const T>&;
 
 /// View an n×3 row-major array as its flat 3n vector (no copy).
-inline Eigen::Map<VecX> flatten(Positions& x) { return {x.data(), x.size()}; }
-inline Eigen::Map<const VecX> flatten(const Positions& x) { return {x.data(), x.size()}; }
+inline Eigen::Map<VecX> flatten(Positions& x) {
+  return { x.data(), x.size() };
+}
+inline Eigen::Map<const VecX> flatten(const Positions& x) {
+  return { x.data(), x.size() };
+}
 /// View a flat 3n vector as n×3 rows (no copy).
-inline Eigen::Map<Positions> unflatten(VecX& v) { return {v.data(), v.size() / 3, 3}; }
-inline Eigen::Map<const Positions> unflatten(const VecX& v) { return {v.data(), v.size() / 3, 3}; }
+inline Eigen::Map<Positions> unflatten(VecX& v) {
+  return { v.data(), v.size() / 3, 3 };
+}
+inline Eigen::Map<const Positions> unflatten(const VecX& v) {
+  return { v.data(), v.size() / 3, 3 };
+}
 
 } // namespace elastolearn

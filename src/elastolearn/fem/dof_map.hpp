@@ -8,14 +8,14 @@
 namespace elastolearn::fem {
 
 class DofMap {
-public:
+  public:
   DofMap() = default;
   /// \param num_vertices  n
   /// \param prescribed_vertices  vertices whose positions are given (fixed or keyframed)
   DofMap(int num_vertices, const std::vector<int>& prescribed_vertices);
 
-  int num_dofs() const { return static_cast<int>(m_free_index.size()); }    ///< 3n
-  int num_free() const { return static_cast<int>(m_free_dofs.size()); }     ///< unknowns
+  int num_dofs() const { return static_cast<int>(m_free_index.size()); } ///< 3n
+  int num_free() const { return static_cast<int>(m_free_dofs.size()); } ///< unknowns
   /// Index of dof d among the unknowns, or −1 if prescribed.
   int free_index(int dof) const { return m_free_index[dof]; }
   bool is_prescribed_vertex(int v) const { return m_free_index[3 * v] < 0; }
@@ -26,7 +26,7 @@ public:
   /// Same, into an existing vector (no allocation once sized).
   void restrict_into(const VecX& full, VecX& reduced) const;
 
-private:
+  private:
   std::vector<int> m_free_index;
   std::vector<int> m_free_dofs;
 };

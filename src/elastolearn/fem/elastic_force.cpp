@@ -11,27 +11,32 @@ namespace elastolearn::fem {
 namespace {
 
 /// a·A + b·B of two eigen-form tangents (the eigen-form is linear in dP/dF).
-material::PrincipalTangent weighted_sum(double a, const material::PrincipalTangent& A, double b,
-                                        const material::PrincipalTangent& B) {
-  return {a * A.block + b * B.block, a * A.twist + b * B.twist, a * A.flip + b * B.flip};
+material::PrincipalTangent weighted_sum(
+    double a, const material::PrincipalTangent& A, double b, const material::PrincipalTangent& B) {
+  return { a * A.block + b * B.block, a * A.twist + b * B.twist, a * A.flip + b * B.flip };
 }
 
 } // namespace
 
 ElasticForce::ElasticForce(const mesh::TetMesh& mesh, MaterialModel material)
-    : m_tets(mesh.tets()), m_rest(precompute_rest_data(mesh)), m_material(std::move(material)) {
+    : m_tets(mesh.tets())
+    , m_rest(precompute_rest_data(mesh))
+    , m_material(std::move(material)) {
   ELASTOLEARN_CHECK(m_material.elastic != nullptr, "ElasticForce needs an elastic model");
   const int m = mesh.num_tets();
   const int n = mesh.num_vertices();
   m_force_buffer.assign(static_cast<size_t>(m) * 12, 0.0);
   m_vertex_offsets.assign(n + 1, 0);
   for (int e = 0; e < m; ++e)
-    for (int a = 0; a < 4; ++a) ++m_vertex_offsets[m_tets(e, a) + 1];
-  for (int v = 0; v < n; ++v) m_vertex_offsets[v + 1] += m_vertex_offsets[v];
+    for (int a = 0; a < 4; ++a)
+      ++m_vertex_offsets[m_tets(e, a) + 1];
+  for (int v = 0; v < n; ++v)
+    m_vertex_offsets[v + 1] += m_vertex_offsets[v];
   m_vertex_sources.resize(m_vertex_offsets[n]);
   std::vector<int> fill(m_vertex_offsets.begin(), m_vertex_offsets.end() - 1);
   for (int e = 0; e < m; ++e)
-    for (int a = 0; a < 4; ++a) m_vertex_sources[fill[m_tets(e, a)]++] = 4 * e + a;
+    for (int a = 0; a < 4; ++a)
+      m_vertex_sources[fill[m_tets(e, a)]++] = 4 * e + a;
 }
 
 void ElasticForce::add_force(const ForceState& state, VecX& f) {
@@ -40,7 +45,8 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
   const auto* damping = m_material.damping.get();
   const double density = m_material.density;
   const int m = static_cast<int>(m_tets.rows());
-  if (m_cache.size() != static_cast<size_t>(m)) m_cache.resize(m);
+  if (m_cache.size() != static_cast<size_t>(m))
+    m_cache.resize(m);
 
   tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
     for (int e = r.begin(); e < r.end(); ++e) {
@@ -53,14 +59,19 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
       Vec3 rates = Vec3::Zero();
       const bool need_rate = correction || (damping != nullptr);
       Mat3 F_rate;
-      if (need_rate) F_rate = deformation_gradient(ve, rest);
-      if (correction) rates = material::stretch_rates(c.frame, F_rate);
-      c.stress = material::corrected_principal_stress(*elastic, correction, c.frame.stretches, rates);
+      if (need_rate)
+        F_rate = deformation_gradient(ve, rest);
+      if (correction)
+        rates = material::stretch_rates(c.frame, F_rate);
+      c.stress
+          = material::corrected_principal_stress(*elastic, correction, c.frame.stretches, rates);
       Mat3 P = material::first_piola(c.frame, c.stress.stress);
-      c.alpha = damping ? damping->coefficients(c.frame.stretches[0]) : material::RayleighCoefficients{};
+      c.alpha = damping ? damping->coefficients(c.frame.stretches[0])
+                        : material::RayleighCoefficients {};
       // A learned Δα₁ scales the nominal stiffness (paper Eq. 13); the total never turns negative.
-      c.alpha1_change =
-          material::corrected_stiffness_damping(c.alpha.alpha1, correction, c.frame.stretches) - c.alpha.alpha1;
+      c.alpha1_change
+          = material::corrected_stiffness_damping(c.alpha.alpha1, correction, c.frame.stretches)
+          - c.alpha.alpha1;
       c.has_tangent = false;
       if (c.alpha.alpha1 != 0 || c.alpha1_change != 0) {
         // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 9×9
@@ -68,19 +79,23 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
         // nominal one (see the class comment). Unprojected: the PSD projection is Newton's device
         // (add_jacobian), and the damping force must stay linear in the correction.
         material::CorrectedStress scratch;
-        const material::CorrectedStress& elastic_stress =
-            material::elastic_part(*elastic, correction, c.frame.stretches, c.stress, scratch);
-        c.tangent = material::damping_tangent(c.frame, elastic_stress.stress, elastic_stress.d_stretches);
+        const material::CorrectedStress& elastic_stress
+            = material::elastic_part(*elastic, correction, c.frame.stretches, c.stress, scratch);
+        c.tangent
+            = material::damping_tangent(c.frame, elastic_stress.stress, elastic_stress.d_stretches);
         c.has_tangent = true;
-        if (c.alpha.alpha1 != 0) P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
+        if (c.alpha.alpha1 != 0)
+          P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
         if (c.alpha1_change != 0) {
           c.nominal_tangent = material::damping_tangent(*elastic, c.frame);
-          P += c.alpha1_change * material::first_piola_differential(c.frame, c.nominal_tangent, F_rate);
+          P += c.alpha1_change
+              * material::first_piola_differential(c.frame, c.nominal_tangent, F_rate);
         }
       }
       Eigen::Map<Eigen::Matrix<double, 3, 4>> force(m_force_buffer.data() + 12 * e);
       force.noalias() = -rest.volume * P * rest.gradients;
-      if (c.alpha.alpha0 != 0) force -= c.alpha.alpha0 * (density * rest.volume / 4.0) * ve;
+      if (c.alpha.alpha0 != 0)
+        force -= c.alpha.alpha0 * (density * rest.volume / 4.0) * ve;
     }
   });
   m_cached_x = state.x;
@@ -89,8 +104,8 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
 }
 
 bool ElasticForce::cache_matches(const ForceState& state) const {
-  return m_cache.size() == static_cast<size_t>(m_tets.rows()) && m_cached_x.size() == state.x.size() &&
-         m_cached_v.size() == state.v.size() && m_cached_x == state.x && m_cached_v == state.v;
+  return m_cache.size() == static_cast<size_t>(m_tets.rows()) && m_cached_x.size() == state.x.size()
+      && m_cached_v.size() == state.v.size() && m_cached_x == state.x && m_cached_v == state.v;
 }
 
 void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) {
@@ -108,27 +123,38 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
     // linear in dP/dF), projected once as a whole.
     material::PrincipalTangent tangent;
     if (!c.has_tangent) {
-      tangent = material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
+      tangent = material::principal_tangent(
+          c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
     } else {
-      tangent = weighted_sum(c_x, material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, false),
-                             c_v * c.alpha.alpha1, c.tangent);
-      if (c.alpha1_change != 0) tangent = weighted_sum(1.0, tangent, c_v * c.alpha1_change, c.nominal_tangent);
-      if (m_project_tangent) tangent = material::projected(tangent);
+      tangent = weighted_sum(c_x,
+          material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, false),
+          c_v * c.alpha.alpha1, c.tangent);
+      if (c.alpha1_change != 0)
+        tangent = weighted_sum(1.0, tangent, c_v * c.alpha1_change, c.nominal_tangent);
+      if (m_project_tangent)
+        tangent = material::projected(tangent);
     }
     J = element_stiffness(c.frame, tangent, rest, c.has_tangent ? 1.0 : c_x);
-    if (c.alpha.alpha0 != 0) J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
+    if (c.alpha.alpha0 != 0)
+      J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
     if (correction && c_v != 0 && !c.stress.d_stretch_rates.isZero(0)) {
       // Project the damping tangent as a whole: the Rayleigh part α₁·block plus the correction's
       // rate part may be PSD together even where the rate part alone is not; projecting them
       // separately would overstate the damping and stall Newton.
       Mat3 rayleigh = Mat3::Zero();
-      if (c.has_tangent) rayleigh = c.alpha.alpha1 * c.tangent.block;
-      if (c.alpha1_change != 0) rayleigh += c.alpha1_change * c.nominal_tangent.block;
-      if (m_project_tangent) rayleigh = material::symmetric_psd(rayleigh);
-      const Mat3 d_rates = m_project_tangent ? Mat3(material::symmetric_psd(rayleigh + c.stress.d_stretch_rates) - rayleigh)
-                                             : c.stress.d_stretch_rates;
+      if (c.has_tangent)
+        rayleigh = c.alpha.alpha1 * c.tangent.block;
+      if (c.alpha1_change != 0)
+        rayleigh += c.alpha1_change * c.nominal_tangent.block;
+      if (m_project_tangent)
+        rayleigh = material::symmetric_psd(rayleigh);
+      const Mat3 d_rates = m_project_tangent
+          ? Mat3(material::symmetric_psd(rayleigh + c.stress.d_stretch_rates) - rayleigh)
+          : c.stress.d_stretch_rates;
       if (!d_rates.isZero(0))
-        J += c_v * element_matrix_from_tangent(material::first_piola_rate_derivative(c.frame, d_rates), rest);
+        J += c_v
+            * element_matrix_from_tangent(
+                material::first_piola_rate_derivative(c.frame, d_rates), rest);
     }
   });
 }

@@ -16,10 +16,10 @@ namespace elastolearn::fem {
 
 /// Everything the element kernel needs to know about the material. Shared, immutable.
 struct MaterialModel {
-  std::shared_ptr<const material::ElasticModel> elastic;   ///< required
-  std::shared_ptr<const material::Correction> correction;  ///< optional N(F̂, Ḟ̂)
-  std::shared_ptr<const material::DampingModel> damping;   ///< optional Rayleigh
-  double density = 1000;                                    ///< ρ [kg/m³]
+  std::shared_ptr<const material::ElasticModel> elastic; ///< required
+  std::shared_ptr<const material::Correction> correction; ///< optional N(F̂, Ḟ̂)
+  std::shared_ptr<const material::DampingModel> damping; ///< optional Rayleigh
+  double density = 1000; ///< ρ [kg/m³]
 };
 
 /// Elastic (+correction) and Rayleigh damping forces of all tets, with their Jacobians.
@@ -43,7 +43,7 @@ struct MaterialModel {
 /// Element loops run in parallel (oneTBB): forces into per-element buffers gathered without
 /// locks, element matrices straight into the SystemMatrix (SystemMatrix::add_elements).
 class ElasticForce final : public ForceTerm {
-public:
+  public:
   ElasticForce(const mesh::TetMesh& mesh, MaterialModel material);
 
   /// Forces; caches each element's SVD and stress (and tangent, when Rayleigh α₁ ≠ 0) for
@@ -62,7 +62,7 @@ public:
   const std::vector<TetRestData>& rest_data() const { return m_rest; }
   const Tets& tets() const { return m_tets; }
 
-private:
+  private:
   /// What the force pass leaves for the Jacobian pass, per element.
   struct ElementCache {
     material::PrincipalFrame frame;
@@ -70,8 +70,10 @@ private:
     material::RayleighCoefficients alpha; ///< the damping model's (nominal) α₀, α₁
     /// A correction's Δα₁ as applied: (α₁ + Δα₁)⁺ − α₁ ≥ −α₁ (0 without a correction).
     double alpha1_change = 0;
-    material::PrincipalTangent tangent; ///< material::damping_tangent of P̂ + N; valid if has_tangent
-    material::PrincipalTangent nominal_tangent; ///< material::damping_tangent of P̂; valid if alpha1_change ≠ 0
+    material::PrincipalTangent
+        tangent; ///< material::damping_tangent of P̂ + N; valid if has_tangent
+    material::PrincipalTangent
+        nominal_tangent; ///< material::damping_tangent of P̂; valid if alpha1_change ≠ 0
     bool has_tangent = false;
   };
   bool cache_matches(const ForceState& state) const;
@@ -80,11 +82,11 @@ private:
   Tets m_tets;
   std::vector<TetRestData> m_rest;
   MaterialModel m_material;
-  std::vector<ElementCache> m_cache;    ///< m, from the last add_force
-  VecX m_cached_x, m_cached_v;          ///< the state m_cache belongs to
-  std::vector<double> m_force_buffer;   ///< m·12
-  std::vector<int> m_vertex_offsets;    ///< vertex → range in m_vertex_sources
-  std::vector<int> m_vertex_sources;    ///< element·4 + local vertex
+  std::vector<ElementCache> m_cache; ///< m, from the last add_force
+  VecX m_cached_x, m_cached_v; ///< the state m_cache belongs to
+  std::vector<double> m_force_buffer; ///< m·12
+  std::vector<int> m_vertex_offsets; ///< vertex → range in m_vertex_sources
+  std::vector<int> m_vertex_sources; ///< element·4 + local vertex
   bool m_project_tangent = true;
 };
 

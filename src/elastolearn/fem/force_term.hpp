@@ -15,7 +15,7 @@ struct ForceState {
 };
 
 class ForceTerm {
-public:
+  public:
   virtual ~ForceTerm() = default;
   /// f += force(x, v, t) (full 3n vector, N).
   virtual void add_force(const ForceState& state, VecX& f) = 0;
@@ -23,10 +23,10 @@ public:
   /// positive semi-definite (projected) Jacobians at `state`. Terms may reuse work cached by the
   /// last add_force at the same state (Newton always asks for the residual first). Terms without
   /// Jacobians (constant loads) add nothing.
-  virtual void add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) {}
+  virtual void add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) { }
   /// Both, in that order.
-  void add_force_and_jacobian(const ForceState& state, double c_x, double c_v, VecX& f,
-                              SystemMatrix& A) {
+  void add_force_and_jacobian(
+      const ForceState& state, double c_x, double c_v, VecX& f, SystemMatrix& A) {
     add_force(state, f);
     add_jacobian(state, c_x, c_v, A);
   }

@@ -8,22 +8,26 @@ const char* to_string(MassType type) {
 }
 
 MassType mass_type_from_string(const std::string& name) {
-  if (name == "lumped") return MassType::Lumped;
-  if (name == "consistent") return MassType::Consistent;
+  if (name == "lumped")
+    return MassType::Lumped;
+  if (name == "consistent")
+    return MassType::Consistent;
   throw InputError("mass", "unknown mass type '" + name + "' (valid: lumped, consistent)");
 }
 
-VecX lumped_vertex_masses(const Tets& tets, const std::vector<TetRestData>& rest, int num_vertices,
-                          double density) {
+VecX lumped_vertex_masses(
+    const Tets& tets, const std::vector<TetRestData>& rest, int num_vertices, double density) {
   VecX m = VecX::Zero(num_vertices);
   for (Eigen::Index e = 0; e < tets.rows(); ++e)
-    for (int a = 0; a < 4; ++a) m[tets(e, a)] += density * rest[e].volume / 4.0;
+    for (int a = 0; a < 4; ++a)
+      m[tets(e, a)] += density * rest[e].volume / 4.0;
   return m;
 }
 
 VecX lumped_dof_masses(const VecX& vertex_masses) {
   VecX out(3 * vertex_masses.size());
-  for (Eigen::Index v = 0; v < vertex_masses.size(); ++v) out.segment<3>(3 * v).setConstant(vertex_masses[v]);
+  for (Eigen::Index v = 0; v < vertex_masses.size(); ++v)
+    out.segment<3>(3 * v).setConstant(vertex_masses[v]);
   return out;
 }
 

@@ -15,8 +15,8 @@ const char* to_string(MassType type);
 MassType mass_type_from_string(const std::string& name);
 
 /// Lumped vertex masses (paper 000's choice): each tet gives ρ·vol/4 to each vertex. Length n [kg].
-VecX lumped_vertex_masses(const Tets& tets, const std::vector<TetRestData>& rest, int num_vertices,
-                          double density);
+VecX lumped_vertex_masses(
+    const Tets& tets, const std::vector<TetRestData>& rest, int num_vertices, double density);
 
 /// Per-dof lumped masses (each vertex mass repeated 3×). Length 3n.
 VecX lumped_dof_masses(const VecX& vertex_masses);

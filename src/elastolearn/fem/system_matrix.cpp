@@ -27,12 +27,15 @@ Adjacency vertex_elements(const Tets& tets, int num_vertices) {
   Adjacency adj;
   adj.offsets.assign(num_vertices + 1, 0);
   for (Eigen::Index e = 0; e < tets.rows(); ++e)
-    for (int a = 0; a < 4; ++a) ++adj.offsets[tets(e, a) + 1];
-  for (int v = 0; v < num_vertices; ++v) adj.offsets[v + 1] += adj.offsets[v];
+    for (int a = 0; a < 4; ++a)
+      ++adj.offsets[tets(e, a) + 1];
+  for (int v = 0; v < num_vertices; ++v)
+    adj.offsets[v + 1] += adj.offsets[v];
   adj.entries.resize(adj.offsets[num_vertices]);
   std::vector<int> fill(adj.offsets.begin(), adj.offsets.end() - 1);
   for (Eigen::Index e = 0; e < tets.rows(); ++e)
-    for (int a = 0; a < 4; ++a) adj.entries[fill[tets(e, a)]++] = static_cast<int>(e);
+    for (int a = 0; a < 4; ++a)
+      adj.entries[fill[tets(e, a)]++] = static_cast<int>(e);
   return adj;
 }
 
@@ -44,7 +47,8 @@ std::vector<int> breadth_first_elements(const Tets& tets, const Adjacency& verte
   order.reserve(m);
   std::vector<char> seen(m, 0);
   for (int start = 0; start < m; ++start) {
-    if (seen[start]) continue;
+    if (seen[start])
+      continue;
     seen[start] = 1;
     order.push_back(start);
     for (size_t head = order.size() - 1; head < order.size(); ++head) {
@@ -53,7 +57,8 @@ std::vector<int> breadth_first_elements(const Tets& tets, const Adjacency& verte
         const int v = tets(e, a);
         for (int j = vertex_elems.offsets[v]; j < vertex_elems.offsets[v + 1]; ++j) {
           const int f = vertex_elems.entries[j];
-          if (!seen[f]) seen[f] = 1, order.push_back(f);
+          if (!seen[f])
+            seen[f] = 1, order.push_back(f);
         }
       }
     }
@@ -63,7 +68,7 @@ std::vector<int> breadth_first_elements(const Tets& tets, const Adjacency& verte
 
 /// Chunk `order` and colour the chunks greedily (chunks of one colour share no free vertex).
 ChunkColouring colour_chunks(const Tets& tets, const DofMap& dofs, const Adjacency& vertex_elems,
-                             const std::vector<int>& order);
+    const std::vector<int>& order);
 
 } // namespace
 
@@ -77,11 +82,13 @@ SystemMatrix::SystemMatrix(const Tets& tets, const DofMap& dofs) {
     for (int a = 0; a < 4; ++a)
       for (int i = 0; i < 3; ++i) {
         const int col = dofs.free_index(3 * tets(e, a) + i);
-        if (col < 0) continue;
+        if (col < 0)
+          continue;
         for (int b = 0; b < 4; ++b)
           for (int k = 0; k < 3; ++k) {
             const int row = dofs.free_index(3 * tets(e, b) + k);
-            if (row >= 0) columns[col].push_back(row);
+            if (row >= 0)
+              columns[col].push_back(row);
           }
       }
   std::vector<int> outer(n + 1, 0);
@@ -93,7 +100,8 @@ SystemMatrix::SystemMatrix(const Tets& tets, const DofMap& dofs) {
   }
   const int nnz = outer[n];
   std::vector<int> inner(nnz);
-  for (int c = 0; c < n; ++c) std::copy(columns[c].begin(), columns[c].end(), inner.begin() + outer[c]);
+  for (int c = 0; c < n; ++c)
+    std::copy(columns[c].begin(), columns[c].end(), inner.begin() + outer[c]);
   std::vector<double> zeros(nnz, 0.0);
   m_matrix = Eigen::Map<const SparseMatrix>(n, n, nnz, outer.data(), inner.data(), zeros.data());
   m_matrix.makeCompressed();
@@ -104,7 +112,8 @@ SystemMatrix::SystemMatrix(const Tets& tets, const DofMap& dofs) {
     return static_cast<int>(std::lower_bound(begin, end, row) - m_matrix.innerIndexPtr());
   };
   m_diagonal_slot.resize(n);
-  for (int c = 0; c < n; ++c) m_diagonal_slot[c] = slot(c, c);
+  for (int c = 0; c < n; ++c)
+    m_diagonal_slot[c] = slot(c, c);
 
   // Element slots, checking the whole-vertex layout the direct assembly relies on.
   const int* col_start = m_matrix.outerIndexPtr();
@@ -113,20 +122,22 @@ SystemMatrix::SystemMatrix(const Tets& tets, const DofMap& dofs) {
   for (int e = 0; e < m; ++e)
     for (int b = 0; b < 4; ++b) {
       const int cb = dofs.free_index(3 * tets(e, b));
-      if (cb < 0) continue;
+      if (cb < 0)
+        continue;
       const int length = col_start[cb + 1] - col_start[cb];
       m_element_column_length[4 * e + b] = length;
       for (int a = 0; a < 4; ++a) {
         const int ra = dofs.free_index(3 * tets(e, a));
-        if (ra < 0) continue;
+        if (ra < 0)
+          continue;
         const int base = slot(ra, cb);
         m_element_slots[16 * e + 4 * b + a] = base;
         for (int k = 0; k < 3; ++k)
           for (int i = 0; i < 3; ++i)
-            ELASTOLEARN_CHECK(dofs.free_index(3 * tets(e, a) + i) == ra + i &&
-                                  dofs.free_index(3 * tets(e, b) + k) == cb + k &&
-                                  slot(ra + i, cb + k) == base + k * length + i,
-                              "SystemMatrix needs whole free vertices with consecutive dofs");
+            ELASTOLEARN_CHECK(dofs.free_index(3 * tets(e, a) + i) == ra + i
+                    && dofs.free_index(3 * tets(e, b) + k) == cb + k
+                    && slot(ra + i, cb + k) == base + k * length + i,
+                "SystemMatrix needs whole free vertices with consecutive dofs");
       }
     }
 
@@ -138,7 +149,8 @@ SystemMatrix::SystemMatrix(const Tets& tets, const DofMap& dofs) {
   // the summation order, hence the values, is the same for any thread count.
   const Adjacency vertex_elems = vertex_elements(tets, num_vertices);
   m_chunk_elements.resize(m);
-  for (int e = 0; e < m; ++e) m_chunk_elements[e] = e;
+  for (int e = 0; e < m; ++e)
+    m_chunk_elements[e] = e;
   ChunkColouring colouring = colour_chunks(tets, dofs, vertex_elems, m_chunk_elements);
   if (colouring.colours() > kMaxIndexOrderColours) {
     m_chunk_elements = breadth_first_elements(tets, vertex_elems);
@@ -152,39 +164,48 @@ SystemMatrix::SystemMatrix(const Tets& tets, const DofMap& dofs) {
 namespace {
 
 ChunkColouring colour_chunks(const Tets& tets, const DofMap& dofs, const Adjacency& vertex_elems,
-                             const std::vector<int>& order) {
+    const std::vector<int>& order) {
   const int m = static_cast<int>(tets.rows());
   ChunkColouring out;
   const int chunk_size = std::clamp(m / 64, 16, 512);
   const int chunks = (m + chunk_size - 1) / chunk_size;
   out.chunk_offsets.resize(chunks + 1);
-  for (int c = 0; c <= chunks; ++c) out.chunk_offsets[c] = std::min(c * chunk_size, m);
+  for (int c = 0; c <= chunks; ++c)
+    out.chunk_offsets[c] = std::min(c * chunk_size, m);
   std::vector<int> chunk_of(m);
   for (int c = 0; c < chunks; ++c)
-    for (int j = out.chunk_offsets[c]; j < out.chunk_offsets[c + 1]; ++j) chunk_of[order[j]] = c;
+    for (int j = out.chunk_offsets[c]; j < out.chunk_offsets[c + 1]; ++j)
+      chunk_of[order[j]] = c;
   std::vector<int> colour(chunks, -1), mark;
   int colours = 0;
   for (int c = 0; c < chunks; ++c) {
     for (int j = out.chunk_offsets[c]; j < out.chunk_offsets[c + 1]; ++j)
       for (int a = 0; a < 4; ++a) {
         const int v = tets(order[j], a);
-        if (dofs.is_prescribed_vertex(v)) continue;
+        if (dofs.is_prescribed_vertex(v))
+          continue;
         for (int t = vertex_elems.offsets[v]; t < vertex_elems.offsets[v + 1]; ++t) {
           const int other = colour[chunk_of[vertex_elems.entries[t]]];
-          if (other >= 0) mark[other] = c;
+          if (other >= 0)
+            mark[other] = c;
         }
       }
     int k = 0;
-    while (k < colours && mark[k] == c) ++k;
-    if (k == colours) ++colours, mark.push_back(-1);
+    while (k < colours && mark[k] == c)
+      ++k;
+    if (k == colours)
+      ++colours, mark.push_back(-1);
     colour[c] = k;
   }
   out.colour_offsets.assign(colours + 1, 0);
-  for (int c = 0; c < chunks; ++c) ++out.colour_offsets[colour[c] + 1];
-  for (int k = 0; k < colours; ++k) out.colour_offsets[k + 1] += out.colour_offsets[k];
+  for (int c = 0; c < chunks; ++c)
+    ++out.colour_offsets[colour[c] + 1];
+  for (int k = 0; k < colours; ++k)
+    out.colour_offsets[k + 1] += out.colour_offsets[k];
   out.colour_chunks.resize(chunks);
   std::vector<int> fill(out.colour_offsets.begin(), out.colour_offsets.end() - 1);
-  for (int c = 0; c < chunks; ++c) out.colour_chunks[fill[colour[c]]++] = c;
+  for (int c = 0; c < chunks; ++c)
+    out.colour_chunks[fill[colour[c]]++] = c;
   return out;
 }
 
@@ -199,33 +220,34 @@ void SystemMatrix::add_elements(const std::function<void(int e, Mat12& K)>& elem
   const int colours = static_cast<int>(m_colour_offsets.size()) - 1;
   for (int k = 0; k < colours; ++k)
     tbb::parallel_for(tbb::blocked_range<int>(m_colour_offsets[k], m_colour_offsets[k + 1], 1),
-                      [&](const tbb::blocked_range<int>& r) {
-      Mat12 K;
-      for (int c = r.begin(); c < r.end(); ++c) {
-        const int chunk = m_colour_chunks[c];
-        for (int j = m_chunk_offsets[chunk]; j < m_chunk_offsets[chunk + 1]; ++j) {
-          const int e = m_chunk_elements[j];
-          element(e, K);
-          const int* slots = m_element_slots.data() + 16 * static_cast<size_t>(e);
-          const int* lengths = m_element_column_length.data() + 4 * static_cast<size_t>(e);
-          for (int b = 0; b < 4; ++b)
-            for (int a = 0; a < 4; ++a) {
-              const int base = slots[4 * b + a];
-              if (base < 0) continue;
-              for (int kk = 0; kk < 3; ++kk) {
-                double* out = values + base + kk * lengths[b];
-                const double* in = K.data() + (3 * b + kk) * 12 + 3 * a;
-                out[0] += in[0], out[1] += in[1], out[2] += in[2];
-              }
+        [&](const tbb::blocked_range<int>& r) {
+          Mat12 K;
+          for (int c = r.begin(); c < r.end(); ++c) {
+            const int chunk = m_colour_chunks[c];
+            for (int j = m_chunk_offsets[chunk]; j < m_chunk_offsets[chunk + 1]; ++j) {
+              const int e = m_chunk_elements[j];
+              element(e, K);
+              const int* slots = m_element_slots.data() + 16 * static_cast<size_t>(e);
+              const int* lengths = m_element_column_length.data() + 4 * static_cast<size_t>(e);
+              for (int b = 0; b < 4; ++b)
+                for (int a = 0; a < 4; ++a) {
+                  const int base = slots[4 * b + a];
+                  if (base < 0)
+                    continue;
+                  for (int kk = 0; kk < 3; ++kk) {
+                    double* out = values + base + kk * lengths[b];
+                    const double* in = K.data() + (3 * b + kk) * 12 + 3 * a;
+                    out[0] += in[0], out[1] += in[1], out[2] += in[2];
+                  }
+                }
             }
-        }
-      }
-    });
+          }
+        });
 }
 
 void SystemMatrix::add_element_blocks(const std::vector<double>& element_blocks, double scale) {
   ELASTOLEARN_CHECK(element_blocks.size() == static_cast<size_t>(num_elements()) * 144,
-                    "element buffer size does not match the mesh");
+      "element buffer size does not match the mesh");
   add_elements([&](int e, Mat12& K) {
     K = scale * Eigen::Map<const Mat12>(element_blocks.data() + 144 * static_cast<size_t>(e));
   });
@@ -233,7 +255,8 @@ void SystemMatrix::add_element_blocks(const std::vector<double>& element_blocks,
 
 void SystemMatrix::add_diagonal(const VecX& reduced_diagonal, double scale) {
   double* values = m_matrix.valuePtr();
-  for (int i = 0; i < size(); ++i) values[m_diagonal_slot[i]] += scale * reduced_diagonal[i];
+  for (int i = 0; i < size(); ++i)
+    values[m_diagonal_slot[i]] += scale * reduced_diagonal[i];
 }
 
 void SystemMatrix::add_values(const VecX& other, double scale) {

@@ -16,7 +16,7 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 /// Full (both triangles) symmetric matrix over the free dofs of a tet mesh.
 class SystemMatrix {
-public:
+  public:
   SystemMatrix() = default;
   /// Build the pattern: every pair of free dofs sharing a tet, and the element colouring.
   /// O(nnz), once per scene. `dofs` frees or prescribes whole vertices (as DofMap does).
@@ -45,18 +45,18 @@ public:
   /// The current values as a vector (to cache a constant matrix such as the consistent mass).
   VecX values() const;
 
-private:
+  private:
   SparseMatrix m_matrix;
-  std::vector<int> m_diagonal_slot;  ///< free dof → position of its diagonal in valuePtr
+  std::vector<int> m_diagonal_slot; ///< free dof → position of its diagonal in valuePtr
   /// Per element, 16 entries (a, b) → position in valuePtr of entry (row 3a', col 3b') for its
   /// vertices' free triplets a', b' (−1 if either is prescribed); entry (3a'+i, 3b'+k) is at
   /// that + k·(column length of 3b') + i, since a vertex's three columns share one pattern.
   std::vector<int> m_element_slots;
   std::vector<int> m_element_column_length; ///< per element and vertex b: length of column 3b'
-  std::vector<int> m_chunk_elements;        ///< elements in chunk order
-  std::vector<int> m_chunk_offsets;         ///< chunk → range in m_chunk_elements
-  std::vector<int> m_colour_chunks;         ///< chunks grouped by colour
-  std::vector<int> m_colour_offsets;        ///< colour → range in m_colour_chunks
+  std::vector<int> m_chunk_elements; ///< elements in chunk order
+  std::vector<int> m_chunk_offsets; ///< chunk → range in m_chunk_elements
+  std::vector<int> m_colour_chunks; ///< chunks grouped by colour
+  std::vector<int> m_colour_offsets; ///< colour → range in m_colour_chunks
 };
 
 } // namespace elastolearn::fem

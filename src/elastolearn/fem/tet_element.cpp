@@ -10,7 +10,8 @@ std::vector<TetRestData> precompute_rest_data(const mesh::TetMesh& mesh) {
   std::vector<TetRestData> out(mesh.num_tets());
   for (int e = 0; e < mesh.num_tets(); ++e) {
     Mat3 Dm;
-    for (int c = 0; c < 3; ++c) Dm.col(c) = (X.row(T(e, c + 1)) - X.row(T(e, 0))).transpose();
+    for (int c = 0; c < 3; ++c)
+      Dm.col(c) = (X.row(T(e, c + 1)) - X.row(T(e, 0))).transpose();
     const Mat3 Dm_inv = Dm.inverse(); // TetMesh guarantees non-degenerate, positive tets
     out[e].volume = Dm.determinant() / 6.0;
     out[e].gradients.rightCols<3>() = Dm_inv.transpose();
@@ -33,21 +34,24 @@ Mat12 element_matrix_from_tangent(const Mat9& H, const TetRestData& rest, bool s
     for (int i = 0; i < 3; ++i) {
       const int row = 3 * a + i;
       for (int col = symmetric ? row : 0; col < 12; ++col)
-        K(row, col) = rest.volume * (g(0, a) * W(i, col) + g(1, a) * W(i + 3, col) + g(2, a) * W(i + 6, col));
+        K(row, col) = rest.volume
+            * (g(0, a) * W(i, col) + g(1, a) * W(i + 3, col) + g(2, a) * W(i + 6, col));
     }
-  if (symmetric) K.triangularView<Eigen::StrictlyLower>() = K.transpose();
+  if (symmetric)
+    K.triangularView<Eigen::StrictlyLower>() = K.transpose();
   return K;
 }
 
 Mat12 element_stiffness(const material::PrincipalFrame& frame, const material::PrincipalTangent& t,
-                        const TetRestData& rest, double scale) {
+    const TetRestData& rest, double scale) {
   const double s = scale * rest.volume;
   const Eigen::Matrix<double, 3, 4> g = frame.V.transpose() * rest.gradients; // ĝ_a, rotated
   // A: the block term; D: the diagonal entries' weights (A_ii on the diagonal, a_il off it);
-  // B: the transposed-entry weights b_ij (zero diagonal). All symmetric except A, D if the block is not.
+  // B: the transposed-entry weights b_ij (zero diagonal). All symmetric except A, D if the block is
+  // not.
   const Mat3 A = s * t.block;
   Mat3 D = A, B = Mat3::Zero();
-  static constexpr int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  static constexpr int pairs[3][2] = { { 0, 1 }, { 0, 2 }, { 1, 2 } };
   for (int m = 0; m < 3; ++m) {
     const int i = pairs[m][0], j = pairs[m][1];
     D(i, j) = D(j, i) = 0.5 * s * (t.twist[m] + t.flip[m]);
@@ -65,7 +69,8 @@ Mat12 element_stiffness(const material::PrincipalFrame& frame, const material::P
     }
   // Mirror the upper triangle (also within the diagonal blocks, which rounding leaves slightly
   // non-symmetric).
-  if (symmetric) K.triangularView<Eigen::StrictlyLower>() = K.transpose();
+  if (symmetric)
+    K.triangularView<Eigen::StrictlyLower>() = K.transpose();
   return K;
 }
 

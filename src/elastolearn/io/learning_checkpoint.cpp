@@ -13,17 +13,20 @@ nlohmann::json correction_json(const std::shared_ptr<const material::RbfCorrecti
   return c ? correction_to_json(*c) : nlohmann::json(nullptr);
 }
 
-std::shared_ptr<const material::RbfCorrection> read_correction(const JsonObject& object, const std::string& key) {
-  if (object.json().at(key).is_null()) return nullptr;
+std::shared_ptr<const material::RbfCorrection> read_correction(
+    const JsonObject& object, const std::string& key) {
+  if (object.json().at(key).is_null())
+    return nullptr;
   auto c = correction_from_json(object.object(key));
   auto rbf = std::dynamic_pointer_cast<const material::RbfCorrection>(c);
-  if (!rbf) object.fail(key, "must be an RBF correction");
+  if (!rbf)
+    object.fail(key, "must be an RBF correction");
   return rbf;
 }
 
 nlohmann::json error_json(const learn::ErrorSummary& e) {
-  return {{"max", e.max}, {"mean", e.mean}, {"rms", e.rms}, {"worst_frame", e.worst_frame},
-          {"worst_vertex", e.worst_vertex}, {"samples", e.samples}};
+  return { { "max", e.max }, { "mean", e.mean }, { "rms", e.rms }, { "worst_frame", e.worst_frame },
+    { "worst_vertex", e.worst_vertex }, { "samples", e.samples } };
 }
 
 learn::ErrorSummary read_error(const JsonObject& o) {
@@ -65,96 +68,95 @@ learn::IterationRecord read_record(const JsonObject& o) {
 } // namespace
 
 nlohmann::json iteration_record_to_json(const learn::IterationRecord& r) {
-  return {{"iteration", r.iteration},
-          {"forward_error", error_json(r.forward_error)},
-          {"forward_completed", r.forward_completed},
-          {"damped_update", r.damped_update},
-          {"forward_fit", r.forward_fit},
-          {"forward_fit_accepted", r.forward_fit_accepted},
-          {"control_force_rms", r.control_force_rms},
-          {"space_time_initial", r.space_time_initial},
-          {"space_time_objective", r.space_time_objective},
-          {"space_time_iterations", r.space_time_iterations},
-          {"modes", r.modes},
-          {"centres", r.centres},
-          {"correction_misfit", r.correction_misfit},
-          {"correction_target", r.correction_target},
-          {"seconds",
-           {{"forward", r.seconds_forward},
-            {"pod", r.seconds_pod},
-            {"constrained", r.seconds_constrained},
-            {"space_time", r.seconds_space_time},
-            {"reconstruction", r.seconds_reconstruction},
-            {"total", r.seconds_total()}}}};
+  return { { "iteration", r.iteration }, { "forward_error", error_json(r.forward_error) },
+    { "forward_completed", r.forward_completed }, { "damped_update", r.damped_update },
+    { "forward_fit", r.forward_fit }, { "forward_fit_accepted", r.forward_fit_accepted },
+    { "control_force_rms", r.control_force_rms }, { "space_time_initial", r.space_time_initial },
+    { "space_time_objective", r.space_time_objective },
+    { "space_time_iterations", r.space_time_iterations }, { "modes", r.modes },
+    { "centres", r.centres }, { "correction_misfit", r.correction_misfit },
+    { "correction_target", r.correction_target },
+    { "seconds",
+        { { "forward", r.seconds_forward }, { "pod", r.seconds_pod },
+            { "constrained", r.seconds_constrained }, { "space_time", r.seconds_space_time },
+            { "reconstruction", r.seconds_reconstruction }, { "total", r.seconds_total() } } } };
 }
 
 nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
-  return {{"max_iterations", o.max_iterations},
-          {"patience", o.patience},
-          {"free_halvings", o.free_halvings},
-          {"pod", {{"max_modes", o.pod.max_modes}, {"energy_fraction", o.pod.energy_fraction},
-                   {"first_frame", o.pod.first_frame}, {"frame_count", o.pod.frame_count},
-                   {"frame_stride", o.pod.frame_stride}, {"mass_orthonormal", o.pod.mass_orthonormal},
-                   {"with_constrained", o.pod_with_constrained}}},
-          {"space_time", {{"position_weight", o.space_time.position_weight},
-                          {"max_iterations", o.space_time.max_iterations},
-                          {"tolerance", o.space_time.tolerance}}},
-          {"centres", o.centres},
-          {"full_space", o.full_space},
-          {"max_reconstruction_frames", o.max_reconstruction_frames},
-          {"rbf", {{"epsilon", o.rbf.epsilon}, {"elastic_polynomial", o.rbf.elastic_polynomial},
-                   {"quadratic_tail", o.rbf.quadratic_tail}, {"stress_free_rest", o.rbf.stress_free_rest},
-                   {"neo_hookean_tail", o.rbf.neo_hookean_tail},
-                   {"fit_damping", o.rbf.fit_damping}, {"damping_polynomial", o.rbf.damping_polynomial},
-                   {"damping_quadratic_tail", o.rbf.damping_quadratic_tail},
-                   {"regularization", o.rbf.regularization},
-                   {"damping_regularization", o.rbf.damping_regularization}}},
-          {"reconstruction", {{"method", learn::reconstruction_method_name(o.reconstruction.method)},
-                              {"frame_stride", o.reconstruction.frame_stride},
-                              {"projected", o.projected_reconstruction},
-                              {"full_space_weight", o.reconstruction.full_space_weight}}},
-          {"stretch_samples", {{"frame_stride", o.stretch_samples.frame_stride},
-                               {"max_samples", o.stretch_samples.max_samples}}},
-          {"seed", o.seed},
-          {"forward_fit", {{"max_iterations", o.forward_fit.max_iterations}, {"damping", o.forward_fit.damping},
-                           {"damping_prior", o.forward_fit.damping_prior},
-                           {"elastic_prior", o.forward_fit.elastic_prior}}}};
+  return { { "max_iterations", o.max_iterations }, { "patience", o.patience },
+    { "free_halvings", o.free_halvings },
+    { "pod",
+        { { "max_modes", o.pod.max_modes }, { "energy_fraction", o.pod.energy_fraction },
+            { "first_frame", o.pod.first_frame }, { "frame_count", o.pod.frame_count },
+            { "frame_stride", o.pod.frame_stride }, { "mass_orthonormal", o.pod.mass_orthonormal },
+            { "with_constrained", o.pod_with_constrained } } },
+    { "space_time",
+        { { "position_weight", o.space_time.position_weight },
+            { "max_iterations", o.space_time.max_iterations },
+            { "tolerance", o.space_time.tolerance } } },
+    { "centres", o.centres }, { "full_space", o.full_space },
+    { "max_reconstruction_frames", o.max_reconstruction_frames },
+    { "rbf",
+        { { "epsilon", o.rbf.epsilon }, { "elastic_polynomial", o.rbf.elastic_polynomial },
+            { "quadratic_tail", o.rbf.quadratic_tail },
+            { "stress_free_rest", o.rbf.stress_free_rest },
+            { "neo_hookean_tail", o.rbf.neo_hookean_tail }, { "fit_damping", o.rbf.fit_damping },
+            { "damping_polynomial", o.rbf.damping_polynomial },
+            { "damping_quadratic_tail", o.rbf.damping_quadratic_tail },
+            { "regularization", o.rbf.regularization },
+            { "damping_regularization", o.rbf.damping_regularization } } },
+    { "reconstruction",
+        { { "method", learn::reconstruction_method_name(o.reconstruction.method) },
+            { "frame_stride", o.reconstruction.frame_stride },
+            { "projected", o.projected_reconstruction },
+            { "full_space_weight", o.reconstruction.full_space_weight } } },
+    { "stretch_samples",
+        { { "frame_stride", o.stretch_samples.frame_stride },
+            { "max_samples", o.stretch_samples.max_samples } } },
+    { "seed", o.seed },
+    { "forward_fit",
+        { { "max_iterations", o.forward_fit.max_iterations }, { "damping", o.forward_fit.damping },
+            { "damping_prior", o.forward_fit.damping_prior },
+            { "elastic_prior", o.forward_fit.elastic_prior } } } };
 }
 
 void write_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs,
-                               const learn::LearningState& state) {
+    const learn::LearningState& state) {
   nlohmann::json history = nlohmann::json::array();
-  for (const auto& r : state.history) history.push_back(iteration_record_to_json(r));
-  const nlohmann::json j = {
-      {"format", std::string(k_format) + "/1"},
-      {"inputs", {{"scene", inputs.scene}, {"observations", inputs.observations}, {"options", inputs.options}}},
-      {"state",
-       {{"next_iteration", state.next_iteration},
-        {"correction", correction_json(state.correction)},
-        {"best", correction_json(state.best)},
-        {"best_error", state.best_error},
-        {"best_iteration", state.best_iteration},
-        {"iterations_without_improvement", state.iterations_without_improvement},
-        {"divergences_in_a_row", state.divergences_in_a_row},
-        {"finished", state.finished},
-        {"forward_fit_steps", state.forward_fit_steps},
-        {"forward_fit_damping", state.forward_fit_damping},
-        {"history", history}}}};
+  for (const auto& r : state.history)
+    history.push_back(iteration_record_to_json(r));
+  const nlohmann::json j = { { "format", std::string(k_format) + "/1" },
+    { "inputs",
+        { { "scene", inputs.scene }, { "observations", inputs.observations },
+            { "options", inputs.options } } },
+    { "state",
+        { { "next_iteration", state.next_iteration },
+            { "correction", correction_json(state.correction) },
+            { "best", correction_json(state.best) }, { "best_error", state.best_error },
+            { "best_iteration", state.best_iteration },
+            { "iterations_without_improvement", state.iterations_without_improvement },
+            { "divergences_in_a_row", state.divergences_in_a_row }, { "finished", state.finished },
+            { "forward_fit_steps", state.forward_fit_steps },
+            { "forward_fit_damping", state.forward_fit_damping }, { "history", history } } } };
   write_json_file(path, j);
 }
 
-learn::LearningState read_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs) {
+learn::LearningState read_learning_checkpoint(
+    const std::filesystem::path& path, const LearningInputs& inputs) {
   const nlohmann::json j = read_json_file(path);
   const JsonObject root(j, path.string());
   check_format(root, k_format, 1);
   const JsonObject in = root.object("inputs");
   if (in.string("scene") != inputs.scene)
-    in.fail("scene", "the checkpoint belongs to scene '" + in.string("scene") + "', not '" + inputs.scene + "'");
+    in.fail("scene",
+        "the checkpoint belongs to scene '" + in.string("scene") + "', not '" + inputs.scene + "'");
   if (in.string("observations") != inputs.observations)
-    in.fail("observations", "the checkpoint belongs to observations '" + in.string("observations") + "', not '" +
-                                inputs.observations + "'");
+    in.fail("observations",
+        "the checkpoint belongs to observations '" + in.string("observations") + "', not '"
+            + inputs.observations + "'");
   if (in.json().at("options") != inputs.options)
-    in.fail("options", "the checkpoint was made with other learning options: resume with the same options");
+    in.fail("options",
+        "the checkpoint was made with other learning options: resume with the same options");
   const JsonObject s = root.object("state");
   learn::LearningState state;
   state.next_iteration = s.integer("next_iteration");
@@ -167,7 +169,8 @@ learn::LearningState read_learning_checkpoint(const std::filesystem::path& path,
   state.finished = s.boolean("finished", false);
   state.forward_fit_steps = s.integer("forward_fit_steps", 0);
   state.forward_fit_damping = s.number("forward_fit_damping", -1.0);
-  for (const auto& r : s.objects("history")) state.history.push_back(read_record(r));
+  for (const auto& r : s.objects("history"))
+    state.history.push_back(read_record(r));
   return state;
 }
 

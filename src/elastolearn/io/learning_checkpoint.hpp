@@ -14,18 +14,19 @@ namespace elastolearn::io {
 
 /// What a checkpoint must match to be resumed: the input files and the options.
 struct LearningInputs {
-  std::string scene;        ///< scene file, as given
+  std::string scene; ///< scene file, as given
   std::string observations; ///< observation file, as given
-  nlohmann::json options;   ///< the learning options (learning_options_to_json)
+  nlohmann::json options; ///< the learning options (learning_options_to_json)
 };
 
 /// Write atomically. Throws InputError naming the path.
 void write_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs,
-                               const learn::LearningState& state);
+    const learn::LearningState& state);
 
 /// Read a checkpoint and check it against `inputs` (same scene and observation paths, same
 /// options). Throws InputError naming the file and the field that differs or is invalid.
-learn::LearningState read_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs);
+learn::LearningState read_learning_checkpoint(
+    const std::filesystem::path& path, const LearningInputs& inputs);
 
 /// One iteration's record as JSON (also used in reports and in the learned material's
 /// "training" provenance).

@@ -44,11 +44,11 @@ Json rbf_to_json(const material::RbfCorrection& c) {
   return Json { { "type", "rbf" }, { "epsilon", p.epsilon }, { "centres", rows_to_json(p.centres) },
     { "weights", vector_to_json(p.weights) }, { "own_slope", p.own_slope },
     { "other_slope", p.other_slope }, { "constant", p.constant },
-    { "quadratic", vector_to_json(p.quadratic) },
-    { "neo_hookean", vector_to_json(p.neo_hookean) },
-    { "damping_weights", vector_to_json(p.damping_weights) }, { "damping_slopes", vector_to_json(p.damping_slopes) },
-    { "damping_constant", p.damping_constant }, { "damping_quadratic", vector_to_json(p.damping_quadratic) },
-    { "damping_floor", floor } };
+    { "quadratic", vector_to_json(p.quadratic) }, { "neo_hookean", vector_to_json(p.neo_hookean) },
+    { "damping_weights", vector_to_json(p.damping_weights) },
+    { "damping_slopes", vector_to_json(p.damping_slopes) },
+    { "damping_constant", p.damping_constant },
+    { "damping_quadratic", vector_to_json(p.damping_quadratic) }, { "damping_floor", floor } };
 }
 
 Json nn_to_json(const material::NnCorrection& c) {
@@ -58,9 +58,8 @@ Json nn_to_json(const material::NnCorrection& c) {
     layers.push_back(
         Json { { "weight", rows_to_json(layer.weight) }, { "bias", vector_to_json(layer.bias) } });
   Json out { { "type", "nn" }, { "input_mean", vector_to_json(p.input_mean) },
-    { "input_scale", vector_to_json(p.input_scale) },
-    { "output_mean", p.output_mean }, { "output_scale", p.output_scale },
-    { "layers", std::move(layers) } };
+    { "input_scale", vector_to_json(p.input_scale) }, { "output_mean", p.output_mean },
+    { "output_scale", p.output_scale }, { "layers", std::move(layers) } };
   if (p.damping)
     out["damping"] = rbf_to_json(*p.damping);
   return out;
@@ -128,8 +127,8 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
 
 std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "epsilon", "centres", "weights", "own_slope", "other_slope",
-      "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes", "damping_slope", "damping_constant",
-      "damping_quadratic", "damping_floor" });
+      "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes", "damping_slope",
+      "damping_constant", "damping_quadratic", "damping_floor" });
   material::RbfCorrection::Parameters p;
   p.epsilon = o.number("epsilon");
   p.centres = read_rows(o, "centres", -1, 3);
@@ -150,7 +149,8 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
     }
   }
   if (o.has("damping_slopes") && o.has("damping_slope"))
-    o.fail("damping_slope", "give either damping_slopes or the older damping_slope (a slope along Σσ − 3), not both");
+    o.fail("damping_slope",
+        "give either damping_slopes or the older damping_slope (a slope along Σσ − 3), not both");
   if (o.has("damping_slopes"))
     p.damping_slopes = read_vector(o, "damping_slopes", 3);
   else // older files: one slope along the trace Σσ − 3 = Σ (s_k − 1), i.e. equal sorted slopes
@@ -253,8 +253,9 @@ material::StretchRange stretch_range_from_json(const JsonObject& object) {
   range.max = object.vec3("max");
   for (int k = 0; k < 3; ++k) {
     if (!(range.min[k] <= range.max[k]))
-      object.fail("max", "entry " + std::to_string(k) + " (" + std::to_string(range.max[k])
-              + ") is below min's (" + std::to_string(range.min[k]) + ")");
+      object.fail("max",
+          "entry " + std::to_string(k) + " (" + std::to_string(range.max[k]) + ") is below min's ("
+              + std::to_string(range.min[k]) + ")");
   }
   return range;
 }
@@ -264,7 +265,8 @@ material::StretchRange stretch_range_from_json(const JsonObject& object) {
 MaterialFile parse_material_file(const Json& json, const std::string& file) {
   const JsonObject root(json, file);
   check_format(root, k_format_kind, k_format_version);
-  root.reject_unknown_keys({ "format", "material", "correction", "training", "training_stretches" });
+  root.reject_unknown_keys(
+      { "format", "material", "correction", "training", "training_stretches" });
   MaterialFile out;
   out.material = root.object("material").json();
   (void)parse_material(root.object("material")); // validate now, naming this file
@@ -330,7 +332,8 @@ MaterialFile scene_material(const JsonObject& scene, const std::filesystem::path
   return out;
 }
 
-fem::MaterialModel scene_material_model(const JsonObject& scene, const std::filesystem::path& base_dir,
+fem::MaterialModel scene_material_model(const JsonObject& scene,
+    const std::filesystem::path& base_dir,
     std::optional<material::StretchRange>* training_stretches) {
   if (training_stretches)
     training_stretches->reset();

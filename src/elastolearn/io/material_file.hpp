@@ -78,7 +78,8 @@ MaterialFile scene_material(const JsonObject& scene, const std::filesystem::path
 /// the scene's field ("scene.json: material.young") and of a referenced one its file.
 /// If `training_stretches` is not null it receives the referenced file's training range (none
 /// for an inline material or a file without one).
-fem::MaterialModel scene_material_model(const JsonObject& scene, const std::filesystem::path& base_dir,
+fem::MaterialModel scene_material_model(const JsonObject& scene,
+    const std::filesystem::path& base_dir,
     std::optional<material::StretchRange>* training_stretches = nullptr);
 
 } // namespace elastolearn::io

@@ -12,34 +12,38 @@ namespace elastolearn::io {
 namespace {
 
 int parse_axis(const JsonObject& o, const std::string& key) {
-  const std::string a = o.choice(key, {"x", "y", "z"});
+  const std::string a = o.choice(key, { "x", "y", "z" });
   return a[0] - 'x';
 }
 
 mesh::TetMesh parse_mesh(const JsonObject& o, const std::filesystem::path& base_dir) {
   if (o.has("file")) {
-    o.reject_unknown_keys({"file"});
+    o.reject_unknown_keys({ "file" });
     std::filesystem::path p = o.string("file");
-    if (p.is_relative()) p = base_dir / p;
+    if (p.is_relative())
+      p = base_dir / p;
     return mesh::read_tet_mesh(p);
   }
-  const std::string type = o.choice("type", {"box", "sphere"});
+  const std::string type = o.choice("type", { "box", "sphere" });
   if (type == "box") {
-    o.reject_unknown_keys({"type", "size", "cells"});
+    o.reject_unknown_keys({ "type", "size", "cells" });
     const Vec3 size = o.vec3("size");
-    if (!(size.minCoeff() > 0)) o.fail("size", "all sizes must be positive");
+    if (!(size.minCoeff() > 0))
+      o.fail("size", "all sizes must be positive");
     const auto cells = o.integers("cells");
     if (cells.size() != 3 || *std::min_element(cells.begin(), cells.end()) < 1)
       o.fail("cells", "expected three positive integers");
-    return mesh::make_box_bar(size, {cells[0], cells[1], cells[2]});
+    return mesh::make_box_bar(size, { cells[0], cells[1], cells[2] });
   }
-  o.reject_unknown_keys({"type", "radius", "tets"});
+  o.reject_unknown_keys({ "type", "radius", "tets" });
   const int tets = o.integer("tets");
-  if (tets < 8) o.fail("tets", "must be at least 8");
+  if (tets < 8)
+    o.fail("tets", "must be at least 8");
   return mesh::make_sphere(o.positive("radius"), tets);
 }
 
-std::vector<int> parse_selection_list(const JsonObject& o, const std::string& key, const mesh::TetMesh& mesh) {
+std::vector<int> parse_selection_list(
+    const JsonObject& o, const std::string& key, const mesh::TetMesh& mesh) {
   std::vector<int> out;
   for (const auto& s : o.objects(key)) {
     auto v = parse_selection(s, mesh);
@@ -51,22 +55,23 @@ std::vector<int> parse_selection_list(const JsonObject& o, const std::string& ke
 }
 
 sim::KeyframeMotion parse_keyframe(const JsonObject& o, const mesh::TetMesh& mesh) {
-  o.reject_unknown_keys({"select", "sinusoid", "piecewise_linear"});
+  o.reject_unknown_keys({ "select", "sinusoid", "piecewise_linear" });
   sim::KeyframeMotion k;
   k.vertices = parse_selection(o.object("select"), mesh);
-  if (k.vertices.empty()) o.fail("select", "selects no vertex");
+  if (k.vertices.empty())
+    o.fail("select", "selects no vertex");
   if (o.has("sinusoid") == o.has("piecewise_linear"))
     o.fail("sinusoid", "give exactly one of \"sinusoid\" or \"piecewise_linear\"");
   if (o.has("sinusoid")) {
     const JsonObject s = o.object("sinusoid");
-    s.reject_unknown_keys({"amplitude", "frequency", "until"});
+    s.reject_unknown_keys({ "amplitude", "frequency", "until" });
     k.kind = sim::KeyframeMotion::Kind::Sinusoid;
     k.amplitude = s.vec3("amplitude");
     k.frequency = s.positive("frequency");
     k.until = s.number("until", std::numeric_limits<double>::infinity());
   } else {
     const JsonObject s = o.object("piecewise_linear");
-    s.reject_unknown_keys({"times", "offsets"});
+    s.reject_unknown_keys({ "times", "offsets" });
     k.kind = sim::KeyframeMotion::Kind::PiecewiseLinear;
     k.times = s.numbers("times");
     const auto& offsets = s.json().at("offsets");
@@ -74,21 +79,24 @@ sim::KeyframeMotion parse_keyframe(const JsonObject& o, const mesh::TetMesh& mes
       s.fail("offsets", "expected an array of [x, y, z] offsets, one per time");
     for (size_t i = 0; i < offsets.size(); ++i) {
       const auto& e = offsets[i];
-      if (!e.is_array() || e.size() != 3 || !e[0].is_number() || !e[1].is_number() || !e[2].is_number())
+      if (!e.is_array() || e.size() != 3 || !e[0].is_number() || !e[1].is_number()
+          || !e[2].is_number())
         s.fail("offsets", "entry " + std::to_string(i) + " is not [x, y, z]");
       k.offsets.emplace_back(e[0].get<double>(), e[1].get<double>(), e[2].get<double>());
     }
     for (size_t i = 1; i < k.times.size(); ++i)
-      if (!(k.times[i] > k.times[i - 1])) s.fail("times", "must be increasing");
+      if (!(k.times[i] > k.times[i - 1]))
+        s.fail("times", "must be increasing");
   }
   return k;
 }
 
 sim::PointLoad parse_load(const JsonObject& o, const mesh::TetMesh& mesh) {
-  o.reject_unknown_keys({"select", "force", "release_time"});
+  o.reject_unknown_keys({ "select", "force", "release_time" });
   sim::PointLoad l;
   l.vertices = parse_selection(o.object("select"), mesh);
-  if (l.vertices.empty()) o.fail("select", "selects no vertex");
+  if (l.vertices.empty())
+    o.fail("select", "selects no vertex");
   l.total_force = o.vec3("force");
   l.release_time = o.number("release_time", std::numeric_limits<double>::infinity());
   return l;
@@ -96,21 +104,23 @@ sim::PointLoad parse_load(const JsonObject& o, const mesh::TetMesh& mesh) {
 
 sim::InitialCondition parse_initial(const JsonObject& o, const mesh::TetMesh& mesh) {
   sim::InitialCondition ic;
-  const std::string type = o.choice("type", {"rest", "velocity", "static"}, "rest");
+  const std::string type = o.choice("type", { "rest", "velocity", "static" }, "rest");
   if (type == "rest") {
-    o.reject_unknown_keys({"type"});
+    o.reject_unknown_keys({ "type" });
   } else if (type == "velocity") {
-    o.reject_unknown_keys({"type", "velocity", "angular_velocity", "center"});
+    o.reject_unknown_keys({ "type", "velocity", "angular_velocity", "center" });
     ic.kind = sim::InitialCondition::Kind::Velocity;
     ic.velocity = o.vec3("velocity", Vec3::Zero());
     ic.angular_velocity = o.vec3("angular_velocity", Vec3::Zero());
     ic.center = o.vec3("center", mesh.bounding_box().center());
   } else {
-    o.reject_unknown_keys({"type", "loads", "load_steps"});
+    o.reject_unknown_keys({ "type", "loads", "load_steps" });
     ic.kind = sim::InitialCondition::Kind::StaticLoad;
-    for (const auto& l : o.objects("loads")) ic.static_loads.push_back(parse_load(l, mesh));
+    for (const auto& l : o.objects("loads"))
+      ic.static_loads.push_back(parse_load(l, mesh));
     ic.load_steps = o.integer("load_steps", 5);
-    if (ic.load_steps < 1) o.fail("load_steps", "must be at least 1");
+    if (ic.load_steps < 1)
+      o.fail("load_steps", "must be at least 1");
   }
   return ic;
 }
@@ -118,70 +128,89 @@ sim::InitialCondition parse_initial(const JsonObject& o, const mesh::TetMesh& me
 } // namespace
 
 std::vector<int> parse_selection(const JsonObject& o, const mesh::TetMesh& mesh) {
-  o.reject_unknown_keys({"vertices", "box", "plane", "min", "max"});
+  o.reject_unknown_keys({ "vertices", "box", "plane", "min", "max" });
   const int kinds = o.has("vertices") + o.has("box") + o.has("plane") + o.has("min") + o.has("max");
-  if (kinds != 1) o.fail("", "a selection needs exactly one of vertices, box, plane, min, max");
+  if (kinds != 1)
+    o.fail("", "a selection needs exactly one of vertices, box, plane, min, max");
   if (o.has("vertices")) {
     auto v = o.integers("vertices");
     for (int i : v)
       if (i < 0 || i >= mesh.num_vertices())
-        o.fail("vertices", "index " + std::to_string(i) + " out of range [0, " + std::to_string(mesh.num_vertices()) + ")");
+        o.fail("vertices",
+            "index " + std::to_string(i) + " out of range [0, "
+                + std::to_string(mesh.num_vertices()) + ")");
     return v;
   }
   if (o.has("box")) {
     const JsonObject b = o.object("box");
-    b.reject_unknown_keys({"min", "max"});
+    b.reject_unknown_keys({ "min", "max" });
     return mesh::vertices_in_box(mesh, Box3(b.vec3("min"), b.vec3("max")));
   }
   const double tol = 1e-9 * std::max(1.0, mesh.bounding_box_diagonal());
   if (o.has("plane")) {
     const JsonObject p = o.object("plane");
-    p.reject_unknown_keys({"axis", "value", "tolerance"});
-    return mesh::vertices_near_plane(mesh, parse_axis(p, "axis"), p.number("value"), p.number("tolerance", tol));
+    p.reject_unknown_keys({ "axis", "value", "tolerance" });
+    return mesh::vertices_near_plane(
+        mesh, parse_axis(p, "axis"), p.number("value"), p.number("tolerance", tol));
   }
-  if (o.has("min")) return mesh::vertices_with_min_coordinate(mesh, parse_axis(o, "min"), tol);
+  if (o.has("min"))
+    return mesh::vertices_with_min_coordinate(mesh, parse_axis(o, "min"), tol);
   return mesh::vertices_with_max_coordinate(mesh, parse_axis(o, "max"), tol);
 }
 
-SceneFile parse_scene(const nlohmann::json& json, const std::string& file, const std::filesystem::path& base_dir) {
+SceneFile parse_scene(
+    const nlohmann::json& json, const std::string& file, const std::filesystem::path& base_dir) {
   const JsonObject root(json, file);
   check_format(root, "elastolearn-scene", 1);
-  root.reject_unknown_keys({"format", "name", "description", "mesh", "material", "mass", "gravity", "fixed",
-                            "keyframes", "loads", "initial", "time", "solver", "output"});
+  root.reject_unknown_keys({ "format", "name", "description", "mesh", "material", "mass", "gravity",
+      "fixed", "keyframes", "loads", "initial", "time", "solver", "output" });
   SceneFile out;
   sim::Scene& s = out.scene;
   s.name = root.string("name", std::filesystem::path(file).stem().string());
   s.mesh = parse_mesh(root.object("mesh"), base_dir);
-  s.material = scene_material_model(root, base_dir, &out.material_training_stretches); // inline object or path of a material file
-  s.mass = root.choice("mass", {"lumped", "consistent"}, "lumped") == "lumped" ? fem::MassType::Lumped
-                                                                             : fem::MassType::Consistent;
+  s.material = scene_material_model(
+      root, base_dir, &out.material_training_stretches); // inline object or path of a material file
+  s.mass = root.choice("mass", { "lumped", "consistent" }, "lumped") == "lumped"
+      ? fem::MassType::Lumped
+      : fem::MassType::Consistent;
   s.gravity = root.vec3("gravity", Vec3::Zero());
-  if (root.has("fixed")) s.fixed_vertices = parse_selection_list(root, "fixed", s.mesh);
+  if (root.has("fixed"))
+    s.fixed_vertices = parse_selection_list(root, "fixed", s.mesh);
   if (root.has("keyframes"))
-    for (const auto& k : root.objects("keyframes")) s.keyframes.push_back(parse_keyframe(k, s.mesh));
+    for (const auto& k : root.objects("keyframes"))
+      s.keyframes.push_back(parse_keyframe(k, s.mesh));
   if (root.has("loads"))
-    for (const auto& l : root.objects("loads")) s.loads.push_back(parse_load(l, s.mesh));
-  if (root.has("initial")) s.initial = parse_initial(root.object("initial"), s.mesh);
+    for (const auto& l : root.objects("loads"))
+      s.loads.push_back(parse_load(l, s.mesh));
+  if (root.has("initial"))
+    s.initial = parse_initial(root.object("initial"), s.mesh);
   const JsonObject time = root.object("time");
-  time.reject_unknown_keys({"dt", "frames"});
+  time.reject_unknown_keys({ "dt", "frames" });
   s.dt = time.positive("dt");
   s.frames = time.integer("frames");
-  if (s.frames < 1) time.fail("frames", "must be at least 1");
+  if (s.frames < 1)
+    time.fail("frames", "must be at least 1");
   if (root.has("solver")) {
     const JsonObject solver = root.object("solver");
-    solver.reject_unknown_keys({"linear", "newton_tolerance", "max_newton_iterations", "reuse_jacobian"});
-    s.linear_solver = sim::linear_solver_type_from_string(solver.choice("linear", {"cholmod", "cg", "eigen-ldlt"}, "cholmod"));
+    solver.reject_unknown_keys(
+        { "linear", "newton_tolerance", "max_newton_iterations", "reuse_jacobian" });
+    s.linear_solver = sim::linear_solver_type_from_string(
+        solver.choice("linear", { "cholmod", "cg", "eigen-ldlt" }, "cholmod"));
     s.newton.relative_tolerance = solver.positive("newton_tolerance", s.newton.relative_tolerance);
     s.newton.max_iterations = solver.integer("max_newton_iterations", s.newton.max_iterations);
-    if (!solver.boolean("reuse_jacobian", true)) s.newton.jacobian_reuse_contraction = 0;
+    if (!solver.boolean("reuse_jacobian", true))
+      s.newton.jacobian_reuse_contraction = 0;
   }
   if (root.has("output")) {
     const JsonObject o = root.object("output");
-    o.reject_unknown_keys({"trajectory", "vtu", "every"});
-    if (o.has("trajectory")) out.outputs.trajectory = base_dir / o.string("trajectory");
-    if (o.has("vtu")) out.outputs.vtu_directory = base_dir / o.string("vtu");
+    o.reject_unknown_keys({ "trajectory", "vtu", "every" });
+    if (o.has("trajectory"))
+      out.outputs.trajectory = base_dir / o.string("trajectory");
+    if (o.has("vtu"))
+      out.outputs.vtu_directory = base_dir / o.string("vtu");
     out.outputs.every = o.integer("every", 1);
-    if (out.outputs.every < 1) o.fail("every", "must be at least 1");
+    if (out.outputs.every < 1)
+      o.fail("every", "must be at least 1");
   }
   try {
     s.validate();

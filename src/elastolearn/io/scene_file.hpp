@@ -15,7 +15,7 @@ namespace elastolearn::io {
 struct SceneOutputs {
   std::optional<std::filesystem::path> trajectory; ///< HDF5
   std::optional<std::filesystem::path> vtu_directory;
-  int every = 1;                                   ///< record every k-th frame
+  int every = 1; ///< record every k-th frame
 };
 
 struct SceneFile {
@@ -31,8 +31,8 @@ SceneFile read_scene_file(const std::filesystem::path& path);
 
 /// Parse a scene from JSON already in memory; `file` is used in messages and `base_dir` to
 /// resolve relative paths.
-SceneFile parse_scene(const nlohmann::json& json, const std::string& file,
-                      const std::filesystem::path& base_dir);
+SceneFile parse_scene(
+    const nlohmann::json& json, const std::string& file, const std::filesystem::path& base_dir);
 
 /// A vertex selection: {"vertices": [...]} | {"box": {"min": [..], "max": [..]}} |
 /// {"plane": {"axis": "x"|"y"|"z", "value": v, "tolerance": t}} | {"min": "x"} | {"max": "y"}

@@ -4,10 +4,10 @@
 namespace elastolearn::io {
 
 sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutputOptions& options,
-                                        const ProgressCallback& progress, std::filesystem::path* pvd,
-                                        learn::StretchCoverage* coverage) {
-  TrajectoryWriter writer(options.trajectory, scene.mesh.rest_positions(), scene.mesh.tets(), Edges(),
-                          scene.mesh.surface_faces());
+    const ProgressCallback& progress, std::filesystem::path* pvd,
+    learn::StretchCoverage* coverage) {
+  TrajectoryWriter writer(options.trajectory, scene.mesh.rest_positions(), scene.mesh.tets(),
+      Edges(), scene.mesh.surface_faces());
   TrajectoryData series; // in memory only when a ParaView series is requested
   if (options.vtu_directory) {
     series.rest_positions = scene.mesh.rest_positions();
@@ -15,8 +15,10 @@ sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutp
   }
   const int every = std::max(1, options.every);
   auto sink = [&](int frame, double time, const VecX& x, const VecX& v) {
-    if (coverage) coverage->add_frame(x);
-    if (frame % every != 0) return;
+    if (coverage)
+      coverage->add_frame(x);
+    if (frame % every != 0)
+      return;
     const Positions positions = unflatten(x);
     const Positions velocities = unflatten(v);
     writer.append(time, positions, velocities);
@@ -27,16 +29,16 @@ sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutp
     }
   };
   sim::SimulationReport report = sim::run_simulation(scene, sink, progress);
-  std::map<std::string, std::string> metadata = {
-      {"scene", scene.name},
-      {"material", scene.material.elastic->name()},
-      {"dt", std::to_string(scene.dt * every)},
-      {"status", report.completed ? "completed" : "stopped: " + report.message}};
-  if (writer.frames() > 0) writer.finish(metadata);
+  std::map<std::string, std::string> metadata = { { "scene", scene.name },
+    { "material", scene.material.elastic->name() }, { "dt", std::to_string(scene.dt * every) },
+    { "status", report.completed ? "completed" : "stopped: " + report.message } };
+  if (writer.frames() > 0)
+    writer.finish(metadata);
   if (options.vtu_directory && !series.positions.empty()) {
     series.metadata = metadata;
     const auto p = write_vtu_series(*options.vtu_directory, scene.name, series);
-    if (pvd) *pvd = p;
+    if (pvd)
+      *pvd = p;
   }
   return report;
 }

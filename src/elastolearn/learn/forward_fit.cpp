@@ -6,7 +6,6 @@
 
 #include <elastolearn/sim/linear_solver.hpp>
 
-
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -27,12 +26,14 @@ struct ObservedDof {
   int component = 0;
 };
 
-std::vector<ObservedDof> observed_free_dofs(const fem::DofMap& dofs, const observe::Observation& observed) {
+std::vector<ObservedDof> observed_free_dofs(
+    const fem::DofMap& dofs, const observe::Observation& observed) {
   std::vector<ObservedDof> out;
   for (int j = 0; j < observed.num_observed(); ++j)
     for (int c = 0; c < 3; ++c) {
       const int free = dofs.free_index(3 * observed.vertex_ids[j] + c);
-      if (free >= 0) out.push_back({free, j, c});
+      if (free >= 0)
+        out.push_back({ free, j, c });
     }
   return out;
 }
@@ -41,7 +42,8 @@ std::vector<ObservedDof> observed_free_dofs(const fem::DofMap& dofs, const obser
 
 void ForwardFitOptions::validate() const {
   if (max_iterations < 0)
-    throw InputError("forward_fit.max_iterations", "must be ≥ 0, got " + std::to_string(max_iterations));
+    throw InputError(
+        "forward_fit.max_iterations", "must be ≥ 0, got " + std::to_string(max_iterations));
   if (!std::isfinite(damping) || damping <= 0)
     throw InputError("forward_fit.damping", "must be finite and > 0");
   if (!std::isfinite(damping_prior) || damping_prior < 0)
@@ -49,17 +51,18 @@ void ForwardFitOptions::validate() const {
   if (!std::isfinite(elastic_prior) || elastic_prior < 0)
     throw InputError("forward_fit.elastic_prior", "must be finite and ≥ 0");
   if (sensitivities == Sensitivities::none)
-    throw InputError("forward_fit.sensitivities", "the fit needs sensitivities (projected or exact)");
+    throw InputError(
+        "forward_fit.sensitivities", "the fit needs sensitivities (projected or exact)");
 }
 
-ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, const observe::Observation& observed,
-    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& unknowns, Sensitivities mode,
-    const ProgressCallback& progress) {
+ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
+    const observe::Observation& observed, const ReconstructionMesh& mesh, const RbfDesign& design,
+    const VecX& unknowns, Sensitivities mode, const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
   const bool sensitivities = mode != Sensitivities::none;
   ForwardSensitivityPass pass;
-  const sim::Scene corrected
-      = with_correction(scene, std::make_shared<material::RbfCorrection>(design.correction(unknowns)));
+  const sim::Scene corrected = with_correction(
+      scene, std::make_shared<material::RbfCorrection>(design.correction(unknowns)));
   sim::Simulator simulator(corrected);
   const auto initial = simulator.apply_initial_condition();
   if (!initial.converged) {
@@ -78,7 +81,8 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
 
   // Work space, allocated once: the system matrices share the pattern, CHOLMOD analyses it once.
   fem::SystemMatrix system = physics.make_matrix(), damping = physics.make_matrix();
-  const std::unique_ptr<sim::LinearSolver> solver = sim::make_linear_solver(sim::LinearSolverType::Cholmod);
+  const std::unique_ptr<sim::LinearSolver> solver
+      = sim::make_linear_solver(sim::LinearSolverType::Cholmod);
   std::unique_ptr<CorrectionForceJacobian> jacobian;
   MatX s_now, s_previous, s_before, rhs, observed_rows(k, u);
   VecX residual, observed_error(k);
@@ -105,7 +109,8 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
       return pass;
     }
   }
-  if (sensitivities) s_before = s_previous;
+  if (sensitivities)
+    s_before = s_previous;
 
   const auto accumulate = [&](int t, const VecX& x) { // the Gauss–Newton sums of frame t
     for (int i = 0; i < k; ++i) {
@@ -135,7 +140,8 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
       system.add_diagonal(masses, 1.0 / (h * h));
       const bool factored = solver->factorize(system.matrix());
       if (!factored) {
-        pass.message = "frame " + std::to_string(t) + ": the step's Jacobian is not positive definite";
+        pass.message
+            = "frame " + std::to_string(t) + ": the step's Jacobian is not positive definite";
         return pass;
       }
       const VecX velocity = (frames[t] - frames[t - 1]) / h;
@@ -151,26 +157,32 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, cons
       s_previous = s_now;
       accumulate(t, frames[t]);
     }
-    if (progress) progress(t, scene.frames, sensitivities ? "forward simulation with sensitivities" : "forward simulation");
+    if (progress)
+      progress(t, scene.frames,
+          sensitivities ? "forward simulation with sensitivities" : "forward simulation");
   }
   pass.completed = true;
   pass.error = observation_error(frames, observed);
   pass.squared_error = pass.error.rms * pass.error.rms * double(pass.error.samples);
-  if (sensitivities) pass.normal.triangularView<Eigen::StrictlyUpper>() = pass.normal.transpose();
+  if (sensitivities)
+    pass.normal.triangularView<Eigen::StrictlyUpper>() = pass.normal.transpose();
   pass.seconds = seconds_since(start);
   return pass;
 }
 
 ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Observation& observed,
-    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start, const ForwardFitOptions& options,
-    const ProgressCallback& progress, const ForwardFitStepCallback& on_step) {
+    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start,
+    const ForwardFitOptions& options, const ProgressCallback& progress,
+    const ForwardFitStepCallback& on_step) {
   options.validate();
   const auto started = std::chrono::steady_clock::now();
   ForwardFitResult result;
   result.unknowns = start;
-  ForwardSensitivityPass current = simulate_with_sensitivities(scene, observed, mesh, design, start, options.sensitivities, progress);
+  ForwardSensitivityPass current = simulate_with_sensitivities(
+      scene, observed, mesh, design, start, options.sensitivities, progress);
   if (!current.completed)
-    throw InputError("forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
+    throw InputError(
+        "forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
   result.rms_history.push_back(current.error.rms);
   double mu = options.damping;
   const int first_damping = design.elastic_unknowns(), n_damping = design.damping_unknowns();
@@ -179,7 +191,8 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
     // fixed by the current pass so that the trial and the current objective are measured alike
     // (and a resumed fit, which recomputes the current pass, takes the same steps).
     VecX prior_weights = VecX::Zero(start.size());
-    prior_weights.head(first_damping) = options.elastic_prior * current.normal.diagonal().head(first_damping);
+    prior_weights.head(first_damping)
+        = options.elastic_prior * current.normal.diagonal().head(first_damping);
     prior_weights.segment(first_damping, n_damping)
         = options.damping_prior * current.normal.diagonal().segment(first_damping, n_damping);
     const auto objective = [&](const ForwardSensitivityPass& pass, const VecX& w) {
@@ -190,12 +203,14 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
     const VecX gradient = current.gradient + prior_weights.cwiseProduct(result.unknowns);
     // Levenberg–Marquardt step on the Jacobi-scaled normal equations, (Ĥ + μ I) Δ̂ = −ĝ: the RBF
     // fit's regularised solve with μ as its (dimensionless) Tikhonov weight.
-    const VecX step = solve_regularised_normal_equations(std::move(normal), -gradient,
-        VecX::Constant(start.size(), mu), current.error.samples);
+    const VecX step = solve_regularised_normal_equations(
+        std::move(normal), -gradient, VecX::Constant(start.size(), mu), current.error.samples);
     const VecX trial = result.unknowns + step;
-    ForwardSensitivityPass next = simulate_with_sensitivities(scene, observed, mesh, design, trial, options.sensitivities, progress);
+    ForwardSensitivityPass next = simulate_with_sensitivities(
+        scene, observed, mesh, design, trial, options.sensitivities, progress);
     result.rms_history.push_back(next.completed ? next.error.rms : -1.0);
-    const bool accepted = next.completed && objective(next, trial) < objective(current, result.unknowns);
+    const bool accepted
+        = next.completed && objective(next, trial) < objective(current, result.unknowns);
     if (accepted) {
       result.unknowns = trial;
       ++result.accepted;
@@ -204,8 +219,10 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
       mu *= 10;
     }
     const bool go_on = !on_step || on_step(next, accepted, result.unknowns, mu);
-    if (accepted) current = std::move(next);
-    if (!go_on) break;
+    if (accepted)
+      current = std::move(next);
+    if (!go_on)
+      break;
   }
   result.seconds = seconds_since(started);
   return result;

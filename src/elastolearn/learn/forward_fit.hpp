@@ -37,17 +37,17 @@ struct ForwardSensitivityPass {
 
 /// Which sensitivities a pass computes.
 enum class Sensitivities {
-  none,      ///< the simulation and its error only
+  none, ///< the simulation and its error only
   projected, ///< with the simulator's PSD-projected step Jacobian (approximate where it is active)
-  exact,     ///< with the exact step Jacobian (exact derivatives, up to the Rayleigh term's ∂K/∂x)
+  exact, ///< with the exact step Jacobian (exact derivatives, up to the Rayleigh term's ∂K/∂x)
 };
 
 /// Simulate `scene` (the nominal model, no correction attached) with design.correction(unknowns)
 /// and compare with `observed` (T + 1 frames, validated by the caller). `mesh` is the
 /// reconstruction mesh of scene.mesh with the nominal material.
-ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene, const observe::Observation& observed,
-    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& unknowns, Sensitivities sensitivities,
-    const ProgressCallback& progress = {});
+ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
+    const observe::Observation& observed, const ReconstructionMesh& mesh, const RbfDesign& design,
+    const VecX& unknowns, Sensitivities sensitivities, const ProgressCallback& progress = {});
 
 struct ForwardFitOptions {
   int max_iterations = 0; ///< trial steps (one forward simulation each) after the start
@@ -86,13 +86,14 @@ struct ForwardFitResult {
 
 /// Called after each trial step with its pass, whether it was accepted, the unknowns kept and
 /// the damping μ for the next step; returns false to stop the fit there.
-using ForwardFitStepCallback
-    = std::function<bool(const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping)>;
+using ForwardFitStepCallback = std::function<bool(
+    const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping)>;
 
 /// Levenberg–Marquardt from `start` (unknowns in design's layout), with options.damping as the
 /// first μ. Throws InputError for invalid options or if the start's simulation diverges.
 ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Observation& observed,
-    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start, const ForwardFitOptions& options,
-    const ProgressCallback& progress = {}, const ForwardFitStepCallback& on_step = {});
+    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start,
+    const ForwardFitOptions& options, const ProgressCallback& progress = {},
+    const ForwardFitStepCallback& on_step = {});
 
 } // namespace elastolearn::learn

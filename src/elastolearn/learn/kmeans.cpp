@@ -142,7 +142,9 @@ class HamerlyAssignment {
   double up(double x) const { return x * (1 + m_slack); }
   double down(double x) const { return x * (1 - m_slack); }
   /// ≤ half the distance of centre a to its nearest other centre (∞ for one centre).
-  double half_gap(int a) const { return m_order.rows() > 0 ? 0.5 * m_gap(m_order(0, a), a) : infinity; }
+  double half_gap(int a) const {
+    return m_order.rows() > 0 ? 0.5 * m_gap(m_order(0, a), a) : infinity;
+  }
   template <int D> void update_gaps(const MatX& centres_t);
   template <int D>
   Nearest nearest_around(

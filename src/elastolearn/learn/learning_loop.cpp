@@ -12,7 +12,9 @@ namespace elastolearn::learn {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 /// The scene with the observed (not already prescribed) vertices following their data.
 sim::Scene constrained_scene(const sim::Scene& scene, const observe::Observation& observed) {
@@ -25,13 +27,15 @@ sim::Scene constrained_scene(const sim::Scene& scene, const observe::Observation
       tracked->vertices.push_back(observed.vertex_ids[j]);
       rows.push_back(j);
     }
-  if (tracked->vertices.empty()) return out;
+  if (tracked->vertices.empty())
+    return out;
   tracked->dt = observed.dt;
   tracked->start_time = observed.start_time;
   tracked->positions.reserve(observed.positions.size());
   for (const auto& frame : observed.positions) {
     Positions p(static_cast<Eigen::Index>(rows.size()), 3);
-    for (size_t i = 0; i < rows.size(); ++i) p.row(static_cast<Eigen::Index>(i)) = frame.row(rows[i]);
+    for (size_t i = 0; i < rows.size(); ++i)
+      p.row(static_cast<Eigen::Index>(i)) = frame.row(rows[i]);
     tracked->positions.push_back(std::move(p));
   }
   out.tracked = std::move(tracked);
@@ -42,25 +46,28 @@ std::vector<int> free_vertices(const sim::Scene& scene) {
   const auto prescribed = scene.prescribed_vertices();
   std::vector<int> out;
   for (int v = 0; v < scene.mesh.num_vertices(); ++v)
-    if (!std::binary_search(prescribed.begin(), prescribed.end(), v)) out.push_back(v);
+    if (!std::binary_search(prescribed.begin(), prescribed.end(), v))
+      out.push_back(v);
   return out;
 }
 
 std::vector<Positions> as_positions(const std::vector<VecX>& frames) {
   std::vector<Positions> out;
   out.reserve(frames.size());
-  for (const auto& x : frames) out.emplace_back(unflatten(x));
+  for (const auto& x : frames)
+    out.emplace_back(unflatten(x));
   return out;
 }
 
 /// `run` with the tracked vertices moved to their data at every frame.
 ForwardRun with_tracked_data(ForwardRun run, const sim::Scene& tracked_scene) {
-  if (!run.completed || !tracked_scene.tracked) return run;
+  if (!run.completed || !tracked_scene.tracked)
+    return run;
   const auto& tracked = *tracked_scene.tracked;
   for (size_t i = 0; i < run.positions.size(); ++i)
     for (size_t j = 0; j < tracked.vertices.size(); ++j)
-      run.positions[i].segment<3>(3 * tracked.vertices[j]) =
-          tracked.position_at(static_cast<int>(j), tracked.start_time + static_cast<double>(i) * tracked.dt);
+      run.positions[i].segment<3>(3 * tracked.vertices[j]) = tracked.position_at(
+          static_cast<int>(j), tracked.start_time + static_cast<double>(i) * tracked.dt);
   return run;
 }
 
@@ -70,40 +77,52 @@ PodBasis identity_basis(int num_vertices, const std::vector<int>& free_vertices)
   const auto columns = static_cast<Eigen::Index>(3 * free_vertices.size());
   basis.modes = MatX::Zero(3 * static_cast<Eigen::Index>(num_vertices), columns);
   for (size_t i = 0; i < free_vertices.size(); ++i)
-    for (int c = 0; c < 3; ++c) basis.modes(3 * free_vertices[i] + c, static_cast<Eigen::Index>(3 * i + c)) = 1;
+    for (int c = 0; c < 3; ++c)
+      basis.modes(3 * free_vertices[i] + c, static_cast<Eigen::Index>(3 * i + c)) = 1;
   basis.captured_energy = 1;
   return basis;
 }
 
 /// The last iteration's control-force RMS is below 95 % of every earlier one.
 bool control_forces_still_shrinking(const std::vector<IterationRecord>& history) {
-  if (history.size() < 2) return false;
+  if (history.size() < 2)
+    return false;
   const double last = history.back().control_force_rms;
   for (size_t i = 0; i + 1 < history.size(); ++i)
-    if (!(last < 0.95 * history[i].control_force_rms)) return false;
+    if (!(last < 0.95 * history[i].control_force_rms))
+      return false;
   return last > 0;
 }
 
-template <typename T> std::vector<T> without_first(const std::vector<T>& v) { return {v.begin() + 1, v.end()}; }
+template <typename T> std::vector<T> without_first(const std::vector<T>& v) {
+  return { v.begin() + 1, v.end() };
+}
 
 } // namespace
 
 void LearningOptions::validate() const {
-  if (max_iterations < 0) throw InputError("learn.max_iterations", "must be ≥ 0");
-  if (patience < 1) throw InputError("learn.patience", "must be ≥ 1");
-  if (free_halvings < 0) throw InputError("learn.free_halvings", "must be ≥ 0");
-  if (centres < 1) throw InputError("learn.centres", "must be ≥ 1");
+  if (max_iterations < 0)
+    throw InputError("learn.max_iterations", "must be ≥ 0");
+  if (patience < 1)
+    throw InputError("learn.patience", "must be ≥ 1");
+  if (free_halvings < 0)
+    throw InputError("learn.free_halvings", "must be ≥ 0");
+  if (centres < 1)
+    throw InputError("learn.centres", "must be ≥ 1");
   pod.validate();
   space_time.validate();
   rbf.validate();
   reconstruction.validate();
   stretch_samples.validate();
   forward_fit.validate();
-  if (max_reconstruction_frames < 0) throw InputError("learn.max_reconstruction_frames", "must be ≥ 0");
-  if (full_space && max_full_space_dofs < 1) throw InputError("learn.max_full_space_dofs", "must be ≥ 1");
+  if (max_reconstruction_frames < 0)
+    throw InputError("learn.max_reconstruction_frames", "must be ≥ 0");
+  if (full_space && max_full_space_dofs < 1)
+    throw InputError("learn.max_full_space_dofs", "must be ≥ 1");
 }
 
-sim::Scene with_correction(const sim::Scene& scene, std::shared_ptr<const material::Correction> correction) {
+sim::Scene with_correction(
+    const sim::Scene& scene, std::shared_ptr<const material::Correction> correction) {
   sim::Scene out = scene;
   out.material.correction = std::move(correction);
   return out;
@@ -115,21 +134,23 @@ ForwardRun simulate_positions(const sim::Scene& scene, const ProgressCallback& p
   const auto report = sim::run_simulation(
       scene,
       [&](int frame, double, const VecX& x, const VecX& v) {
-        if (frame == 0) run.initial_velocity = v;
+        if (frame == 0)
+          run.initial_velocity = v;
         run.positions.push_back(x);
       },
       progress);
   run.completed = report.completed;
   run.message = report.message;
-  if (!run.completed) run.positions.clear();
+  if (!run.completed)
+    run.positions.clear();
   return run;
 }
 
 namespace {
 
 /// RBF centres: k-means over the stretch views of `positions` (at most options.centres).
-MatX rbf_centres(const ReconstructionMesh& mesh, const std::vector<VecX>& positions, const LearningOptions& options,
-                 std::uint64_t seed) {
+MatX rbf_centres(const ReconstructionMesh& mesh, const std::vector<VecX>& positions,
+    const LearningOptions& options, std::uint64_t seed) {
   const MatX stretches = stretch_views(collect_stretches(mesh, positions, options.stretch_samples));
   KMeansOptions kmeans_options;
   kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(stretches.rows()));
@@ -140,23 +161,30 @@ MatX rbf_centres(const ReconstructionMesh& mesh, const std::vector<VecX>& positi
 /// The stage after the loop: Levenberg–Marquardt on the forward error from the best correction
 /// (LearningOptions::forward_fit). Each step is one IterationRecord and one checkpoint; a resumed
 /// run restarts from the best correction with the saved μ, so it takes the same steps.
-bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observed, const LearningOptions& options,
-                     const ReconstructionMesh& mesh, LearningState& state, const LearningCallbacks& callbacks) {
+bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observed,
+    const LearningOptions& options, const ReconstructionMesh& mesh, LearningState& state,
+    const LearningCallbacks& callbacks) {
   const int remaining = options.forward_fit.max_iterations - state.forward_fit_steps;
-  if (remaining <= 0) return true;
-  if (callbacks.interrupted && callbacks.interrupted()) return false;
-  // Centres: the best correction's, or (nothing learned) k-means over the nominal motion's stretches.
+  if (remaining <= 0)
+    return true;
+  if (callbacks.interrupted && callbacks.interrupted())
+    return false;
+  // Centres: the best correction's, or (nothing learned) k-means over the nominal motion's
+  // stretches.
   MatX centres;
   if (state.best) {
     centres = state.best->parameters().centres;
   } else {
-    centres = rbf_centres(mesh, simulate_positions(scene, callbacks.progress).positions, options, options.seed);
+    centres = rbf_centres(
+        mesh, simulate_positions(scene, callbacks.progress).positions, options, options.seed);
   }
   const RbfDesign design(centres, options.rbf);
-  const VecX start = state.best ? design.unknowns(*state.best) : VecX(VecX::Zero(design.num_unknowns()));
+  const VecX start
+      = state.best ? design.unknowns(*state.best) : VecX(VecX::Zero(design.num_unknowns()));
   ForwardFitOptions fit_options = options.forward_fit;
   fit_options.max_iterations = remaining;
-  if (state.forward_fit_damping > 0) fit_options.damping = state.forward_fit_damping;
+  if (state.forward_fit_damping > 0)
+    fit_options.damping = state.forward_fit_damping;
   bool stopped = false;
   fit_to_observations(scene, observed, mesh, design, start, fit_options, callbacks.progress,
       [&](const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping) {
@@ -165,7 +193,8 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
         record.forward_fit = true;
         record.forward_fit_accepted = accepted;
         record.forward_completed = trial.completed;
-        if (trial.completed) record.forward_error = trial.error;
+        if (trial.completed)
+          record.forward_error = trial.error;
         record.centres = design.num_centres();
         record.seconds_forward = trial.seconds;
         // The kept unknowns are the best correction (the start's, until a step is accepted).
@@ -179,8 +208,10 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
         state.forward_fit_damping = damping;
         state.next_iteration = record.iteration + 1;
         state.history.push_back(record);
-        if (callbacks.iteration) callbacks.iteration(record);
-        if (callbacks.checkpoint) callbacks.checkpoint(state);
+        if (callbacks.iteration)
+          callbacks.iteration(record);
+        if (callbacks.checkpoint)
+          callbacks.checkpoint(state);
         stopped = callbacks.interrupted && callbacks.interrupted();
         return !stopped;
       });
@@ -189,11 +220,12 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
 
 } // namespace
 
-bool run_learning(const sim::Scene& scene, const observe::Observation& observed, const LearningOptions& options,
-                  LearningState& state, const LearningCallbacks& callbacks) {
+bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
+    const LearningOptions& options, LearningState& state, const LearningCallbacks& callbacks) {
   options.validate();
   scene.validate();
-  if (scene.material.correction) throw InputError("material", "the nominal scene must not carry a correction already");
+  if (scene.material.correction)
+    throw InputError("material", "the nominal scene must not carry a correction already");
   observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, "observations");
   auto interrupted = [&] { return callbacks.interrupted && callbacks.interrupted(); };
 
@@ -203,16 +235,20 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
   const std::vector<int> basis_vertices = free_vertices(scene);
   const sim::Scene tracked_scene = constrained_scene(scene, observed);
   // Every free vertex observed (small meshes): the constrained trajectory is the data itself.
-  const bool all_free_tracked = tracked_scene.tracked && tracked_scene.tracked->vertices.size() == basis_vertices.size();
-  if (options.full_space && 3 * static_cast<long>(basis_vertices.size()) > options.max_full_space_dofs)
-    throw InputError("learn.full_space", "the full-space variant solves dense " + std::to_string(3 * basis_vertices.size()) +
-                                             "² blocks per frame; it is meant for meshes up to " +
-                                             std::to_string(options.max_full_space_dofs) +
-                                             " free dofs: use the reduced (POD) variant");
+  const bool all_free_tracked
+      = tracked_scene.tracked && tracked_scene.tracked->vertices.size() == basis_vertices.size();
+  if (options.full_space
+      && 3 * static_cast<long>(basis_vertices.size()) > options.max_full_space_dofs)
+    throw InputError("learn.full_space",
+        "the full-space variant solves dense " + std::to_string(3 * basis_vertices.size())
+            + "² blocks per frame; it is meant for meshes up to "
+            + std::to_string(options.max_full_space_dofs)
+            + " free dofs: use the reduced (POD) variant");
   TrajectoryPhysics nominal_physics(scene);
 
   while (!state.finished) {
-    if (interrupted()) return false;
+    if (interrupted())
+      return false;
     IterationRecord record;
     record.iteration = state.next_iteration;
     LearningState next = state; // committed only once the iteration is complete
@@ -224,13 +260,16 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
     record.seconds_forward = seconds_since(t0);
     record.forward_completed = forward.completed;
     if (!forward.completed && record.iteration == 0)
-      throw InputError("scene", "the nominal model's forward simulation failed: " + forward.message);
+      throw InputError(
+          "scene", "the nominal model's forward simulation failed: " + forward.message);
     const double error = forward.completed ? observation_error(forward.positions, observed).rms
                                            : std::numeric_limits<double>::infinity();
-    if (forward.completed) record.forward_error = observation_error(forward.positions, observed);
+    if (forward.completed)
+      record.forward_error = observation_error(forward.positions, observed);
     // Progress is a better forward error, or (paper §3) control forces that still shrink clearly
     // although the forward error does not show it yet; the best correction is chosen by the former.
-    const bool better_forward = forward.completed && (next.best_error < 0 || error < next.best_error);
+    const bool better_forward
+        = forward.completed && (next.best_error < 0 || error < next.best_error);
     if (better_forward) {
       next.best = state.correction;
       next.best_error = error;
@@ -241,31 +280,35 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       next.iterations_without_improvement = 0;
     else if (next.divergences_in_a_row == 0 || next.divergences_in_a_row > options.free_halvings)
       ++next.iterations_without_improvement;
-    if (next.iterations_without_improvement >= options.patience || record.iteration >= options.max_iterations)
+    if (next.iterations_without_improvement >= options.patience
+        || record.iteration >= options.max_iterations)
       next.finished = true;
     if (!forward.completed && !next.finished) {
       // C_k overshot (its simulation diverged): halve the step from the best correction and try
       // that. Deterministic, so a resumed run takes the same path.
-      next.correction =
-          std::make_shared<material::RbfCorrection>(material::blend(*state.correction, next.best.get(), 0.5));
+      next.correction = std::make_shared<material::RbfCorrection>(
+          material::blend(*state.correction, next.best.get(), 0.5));
       record.damped_update = true;
     } else if (!next.finished) {
-      if (interrupted()) return false;
+      if (interrupted())
+        return false;
       // 2. Constrained forward simulation: the starting trajectory (falls back to the forward one).
       t0 = Clock::now();
-      const ForwardRun constrained =
-          all_free_tracked ? with_tracked_data(forward, tracked_scene)
-                           : simulate_positions(with_correction(tracked_scene, state.correction), callbacks.progress);
+      const ForwardRun constrained = all_free_tracked
+          ? with_tracked_data(forward, tracked_scene)
+          : simulate_positions(
+              with_correction(tracked_scene, state.correction), callbacks.progress);
       record.seconds_constrained = seconds_since(t0);
 
       // 3. POD basis of the forward simulation (and of the constrained one).
       t0 = Clock::now();
-      std::vector<std::vector<Positions>> snapshots{as_positions(forward.positions)};
-      if (options.pod_with_constrained && constrained.completed) snapshots.push_back(as_positions(constrained.positions));
-      const PodBasis basis =
-          options.full_space ? identity_basis(scene.mesh.num_vertices(), basis_vertices)
-                             : pod_basis(std::span<const std::vector<Positions>>(snapshots), scene.mesh.rest_positions(),
-                                         basis_vertices, options.pod);
+      std::vector<std::vector<Positions>> snapshots { as_positions(forward.positions) };
+      if (options.pod_with_constrained && constrained.completed)
+        snapshots.push_back(as_positions(constrained.positions));
+      const PodBasis basis = options.full_space
+          ? identity_basis(scene.mesh.num_vertices(), basis_vertices)
+          : pod_basis(std::span<const std::vector<Positions>>(snapshots),
+              scene.mesh.rest_positions(), basis_vertices, options.pod);
       record.modes = basis.num_modes();
       record.seconds_pod = seconds_since(t0);
       t0 = Clock::now();
@@ -276,42 +319,47 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       std::vector<VecX> origin = forward.positions;
       if (constrained.completed)
         for (size_t i = 0; i < origin.size(); ++i)
-          origin[i].noalias() += basis.modes * (basis.modes.transpose() * (constrained.positions[i] - forward.positions[i]));
+          origin[i].noalias() += basis.modes
+              * (basis.modes.transpose() * (constrained.positions[i] - forward.positions[i]));
       record.seconds_constrained += seconds_since(t0);
-      if (interrupted()) return false;
+      if (interrupted())
+        return false;
 
       // 4. Sparse reduced space-time optimisation.
       t0 = Clock::now();
       TrajectoryPhysics physics(current);
-      const SpaceTimeResult optimized = optimize_space_time(physics, basis.modes, origin, forward.initial_velocity,
-                                                            observed, options.space_time, callbacks.progress);
+      const SpaceTimeResult optimized = optimize_space_time(physics, basis.modes, origin,
+          forward.initial_velocity, observed, options.space_time, callbacks.progress);
       record.space_time_initial = optimized.initial_objective;
       record.space_time_objective = optimized.objective;
       record.space_time_iterations = optimized.iterations;
       record.control_force_rms = optimized.physics_rms;
       record.seconds_space_time = seconds_since(t0);
-      if (interrupted()) return false;
+      if (interrupted())
+        return false;
 
       // 5–6. Control forces → the total force the correction must produce (nominal residual),
       // centres by k-means, stress reconstruction.
       t0 = Clock::now();
-      const auto targets = trajectory_residuals(nominal_physics, optimized.positions, forward.initial_velocity);
-      const auto velocities = finite_difference_velocities(optimized.positions, forward.initial_velocity, scene.dt);
+      const auto targets
+          = trajectory_residuals(nominal_physics, optimized.positions, forward.initial_velocity);
+      const auto velocities
+          = finite_difference_velocities(optimized.positions, forward.initial_velocity, scene.dt);
       const RbfDesign design(rbf_centres(reconstruction_mesh, optimized.positions, options,
-                                         options.seed + static_cast<std::uint64_t>(record.iteration)),
-                             rbf);
+                                 options.seed + static_cast<std::uint64_t>(record.iteration)),
+          rbf);
       StressReconstructionOptions reconstruction_options = options.reconstruction;
       if (options.max_reconstruction_frames > 0)
-        reconstruction_options.frame_stride =
-            std::max(reconstruction_options.frame_stride,
-                     (scene.frames + options.max_reconstruction_frames - 1) / options.max_reconstruction_frames);
+        reconstruction_options.frame_stride = std::max(reconstruction_options.frame_stride,
+            (scene.frames + options.max_reconstruction_frames - 1)
+                / options.max_reconstruction_frames);
       MatX projection; // Φ on the free dofs
-      if (options.projected_reconstruction && !options.full_space &&
-          options.reconstruction.method == ReconstructionMethod::normal_equations)
+      if (options.projected_reconstruction && !options.full_space
+          && options.reconstruction.method == ReconstructionMethod::normal_equations)
         projection = basis.modes(physics.dofs().free_dofs(), Eigen::all);
       const StressReconstructionResult reconstructed = reconstruct_rbf_correction(
-          reconstruction_mesh, physics.dofs(), design, without_first(optimized.positions), without_first(velocities),
-          without_first(targets), reconstruction_options, projection);
+          reconstruction_mesh, physics.dofs(), design, without_first(optimized.positions),
+          without_first(velocities), without_first(targets), reconstruction_options, projection);
       record.centres = design.num_centres();
       record.correction_misfit = reconstructed.misfit.rms_residual;
       record.correction_target = reconstructed.misfit.rms_target;
@@ -320,10 +368,13 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
     }
     next.next_iteration = record.iteration + 1;
     next.history.push_back(record);
-    if (interrupted()) return false;
+    if (interrupted())
+      return false;
     state = std::move(next);
-    if (callbacks.iteration) callbacks.iteration(record);
-    if (callbacks.checkpoint) callbacks.checkpoint(state);
+    if (callbacks.iteration)
+      callbacks.iteration(record);
+    if (callbacks.checkpoint)
+      callbacks.checkpoint(state);
   }
   return run_forward_fit(scene, observed, options, reconstruction_mesh, state, callbacks);
 }

@@ -37,13 +37,13 @@ namespace elastolearn::learn {
 
 struct LearningOptions {
   int max_iterations = 8; ///< corrections computed at most
-  int patience = 2;       ///< stop after this many iterations without a better forward error
+  int patience = 2; ///< stop after this many iterations without a better forward error
   /// Divergences in a row that are halved towards the best correction without counting against
   /// patience: a step that overshoots is shortened to ½, ¼, … of itself before the loop gives up
   /// on its direction (full-size sphere-tension: C_3 and ½ C_3 diverged, ¼ C_3 learned;
   /// docs/benchmarks_learning.md, "Update 6"). Each halving still counts as an iteration.
   int free_halvings = 2;
-  PodOptions pod;         ///< reduced basis (max_modes, frame window and stride)
+  PodOptions pod; ///< reduced basis (max_modes, frame window and stride)
   /// POD snapshots from the constrained simulation too, not only the forward one, so that span Φ
   /// contains the observed shapes the current model does not reach (docs/learning_loop.md: a
   /// sub-millimetre shape error outside span Φ leaves residual forces no material explains).
@@ -53,8 +53,8 @@ struct LearningOptions {
   bool full_space = false;
   int max_full_space_dofs = 1500; ///< refuse the full-space variant above this many free dofs
   SpaceTimeOptions space_time;
-  int centres = 40;       ///< RBF kernels m (k-means clusters)
-  RbfFitOptions rbf;      ///< ε, polynomial tails, damping part, regularisation
+  int centres = 40; ///< RBF kernels m (k-means clusters)
+  RbfFitOptions rbf; ///< ε, polynomial tails, damping part, regularisation
   StressReconstructionOptions reconstruction;
   /// Fit the correction's nodal forces to the control forces mainly within span Φ (the POD basis),
   /// where the reduced space-time optimisation controls the residual, instead of at every free
@@ -69,7 +69,7 @@ struct LearningOptions {
   /// information at a fraction of the cost on long, finely stepped runs.
   int max_reconstruction_frames = 150;
   /// Samples for k-means; capped so that clustering stays cheap on big meshes and long runs.
-  StretchSampleOptions stretch_samples = {1, 100000};
+  StretchSampleOptions stretch_samples = { 1, 100000 };
   std::uint64_t seed = 1; ///< k-means seeding
   /// After the loop: Levenberg–Marquardt steps on the forward simulation's error itself, from
   /// the best correction over its centres (forward_fit.hpp; 0 = none). The space-time stages
@@ -83,50 +83,51 @@ struct LearningOptions {
 
 /// What one iteration measured. Times in seconds.
 struct IterationRecord {
-  int iteration = 0;                ///< k (0: the nominal model)
-  ErrorSummary forward_error;       ///< of C_k's forward simulation at the observed vertices [m]
-  bool forward_completed = true;    ///< false if C_k's forward simulation diverged
+  int iteration = 0; ///< k (0: the nominal model)
+  ErrorSummary forward_error; ///< of C_k's forward simulation at the observed vertices [m]
+  bool forward_completed = true; ///< false if C_k's forward simulation diverged
   /// C_k diverged and C_{k+1} = ½ (C_k + best) was tried instead (a damped update).
   bool damped_update = false;
   /// A step of the forward fit after the loop (no trajectory stages): C_k is the trial, and
   /// forward_fit_accepted says whether it lowered the error (and became the best).
   bool forward_fit = false;
   bool forward_fit_accepted = false;
-  double control_force_rms = 0;     ///< √(mean r²) of the optimised trajectory [N]
-  double space_time_initial = 0;    ///< E at the constrained simulation
-  double space_time_objective = 0;  ///< E after optimisation
+  double control_force_rms = 0; ///< √(mean r²) of the optimised trajectory [N]
+  double space_time_initial = 0; ///< E at the constrained simulation
+  double space_time_objective = 0; ///< E after optimisation
   int space_time_iterations = 0;
   int modes = 0;
   int centres = 0;
-  double correction_misfit = 0;     ///< RMS force misfit of C_{k+1} against its targets [N]
-  double correction_target = 0;     ///< RMS of those targets [N]
+  double correction_misfit = 0; ///< RMS force misfit of C_{k+1} against its targets [N]
+  double correction_target = 0; ///< RMS of those targets [N]
   double seconds_forward = 0, seconds_pod = 0, seconds_constrained = 0, seconds_space_time = 0,
          seconds_reconstruction = 0;
   double seconds_total() const {
-    return seconds_forward + seconds_pod + seconds_constrained + seconds_space_time + seconds_reconstruction;
+    return seconds_forward + seconds_pod + seconds_constrained + seconds_space_time
+        + seconds_reconstruction;
   }
 };
 
 /// Everything needed to continue a run: the checkpoint.
 struct LearningState {
-  int next_iteration = 0;                                     ///< k of the next forward simulation
-  std::shared_ptr<const material::RbfCorrection> correction;  ///< C_k (null = nominal)
-  std::shared_ptr<const material::RbfCorrection> best;        ///< best so far (null = nominal)
-  double best_error = -1;                                     ///< its RMS forward error [m] (−1: none yet)
+  int next_iteration = 0; ///< k of the next forward simulation
+  std::shared_ptr<const material::RbfCorrection> correction; ///< C_k (null = nominal)
+  std::shared_ptr<const material::RbfCorrection> best; ///< best so far (null = nominal)
+  double best_error = -1; ///< its RMS forward error [m] (−1: none yet)
   int best_iteration = -1;
   int iterations_without_improvement = 0;
-  int divergences_in_a_row = 0;                               ///< forward simulations diverged in a row
-  bool finished = false;                                      ///< the loop (its space-time iterations) ended
-  int forward_fit_steps = 0;                                  ///< forward-fit steps taken after it
-  double forward_fit_damping = -1;                            ///< its current μ (−1: not started)
+  int divergences_in_a_row = 0; ///< forward simulations diverged in a row
+  bool finished = false; ///< the loop (its space-time iterations) ended
+  int forward_fit_steps = 0; ///< forward-fit steps taken after it
+  double forward_fit_damping = -1; ///< its current μ (−1: not started)
   std::vector<IterationRecord> history;
 };
 
 struct LearningCallbacks {
-  ProgressCallback progress;                                ///< within long stages
-  std::function<void(const IterationRecord&)> iteration;    ///< after each iteration (log a line)
-  std::function<void(const LearningState&)> checkpoint;     ///< after each iteration (save)
-  std::function<bool()> interrupted;                        ///< polled between stages
+  ProgressCallback progress; ///< within long stages
+  std::function<void(const IterationRecord&)> iteration; ///< after each iteration (log a line)
+  std::function<void(const LearningState&)> checkpoint; ///< after each iteration (save)
+  std::function<bool()> interrupted; ///< polled between stages
 };
 
 /// Run (or continue, from `state`) the loop for `scene` (the nominal model: its material must
@@ -134,11 +135,12 @@ struct LearningCallbacks {
 /// On return `state.best` is the learned correction (null if nothing beat the nominal model).
 /// Returns false if interrupted (state is then the last checkpoint's). Throws InputError for
 /// invalid inputs.
-bool run_learning(const sim::Scene& scene, const observe::Observation& observed, const LearningOptions& options,
-                  LearningState& state, const LearningCallbacks& callbacks = {});
+bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
+    const LearningOptions& options, LearningState& state, const LearningCallbacks& callbacks = {});
 
 /// The scene with `correction` attached to its material.
-sim::Scene with_correction(const sim::Scene& scene, std::shared_ptr<const material::Correction> correction);
+sim::Scene with_correction(
+    const sim::Scene& scene, std::shared_ptr<const material::Correction> correction);
 
 /// All states of a forward simulation (flat 3n), and its initial velocity. Empty positions if it
 /// diverged before the end (message then says where).

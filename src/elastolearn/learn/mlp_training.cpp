@@ -22,7 +22,9 @@ template <typename T> std::string str(T v) {
   return s.str();
 }
 
-double elu(double z) { return z > 0 ? z : std::expm1(z); }
+double elu(double z) {
+  return z > 0 ? z : std::expm1(z);
+}
 
 /// Adam moments of one parameter array.
 struct AdamMoments {
@@ -60,7 +62,8 @@ struct LayerWork {
 
 /// One Adam update of `param` with gradient `grad` (step size already bias-corrected).
 template <typename P, typename G>
-void adam_update(P& param, const G& grad, AdamMoments& s, const MlpTrainingOptions& o, double step) {
+void adam_update(
+    P& param, const G& grad, AdamMoments& s, const MlpTrainingOptions& o, double step) {
   s.m = o.beta1 * s.m + (1 - o.beta1) * grad;
   s.v = o.beta2 * s.v + (1 - o.beta2) * grad.cwiseAbs2();
   param.array() -= step * s.m.array() / (s.v.array().sqrt() + o.adam_epsilon);
@@ -75,8 +78,8 @@ void check_set(const char* field, ConstRef<MatX> x, ConstRef<MatX> y, int inputs
     fail(field, "is empty");
   if (x.rows() != inputs || y.rows() != outputs || y.cols() != x.cols()) {
     fail(field,
-        "inputs " + str(x.rows()) + " × " + str(x.cols()) + " and targets " + str(y.rows())
-            + " × " + str(y.cols()) + " do not match (" + str(inputs) + " inputs, " + str(outputs)
+        "inputs " + str(x.rows()) + " × " + str(x.cols()) + " and targets " + str(y.rows()) + " × "
+            + str(y.cols()) + " do not match (" + str(inputs) + " inputs, " + str(outputs)
             + " outputs, one column per sample)");
   }
   if (!x.allFinite() || !y.allFinite())
@@ -85,7 +88,9 @@ void check_set(const char* field, ConstRef<MatX> x, ConstRef<MatX> y, int inputs
 
 } // namespace
 
-double uniform01(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
+double uniform01(std::mt19937_64& rng) {
+  return double(rng() >> 11) * 0x1.0p-53;
+}
 
 double standard_normal(std::mt19937_64& rng) {
   const double u = 1.0 - uniform01(rng); // (0, 1]: log is finite
@@ -189,8 +194,7 @@ MatX evaluate(const BatchNormMlp& net, ConstRef<MatX> x, BatchNormMode mode) {
         mean = z.rowwise().mean();
         var = (z.colwise() - mean).rowwise().squaredNorm() / double(z.cols());
       }
-      const VecX scale
-          = l.gamma.array() / (var.array() + net.batch_norm_epsilon).sqrt();
+      const VecX scale = l.gamma.array() / (var.array() + net.batch_norm_epsilon).sqrt();
       z = ((z.colwise() - mean).array().colwise() * scale.array()).colwise() + l.beta.array();
     }
     a = z.unaryExpr(&elu);
@@ -203,8 +207,7 @@ std::vector<material::NnCorrection::Layer> fold_batch_norm(const BatchNormMlp& n
   for (const auto& l : net.layers) {
     material::NnCorrection::Layer f { l.weight, l.bias };
     if (l.has_batch_norm()) {
-      const VecX s
-          = l.gamma.array() / (l.running_var.array() + net.batch_norm_epsilon).sqrt();
+      const VecX s = l.gamma.array() / (l.running_var.array() + net.batch_norm_epsilon).sqrt();
       f.weight = s.asDiagonal() * l.weight;
       f.bias = s.cwiseProduct(l.bias - l.running_mean) + l.beta;
     }

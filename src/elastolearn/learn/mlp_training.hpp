@@ -69,8 +69,8 @@ enum class BatchNormMode {
 /// A freshly initialised network: Glorot-uniform weights from `seed`, zero biases, γ = 1, β = 0,
 /// running mean 0 and variance 1. Throws InputError("mlp_training.hidden_widths", ...) for a
 /// width outside 1..NnCorrection::max_width, or if inputs/outputs < 1.
-BatchNormMlp make_batch_norm_mlp(
-    int inputs, const std::vector<int>& hidden_widths, int outputs, bool batch_norm, std::uint64_t seed);
+BatchNormMlp make_batch_norm_mlp(int inputs, const std::vector<int>& hidden_widths, int outputs,
+    bool batch_norm, std::uint64_t seed);
 
 /// Network outputs (outputs × B) for inputs `x` (inputs × B, one column per sample).
 MatX evaluate(const BatchNormMlp& network, ConstRef<MatX> x, BatchNormMode mode);

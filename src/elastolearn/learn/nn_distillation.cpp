@@ -51,8 +51,8 @@ void row_statistics(const MatX& m, VecX& mean, VecX& scale) {
 }
 
 /// RMS over the states `states` of ‖N(σ_j, ḟ_j) − N_teacher,j‖ [Pa] (one state = 3 directions).
-double rms_error(const material::Correction& n, const StressSamples& samples,
-    const std::vector<int>& states) {
+double rms_error(
+    const material::Correction& n, const StressSamples& samples, const std::vector<int>& states) {
   double sum = 0;
   for (int j : states) {
     const Vec3 out = n.correction(
@@ -64,8 +64,8 @@ double rms_error(const material::Correction& n, const StressSamples& samples,
 
 /// The training rows of the states `states`: per state and direction k, x = nn_input(σ, ḟ, k)
 /// (a column of `inputs`, 6 × 3·|states|) and N_teacher,k (an entry of `targets`, 1 × …).
-void direction_rows(const StressSamples& samples, const std::vector<int>& states, MatX& inputs,
-    MatX& targets) {
+void direction_rows(
+    const StressSamples& samples, const std::vector<int>& states, MatX& inputs, MatX& targets) {
   const auto rows = static_cast<Eigen::Index>(3 * states.size());
   inputs.resize(6, rows);
   targets.resize(1, rows);
@@ -186,8 +186,8 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   return out;
 }
 
-material::NnCorrection with_teacher_damping(const material::NnCorrection& network,
-    const material::Correction& teacher) {
+material::NnCorrection with_teacher_damping(
+    const material::NnCorrection& network, const material::Correction& teacher) {
   material::NnCorrection::Parameters p = network.parameters();
   p.damping.reset();
   if (const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&teacher)) {
@@ -196,7 +196,8 @@ material::NnCorrection with_teacher_damping(const material::NnCorrection& networ
   } else if (const auto* nn = dynamic_cast<const material::NnCorrection*>(&teacher)) {
     p.damping = nn->parameters().damping;
   } else if (teacher.stiffness_damping(Vec3::Ones()) != 0) {
-    fail("teacher", "a \"" + teacher.name() + "\" correction's damping cannot be carried over (only an RBF's)");
+    fail("teacher",
+        "a \"" + teacher.name() + "\" correction's damping cannot be carried over (only an RBF's)");
   }
   return material::NnCorrection(std::move(p));
 }
@@ -205,8 +206,8 @@ StressSamples distillation_samples(const sim::Scene& scene, std::span<const doub
     const material::Correction& teacher, const DistillationSampleOptions& options,
     DistillationSampleReport* report) {
   const double one = 1.0;
-  const std::vector<sim::Scene> scenes
-      = scaled_motions(scene, motion_scales.empty() ? std::span<const double>(&one, 1) : motion_scales);
+  const std::vector<sim::Scene> scenes = scaled_motions(
+      scene, motion_scales.empty() ? std::span<const double>(&one, 1) : motion_scales);
   return distillation_samples(std::span<const sim::Scene>(scenes), teacher, options, report);
 }
 
@@ -240,8 +241,8 @@ NnDistillationResult distill_nn_correction(
   const Eigen::Index n = samples.stretches.rows();
   if (samples.stretch_rates.rows() != n || samples.targets.rows() != n) {
     fail("samples",
-        str(n) + " stretch samples but " + str(samples.stretch_rates.rows())
-            + " stretch rates and " + str(samples.targets.rows()) + " targets");
+        str(n) + " stretch samples but " + str(samples.stretch_rates.rows()) + " stretch rates and "
+            + str(samples.targets.rows()) + " targets");
   }
   if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite()
       || !samples.targets.allFinite()) {

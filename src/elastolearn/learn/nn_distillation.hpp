@@ -64,8 +64,8 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
 /// `network` with the teacher's damping correction Δα₁ attached unchanged (an RBF teacher's
 /// damping_part, a network teacher's damping; none if the teacher has none), replacing any it had.
 /// Throws InputError("distillation.teacher", ...) for another kind of teacher with damping.
-material::NnCorrection with_teacher_damping(const material::NnCorrection& network,
-    const material::Correction& teacher);
+material::NnCorrection with_teacher_damping(
+    const material::NnCorrection& network, const material::Correction& teacher);
 
 /// Convenience: distillation_samples over scaled_motions(scene, motion_scales), i.e. the scene's
 /// motion at several amplitudes (e.g. {0.5, 1, 1.5}); an empty list means {1}.

@@ -40,7 +40,8 @@ void PodOptions::validate() const {
 
 PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> rest,
     const std::vector<int>& free_vertices, const PodOptions& options, ConstRef<VecX> dof_masses) {
-  return pod_basis(std::span<const std::vector<Positions>>(&frames, 1), rest, free_vertices, options, dof_masses);
+  return pod_basis(std::span<const std::vector<Positions>>(&frames, 1), rest, free_vertices,
+      options, dof_masses);
 }
 
 PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRef<Positions> rest,

@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <array>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 namespace elastolearn::learn {
@@ -40,21 +40,26 @@ void RbfFitOptions::validate() const {
     fail("damping_quadratic_tail", "needs damping_polynomial (the linear tail)");
 }
 
-RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_options(options) {
+RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options)
+    : m_options(options) {
   options.validate();
   if (centres.rows() < 1 || centres.cols() != 3)
-    fail("centres", "expected m × 3 with m ≥ 1, got " + str(centres.rows()) + " × " + str(centres.cols()));
-  if (!centres.allFinite()) fail("centres", "contains a non-finite value");
+    fail("centres",
+        "expected m × 3 with m ≥ 1, got " + str(centres.rows()) + " × " + str(centres.cols()));
+  if (!centres.allFinite())
+    fail("centres", "contains a non-finite value");
   m_centres = centres;
   const int m = static_cast<int>(centres.rows());
   m_rest_kernels = VecX::Zero(m);
   if (options.stress_free_rest)
     for (int i = 0; i < m; ++i)
-      m_rest_kernels[i] = material::rbf_kernel((Vec3::Ones() - centres.row(i).transpose()).squaredNorm(), options.epsilon);
+      m_rest_kernels[i] = material::rbf_kernel(
+          (Vec3::Ones() - centres.row(i).transpose()).squaredNorm(), options.epsilon);
   m_elastic = m;
   if (options.elastic_polynomial) {
     m_elastic += 2;
-    if (!options.stress_free_rest) m_constant = m_elastic++;
+    if (!options.stress_free_rest)
+      m_constant = m_elastic++;
     if (options.quadratic_tail) {
       m_quadratic = m_elastic;
       m_elastic += 4;
@@ -64,7 +69,9 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options) : m_o
       m_elastic += 2;
     }
   }
-  m_damping = options.fit_damping ? m + (options.damping_polynomial ? 4 : 0) + (options.damping_quadratic_tail ? 3 : 0) : 0;
+  m_damping = options.fit_damping
+      ? m + (options.damping_polynomial ? 4 : 0) + (options.damping_quadratic_tail ? 3 : 0)
+      : 0;
 }
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
@@ -73,19 +80,23 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
   for (int k = 0; k < 3; ++k) {
     const Vec3 y = material::stretch_view(stretches, k);
     for (Eigen::Index i = 0; i < m; ++i)
-      out(k, i) = material::rbf_kernel((y - m_centres.row(i).transpose()).squaredNorm(), eps) - m_rest_kernels[i];
+      out(k, i) = material::rbf_kernel((y - m_centres.row(i).transpose()).squaredNorm(), eps)
+          - m_rest_kernels[i];
     if (m_options.elastic_polynomial) {
       out(k, m) = y[0] - 1;
       out(k, m + 1) = y[1] + y[2] - 2;
-      if (m_constant >= 0) out(k, m_constant) = 1;
-      if (m_quadratic >= 0) out.block<1, 4>(k, m_quadratic) = material::quadratic_tail_basis(y).transpose();
-      if (m_neo_hookean >= 0) out.block<1, 2>(k, m_neo_hookean) = material::neo_hookean_tail_basis(y).transpose();
+      if (m_constant >= 0)
+        out(k, m_constant) = 1;
+      if (m_quadratic >= 0)
+        out.block<1, 4>(k, m_quadratic) = material::quadratic_tail_basis(y).transpose();
+      if (m_neo_hookean >= 0)
+        out.block<1, 2>(k, m_neo_hookean) = material::neo_hookean_tail_basis(y).transpose();
     }
   }
 }
 
-void RbfDesign::output_matrix(
-    const Vec3& stretches, Eigen::Ref<OutputMatrix> out, Eigen::Ref<OutputGradient> gradient) const {
+void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
+    Eigen::Ref<OutputGradient> gradient) const {
   output_matrix(stretches, out);
   gradient.setZero();
   const Eigen::Index m = m_centres.rows();
@@ -94,12 +105,14 @@ void RbfDesign::output_matrix(
     const Vec3 y(stretches[idx[0]], stretches[idx[1]], stretches[idx[2]]);
     // ∂/∂σ_idx[c] of the view's entry c; collect into row 3 idx[c] + k.
     const auto add = [&](Eigen::Index column, const Vec3& d_y) {
-      for (int c = 0; c < 3; ++c) gradient(3 * idx[c] + k, column) += d_y[c];
+      for (int c = 0; c < 3; ++c)
+        gradient(3 * idx[c] + k, column) += d_y[c];
     };
     for (Eigen::Index i = 0; i < m; ++i) {
       const Vec3 d = y - m_centres.row(i).transpose();
       const double phi = out(k, i) + m_rest_kernels[i];
-      if (phi > 0) add(i, d / phi);
+      if (phi > 0)
+        add(i, d / phi);
     }
     if (m_options.elastic_polynomial) {
       add(m, Vec3(1, 0, 0));
@@ -122,16 +135,19 @@ void RbfDesign::output_matrix(
 }
 
 void RbfDesign::damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd> out) const {
-  if (m_damping == 0) return;
+  if (m_damping == 0)
+    return;
   const Eigen::Index m = m_centres.rows();
   Vec3 s = stretches;
   std::sort(s.data(), s.data() + 3, std::greater<>());
   for (Eigen::Index i = 0; i < m; ++i)
-    out[i] = material::rbf_kernel((s - m_centres.row(i).transpose()).squaredNorm(), m_options.epsilon);
+    out[i]
+        = material::rbf_kernel((s - m_centres.row(i).transpose()).squaredNorm(), m_options.epsilon);
   if (m_options.damping_polynomial) {
     out.segment<3>(m) = (s - Vec3::Ones()).transpose();
     out[m + 3] = 1;
-    if (m_options.damping_quadratic_tail) out.segment<3>(m + 4) = (s - Vec3::Ones()).cwiseAbs2().transpose();
+    if (m_options.damping_quadratic_tail)
+      out.segment<3>(m + 4) = (s - Vec3::Ones()).cwiseAbs2().transpose();
   }
 }
 
@@ -146,9 +162,12 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
   if (m_options.elastic_polynomial) {
     p.own_slope = x[m];
     p.other_slope = x[m + 1];
-    if (m_constant >= 0) p.constant = x[m_constant];
-    if (m_quadratic >= 0) p.quadratic = x.segment<4>(m_quadratic);
-    if (m_neo_hookean >= 0) p.neo_hookean = x.segment<2>(m_neo_hookean);
+    if (m_constant >= 0)
+      p.constant = x[m_constant];
+    if (m_quadratic >= 0)
+      p.quadratic = x.segment<4>(m_quadratic);
+    if (m_neo_hookean >= 0)
+      p.neo_hookean = x.segment<2>(m_neo_hookean);
   }
   if (m_damping > 0) {
     const auto v = x.tail(m_damping);
@@ -156,7 +175,8 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
     if (m_options.damping_polynomial) {
       p.damping_slopes = v.segment<3>(m);
       p.damping_constant = v[m + 3];
-      if (m_options.damping_quadratic_tail) p.damping_quadratic = v.segment<3>(m + 4);
+      if (m_options.damping_quadratic_tail)
+        p.damping_quadratic = v.segment<3>(m + 4);
     }
     p.damping_floor = m_options.damping_floor;
   }
@@ -169,31 +189,39 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon)
     fail("correction", "its centres or kernel smoothing differ from the design's");
   const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();
-  const bool has_damping_tail = !p.damping_slopes.isZero(0) || p.damping_constant != 0 || !p.damping_quadratic.isZero(0);
+  const bool has_damping_tail
+      = !p.damping_slopes.isZero(0) || p.damping_constant != 0 || !p.damping_quadratic.isZero(0);
   const bool has_damping = p.damping_weights.size() > 0 || has_damping_tail;
-  if ((has_tail && !m_options.elastic_polynomial) || (!p.quadratic.isZero() && m_quadratic < 0) ||
-      (!p.neo_hookean.isZero() && m_neo_hookean < 0) ||
-      (has_damping && m_damping == 0))
+  if ((has_tail && !m_options.elastic_polynomial) || (!p.quadratic.isZero() && m_quadratic < 0)
+      || (!p.neo_hookean.isZero() && m_neo_hookean < 0) || (has_damping && m_damping == 0))
     fail("correction", "it has a term the design does not fit");
   VecX x = VecX::Zero(num_unknowns());
   x.head(m) = p.weights;
   if (m_options.elastic_polynomial) {
     x[m] = p.own_slope;
     x[m + 1] = p.other_slope;
-    if (m_constant >= 0) x[m_constant] = p.constant;
-    if (m_quadratic >= 0) x.segment<4>(m_quadratic) = p.quadratic;
-    if (m_neo_hookean >= 0) x.segment<2>(m_neo_hookean) = p.neo_hookean;
+    if (m_constant >= 0)
+      x[m_constant] = p.constant;
+    if (m_quadratic >= 0)
+      x.segment<4>(m_quadratic) = p.quadratic;
+    if (m_neo_hookean >= 0)
+      x.segment<2>(m_neo_hookean) = p.neo_hookean;
   }
   const double prestress = p.constant + p.weights.dot(m_rest_kernels);
-  if (m_constant < 0 && std::abs(prestress) > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels) + 1))
+  if (m_constant < 0
+      && std::abs(prestress)
+          > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels) + 1))
     fail("correction", "it is not stress-free at rest (N(1) = " + str(prestress) + " Pa)");
   if (m_damping > 0) {
-    if (p.damping_weights.size() == m) x.segment(m_elastic, m) = p.damping_weights;
+    if (p.damping_weights.size() == m)
+      x.segment(m_elastic, m) = p.damping_weights;
     if (m_options.damping_polynomial) {
       x.segment<3>(m_elastic + m) = p.damping_slopes;
       x[m_elastic + m + 3] = p.damping_constant;
-      if (m_options.damping_quadratic_tail) x.segment<3>(m_elastic + m + 4) = p.damping_quadratic;
-      else if (!p.damping_quadratic.isZero(0)) fail("correction", "it has a quadratic damping tail the design does not fit");
+      if (m_options.damping_quadratic_tail)
+        x.segment<3>(m_elastic + m + 4) = p.damping_quadratic;
+      else if (!p.damping_quadratic.isZero(0))
+        fail("correction", "it has a quadratic damping tail the design does not fit");
     } else if (has_damping_tail)
       fail("correction", "it has a damping tail the design does not fit");
   }
@@ -204,7 +232,8 @@ MatX stretch_views(ConstRef<MatX> stretches) {
   ELASTOLEARN_CHECK(stretches.cols() == 3, "stretch_views: N × 3 expected");
   MatX out(3 * stretches.rows(), 3);
   for (Eigen::Index j = 0; j < stretches.rows(); ++j)
-    for (int k = 0; k < 3; ++k) out.row(3 * j + k) = material::stretch_view(stretches.row(j).transpose(), k).transpose();
+    for (int k = 0; k < 3; ++k)
+      out.row(3 * j + k) = material::stretch_view(stretches.row(j).transpose(), k).transpose();
   return out;
 }
 
@@ -215,30 +244,37 @@ VecX RbfDesign::regularization_weights() const {
   return w;
 }
 
-VecX solve_regularised_normal_equations(MatX normal, ConstRef<VecX> rhs, ConstRef<VecX> regularization, long samples) {
+VecX solve_regularised_normal_equations(
+    MatX normal, ConstRef<VecX> rhs, ConstRef<VecX> regularization, long samples) {
   const Eigen::Index u = normal.rows();
   // Jacobi scaling, then Tikhonov on the scaled unknowns (λ dimensionless).
   VecX scale = normal.diagonal().cwiseSqrt();
   for (Eigen::Index i = 0; i < u; ++i)
-    if (!(scale[i] > 0)) scale[i] = 1; // an unused unknown (e.g. no stretch rate): only λ constrains it
+    if (!(scale[i] > 0))
+      scale[i] = 1; // an unused unknown (e.g. no stretch rate): only λ constrains it
   normal = scale.cwiseInverse().asDiagonal() * normal * scale.cwiseInverse().asDiagonal();
   normal.diagonal() += regularization;
   const Eigen::LLT<MatX> llt(normal);
   if (llt.info() != Eigen::Success)
-    fail("regularization", "the normal equations are singular (" + str(samples) + " samples, " + str(u) +
-                               " unknowns); increase the regularisation or give more varied samples");
+    fail("regularization",
+        "the normal equations are singular (" + str(samples) + " samples, " + str(u)
+            + " unknowns); increase the regularisation or give more varied samples");
   const VecX x = (llt.solve(rhs.cwiseQuotient(scale))).cwiseQuotient(scale);
-  if (!x.allFinite()) fail("regularization", "the fit produced non-finite weights; increase the regularisation");
+  if (!x.allFinite())
+    fail("regularization", "the fit produced non-finite weights; increase the regularisation");
   return x;
 }
 
 RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& samples) {
   const Eigen::Index n = samples.stretches.rows();
-  if (n == 0) fail("samples", "no samples to fit");
+  if (n == 0)
+    fail("samples", "no samples to fit");
   if (samples.stretch_rates.rows() != n || samples.targets.rows() != n)
-    fail("samples", str(n) + " stretch samples but " + str(samples.stretch_rates.rows()) + " stretch rates and " +
-                        str(samples.targets.rows()) + " targets");
-  if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite() || !samples.targets.allFinite())
+    fail("samples",
+        str(n) + " stretch samples but " + str(samples.stretch_rates.rows()) + " stretch rates and "
+            + str(samples.targets.rows()) + " targets");
+  if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite()
+      || !samples.targets.allFinite())
     fail("samples", "contain a non-finite value");
   const int u = design.elastic_unknowns();
   MatX normal = MatX::Zero(u, u);
@@ -259,7 +295,8 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
   }
   normal.triangularView<Eigen::StrictlyUpper>() = normal.transpose();
   VecX x = VecX::Zero(design.num_unknowns());
-  x.head(u) = solve_regularised_normal_equations(normal, rhs, design.regularization_weights().head(u), n);
+  x.head(u)
+      = solve_regularised_normal_equations(normal, rhs, design.regularization_weights().head(u), n);
   RbfFitResult result { design.correction(x), x, 0, 0, static_cast<int>(n) };
   double residual = 0, target = 0;
   for (Eigen::Index j = 0; j < n; ++j) {

@@ -12,7 +12,8 @@ namespace elastolearn::learn {
 
 struct RbfFitOptions {
   double epsilon = 1e-3; ///< kernel smoothing ε of material::rbf_kernel [-]
-  bool elastic_polynomial = true; ///< fit the linear tail a, b (and c, see below) of the elastic part
+  bool elastic_polynomial
+      = true; ///< fit the linear tail a, b (and c, see below) of the elastic part
   /// Keep the rest shape stress-free: N(1, 1, 1) = 0, as for every hyperelastic model. The
   /// kernels enter as φ_i(y) − φ_i(1) and the pressure c is not an unknown but follows from the
   /// weights (c = −Σ w_i φ_i(1)). Without it the fit may explain residual forces by a prestress
@@ -49,14 +50,14 @@ struct RbfFitOptions {
 
 /// The unknowns of an RBF correction with given centres, and the linear maps from them to N and
 /// Δα₁. Unknowns x = [x_e; x_d] with x_e = [w (m); a, b, c, q, r (with the elastic tail; c only
-/// without stress_free_rest, q only with quadratic_tail, r only with neo_hookean_tail)] and x_d = [v (m); a_d (3), a₀ (with the
-/// damping tail); d (3) (with damping_quadratic_tail)] (only when fit_damping), in the notation of
-/// material::RbfCorrection (before Δα₁'s floor):
-///   N(σ) = A(σ) x_e,   row k of A = [φ_i(y_k) − r_i …, y_k1 − 1, y_k2 + y_k3 − 2, 1, t(y_k)ᵀ, g(y_k)ᵀ],
-///   Δα₁(σ) = d(σ) x_d, d = [φ_i(s) …, (s − 1)ᵀ, 1, ((s − 1)²)ᵀ], s = sort↓ σ,
+/// without stress_free_rest, q only with quadratic_tail, r only with neo_hookean_tail)] and x_d =
+/// [v (m); a_d (3), a₀ (with the damping tail); d (3) (with damping_quadratic_tail)] (only when
+/// fit_damping), in the notation of material::RbfCorrection (before Δα₁'s floor):
+///   N(σ) = A(σ) x_e,   row k of A = [φ_i(y_k) − r_i …, y_k1 − 1, y_k2 + y_k3 − 2, 1, t(y_k)ᵀ,
+///   g(y_k)ᵀ], Δα₁(σ) = d(σ) x_d, d = [φ_i(s) …, (s − 1)ᵀ, 1, ((s − 1)²)ᵀ], s = sort↓ σ,
 /// with r_i = φ_i(1, 1, 1) under stress_free_rest (else 0).
 class RbfDesign {
-public:
+  public:
   using OutputMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic>;
   /// `centres` m × 3 (m ≥ 1, finite). Throws InputError for invalid options or centres.
   RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options);
@@ -71,7 +72,8 @@ public:
   /// A(σ) and its stretch derivative: row 3j + k of `gradient` (9 × elastic_unknowns()) is
   /// ∂A(k, ·)/∂σ_j, i.e. column i reshaped (column-major) is ∂N/∂σ of unknown i alone. Exact
   /// (subgradients at ties, and at a centre for ε = 0). No allocation.
-  void output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out, Eigen::Ref<OutputGradient> gradient) const;
+  void output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
+      Eigen::Ref<OutputGradient> gradient) const;
   /// d(σ) into `out` (damping_unknowns() entries), for stretches in any order. No allocation.
   void damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd> out) const;
   /// Tikhonov weight of each unknown (regularization, or damping_regularization).
@@ -84,7 +86,7 @@ public:
   /// prestress N(1) ≠ 0 under stress_free_rest).
   VecX unknowns(const material::RbfCorrection& correction) const;
 
-private:
+  private:
   material::RbfCorrection::Centres m_centres;
   RbfFitOptions m_options;
   VecX m_rest_kernels; ///< r_i = φ_i(1, 1, 1) under stress_free_rest, else 0
@@ -112,12 +114,11 @@ struct RbfFitResult {
 
 /// Minimise Σ_j ‖N(σ_j) − y_j‖² + Tikhonov (see RbfFitOptions::regularization) over the
 /// elastic unknowns of `design`; its damping unknowns, if any, are left at zero (stress samples
-/// say nothing about Δα₁). The stretch rates of the samples are not used. The normal equations are accumulated in chunks by symmetric rank
-/// updates of the stacked output matrices, O(N u²) time and O(u² + chunk·u) memory for
-/// u = num_unknowns(); solved by dense Cholesky.
-/// Throws InputError if the sample arrays disagree in size, are empty or not finite, or the
-/// regularised normal matrix is singular (e.g. λ = 0 with fewer independent samples than
-/// unknowns).
+/// say nothing about Δα₁). The stretch rates of the samples are not used. The normal equations are
+/// accumulated in chunks by symmetric rank updates of the stacked output matrices, O(N u²) time and
+/// O(u² + chunk·u) memory for u = num_unknowns(); solved by dense Cholesky. Throws InputError if
+/// the sample arrays disagree in size, are empty or not finite, or the regularised normal matrix is
+/// singular (e.g. λ = 0 with fewer independent samples than unknowns).
 RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& samples);
 
 /// The stretch views (material::stretch_view) of every sample, 3N × 3 (rows 3j..3j+2 are sample
@@ -128,6 +129,7 @@ MatX stretch_views(ConstRef<MatX> stretches);
 /// S = √diag and Tikhonov λ_i (one per unknown) on the scaled unknowns:
 /// (S⁻¹ N S⁻¹ + diag λ) S x = S⁻¹ rhs.
 /// `samples` is only quoted in the error. Throws InputError if the system is singular.
-VecX solve_regularised_normal_equations(MatX normal, ConstRef<VecX> rhs, ConstRef<VecX> regularization, long samples);
+VecX solve_regularised_normal_equations(
+    MatX normal, ConstRef<VecX> rhs, ConstRef<VecX> regularization, long samples);
 
 } // namespace elastolearn::learn

@@ -113,11 +113,13 @@ Eigen::Matrix<double, 12, 3> element_force_operator(
 namespace {
 
 /// −vol (dP/dF : Ḟ) g_a for an eigen-form tangent (local dofs x0, y0, z0, x1, …).
-Vec12 stiffness_damping_force(
-    const fem::TetRestData& rest, const ElementState& state, const material::PrincipalTangent& tangent) {
-  const Mat3 stress_rate = material::first_piola_differential(state.frame, tangent, state.deformation_rate);
+Vec12 stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
+    const material::PrincipalTangent& tangent) {
+  const Mat3 stress_rate
+      = material::first_piola_differential(state.frame, tangent, state.deformation_rate);
   Vec12 f;
-  Eigen::Map<Eigen::Matrix<double, 3, 4>>(f.data()).noalias() = -rest.volume * stress_rate * rest.gradients;
+  Eigen::Map<Eigen::Matrix<double, 3, 4>>(f.data()).noalias()
+      = -rest.volume * stress_rate * rest.gradients;
   return f;
 }
 
@@ -136,8 +138,10 @@ Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
   for (int c = 0; c < 12; ++c) {
     Vec3 stress = Vec3::Zero();
     Mat3 derivative = Mat3::Zero();
-    if (c < 3) stress[c] = 1;
-    else derivative((c - 3) % 3, (c - 3) / 3) = 1;
+    if (c < 3)
+      stress[c] = 1;
+    else
+      derivative((c - 3) % 3, (c - 3) / 3) = 1;
     op.col(c) = stiffness_damping_force(
         rest, state, material::damping_tangent(state.frame, stress, derivative));
   }
@@ -164,13 +168,15 @@ CorrectionForceJacobian::CorrectionForceJacobian(
     , m_free_rows(element_free_rows(mesh, dofs))
     , m_states(mesh.num_tets())
     , m_jt(design.num_unknowns(), dofs.num_free())
-    , m_batch(12 * std::min(k_jacobian_batch, std::max(1, mesh.num_tets())), design.num_unknowns()) {
+    , m_batch(
+          12 * std::min(k_jacobian_batch, std::max(1, mesh.num_tets())), design.num_unknowns()) {
   if (design.damping_unknowns() > 0 && mesh.nominal.elastic == nullptr)
     fail("nominal", "fitting the damping correction needs the nominal elastic model");
 }
 
-void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows, RbfDesign::OutputMatrix& outputs,
-    RbfDesign::OutputGradient& gradients, Eigen::RowVectorXd& damping_row) const {
+void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
+    RbfDesign::OutputMatrix& outputs, RbfDesign::OutputGradient& gradients,
+    Eigen::RowVectorXd& damping_row) const {
   const material::ElasticModel* elastic = m_mesh.nominal.elastic.get();
   const int u = m_design.num_unknowns(), u_elastic = m_design.elastic_unknowns();
   const ElementState& st = m_states[e];
@@ -178,7 +184,8 @@ void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows, RbfDesi
   const double alpha1 = elastic != nullptr ? nominal_alpha1(m_mesh, st.frame.stretches) : 0.0;
   if (alpha1 != 0) {
     m_design.output_matrix(st.frame.stretches, outputs, gradients);
-    const Eigen::Matrix<double, 12, 12> D = alpha1 * element_stiffness_damping_operator(m_mesh.rest[e], st);
+    const Eigen::Matrix<double, 12, 12> D
+        = alpha1 * element_stiffness_damping_operator(m_mesh.rest[e], st);
     rows.leftCols(u_elastic).noalias() = (G + D.leftCols<3>()) * outputs;
     rows.leftCols(u_elastic).noalias() += D.rightCols<9>() * gradients;
   } else {
@@ -187,7 +194,8 @@ void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows, RbfDesi
   }
   if (u > u_elastic) {
     m_design.damping_row(st.frame.stretches, damping_row);
-    rows.rightCols(u - u_elastic).noalias() = element_stiffness_damping_force(m_mesh.rest[e], st, *elastic) * damping_row;
+    rows.rightCols(u - u_elastic).noalias()
+        = element_stiffness_damping_force(m_mesh.rest[e], st, *elastic) * damping_row;
   }
 }
 
@@ -209,7 +217,8 @@ const MatX& CorrectionForceJacobian::transposed(const VecX& x, const VecX& v) {
     for (int i = 0; i < count; ++i)
       for (int l = 0; l < 12; ++l) {
         const int row = m_free_rows[first + i][l];
-        if (row >= 0) m_jt.col(row) += m_batch.row(12 * i + l).transpose();
+        if (row >= 0)
+          m_jt.col(row) += m_batch.row(12 * i + l).transpose();
       }
   }
   return m_jt;
@@ -233,20 +242,25 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
       const material::CorrectedStress total = material::corrected_principal_stress(
           *elastic, &correction, s.frame.stretches, s.stretch_rates);
       const Vec3 nominal_stress = elastic->principal_stress(s.frame.stretches);
-      element_forces[e].noalias() = element_force_operator(mesh.rest[e], s.frame) * (total.stress - nominal_stress);
+      element_forces[e].noalias()
+          = element_force_operator(mesh.rest[e], s.frame) * (total.stress - nominal_stress);
       // ElasticForce's damping with the correction minus without it: α₁ on the corrected minus
       // the nominal stiffness, and the learned Δα₁ on the nominal one (same clamp α₁ + Δα₁ ≥ 0).
       const double alpha1 = nominal_alpha1(mesh, s.frame.stretches);
-      const double change = material::corrected_stiffness_damping(alpha1, &correction, s.frame.stretches) - alpha1;
+      const double change
+          = material::corrected_stiffness_damping(alpha1, &correction, s.frame.stretches) - alpha1;
       if (alpha1 == 0 && change == 0)
         continue;
       if (alpha1 != 0) {
         material::CorrectedStress scratch;
         const material::CorrectedStress& elastic_stress
             = material::elastic_part(*elastic, &correction, s.frame.stretches, total, scratch);
-        element_forces[e] += alpha1 * (stiffness_damping_force(mesh.rest[e], s,
-            material::damping_tangent(s.frame, elastic_stress.stress, elastic_stress.d_stretches))
-            - stiffness_damping_force(mesh.rest[e], s, material::damping_tangent(*elastic, s.frame)));
+        element_forces[e] += alpha1
+            * (stiffness_damping_force(mesh.rest[e], s,
+                   material::damping_tangent(
+                       s.frame, elastic_stress.stress, elastic_stress.d_stretches))
+                - stiffness_damping_force(
+                    mesh.rest[e], s, material::damping_tangent(*elastic, s.frame)));
       }
       if (change != 0)
         element_forces[e] += change * element_stiffness_damping_force(mesh.rest[e], s, *elastic);
@@ -383,7 +397,8 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
     const StressReconstructionOptions& options, ConstRef<MatX> projection) {
   options.validate();
   const bool projected = projection.size() > 0;
-  const double full_weight = projected ? options.full_space_weight : 1.0; // of the unprojected misfit
+  const double full_weight
+      = projected ? options.full_space_weight : 1.0; // of the unprojected misfit
   if (projected && options.method == ReconstructionMethod::lsqr)
     fail("method", "the lsqr method has no force projection: use normal_equations");
   if (options.method == ReconstructionMethod::lsqr)
@@ -394,8 +409,8 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
   if (rows == 0)
     fail("dofs", "no free degree of freedom");
   if (projected && (projection.rows() != rows || !projection.allFinite()))
-    fail("projection", "must have one finite row per free dof (" + str(rows) + "), got "
-        + str(projection.rows()));
+    fail("projection",
+        "must have one finite row per free dof (" + str(rows) + "), got " + str(projection.rows()));
   if (design.damping_unknowns() > 0 && mesh.nominal.elastic == nullptr)
     fail("nominal", "fitting the damping correction needs the nominal elastic model");
   const auto start = std::chrono::steady_clock::now();
@@ -408,8 +423,8 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
   const int blocks = std::min<int>(k_frame_blocks, int(frames.size()));
   std::vector<BlockSums> sums(blocks);
   tbb::enumerable_thread_specific<AssemblyScratch> scratch([&] {
-    AssemblyScratch s { CorrectionForceJacobian(mesh, dofs, design), VecX(), MatX(u, projection.cols()),
-        VecX(projection.cols()) };
+    AssemblyScratch s { CorrectionForceJacobian(mesh, dofs, design), VecX(),
+      MatX(u, projection.cols()), VecX(projection.cols()) };
     return s;
   });
   tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 1), [&](const tbb::blocked_range<int>& r) {
@@ -446,7 +461,8 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
   const double assembly_seconds = seconds_since(start);
 
   const auto solve_start = std::chrono::steady_clock::now();
-  VecX x = solve_regularised_normal_equations(std::move(normal), rhs, design.regularization_weights(), long(frames.size()));
+  VecX x = solve_regularised_normal_equations(
+      std::move(normal), rhs, design.regularization_weights(), long(frames.size()));
   material::RbfCorrection correction = design.correction(x);
   const double solve_seconds = seconds_since(solve_start);
 

@@ -62,13 +62,13 @@ Eigen::Matrix<double, 12, 3> element_force_operator(
 /// The element's stiffness-damping force per unit Δα₁ [N·s]: −K_e v_e = −vol (dP/dF : Ḟ) g_a
 /// with dP/dF the damping tangent (material::damping_tangent) of the nominal model `elastic`,
 /// exactly as fem::ElasticForce applies Δα₁. Local dofs ordered x0, y0, z0, x1, ….
-Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
-    const material::ElasticModel& elastic);
+Vec12 element_stiffness_damping_force(
+    const fem::TetRestData& rest, const ElementState& state, const material::ElasticModel& elastic);
 
 /// The element's stiffness-damping force per unit α₁ as a linear function of a principal stress
 /// and its stretch derivative: column c maps entry c of [p̂; vec(∂p̂/∂σ)] (3 + 9, column-major)
-/// to the nodal forces −vol (dP/dF : Ḟ) g_a of material::damping_tangent of p̂ [N·s per Pa]. Applied to
-/// an RBF unknown's output and gradient (RbfDesign::output_matrix) it gives that unknown's share
+/// to the nodal forces −vol (dP/dF : Ḟ) g_a of material::damping_tangent of p̂ [N·s per Pa]. Applied
+/// to an RBF unknown's output and gradient (RbfDesign::output_matrix) it gives that unknown's share
 /// of the nominal α₁'s action on the corrected stiffness (fem::ElasticForce).
 Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
     const fem::TetRestData& rest, const ElementState& state);
@@ -90,20 +90,22 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
 /// space (allocated once); one instance per concurrent caller. `mesh`, `dofs` and `design` must
 /// outlive it.
 class CorrectionForceJacobian {
-public:
+  public:
   /// Throws InputError if the design fits damping but mesh.nominal has no elastic model.
-  CorrectionForceJacobian(const ReconstructionMesh& mesh, const fem::DofMap& dofs, const RbfDesign& design);
+  CorrectionForceJacobian(
+      const ReconstructionMesh& mesh, const fem::DofMap& dofs, const RbfDesign& design);
   /// Jᵀ (unknowns × free dofs) at flat 3n positions x [m] and velocities v [m/s].
   const MatX& transposed(const VecX& x, const VecX& v);
 
-private:
+  private:
   /// Element e's 12 × u block into `rows`.
   void element_rows(int e, Eigen::Ref<MatX> rows, RbfDesign::OutputMatrix& outputs,
       RbfDesign::OutputGradient& gradients, Eigen::RowVectorXd& damping_row) const;
 
   const ReconstructionMesh& m_mesh;
   const RbfDesign& m_design;
-  std::vector<std::array<int, 12>> m_free_rows; ///< free index of each element's local dofs (−1: prescribed)
+  std::vector<std::array<int, 12>>
+      m_free_rows; ///< free index of each element's local dofs (−1: prescribed)
   std::vector<ElementState> m_states;
   MatX m_jt;
   MatX m_batch; ///< 12 rows per element of one batch
@@ -192,11 +194,11 @@ struct StressReconstructionResult {
 /// with μ = options.full_space_weight: the misfit is measured mainly where the reduced
 /// space-time optimisation controls the residual (docs/learning.md, "Projected reconstruction"),
 /// F_t x = Σ_e (G_e A_e + α₁ D_e [A_e; ∂A_e/∂σ]) x_e + (−K_e v_e) d_e x_d the nodal force of the
-/// correction with unknowns x at frame t (= correction_force while α₁ + Δα₁ ≥ 0), and g_t (target_forces[t], flat 3n, only
-/// free dofs used) the force the new correction must produce (current correction force + control
-/// force). D_e is element_stiffness_damping_operator, K_e the nominal model's stiffness
-/// (element_stiffness_damping_force); both need `mesh.nominal.elastic` (required when the design
-/// fits damping; without it the α₁ term is left out). Tikhonov:
+/// correction with unknowns x at frame t (= correction_force while α₁ + Δα₁ ≥ 0), and g_t
+/// (target_forces[t], flat 3n, only free dofs used) the force the new correction must produce
+/// (current correction force + control force). D_e is element_stiffness_damping_operator, K_e the
+/// nominal model's stiffness (element_stiffness_damping_force); both need `mesh.nominal.elastic`
+/// (required when the design fits damping; without it the α₁ term is left out). Tikhonov:
 /// design.options().regularization on the Jacobi-scaled unknowns, as fit_rbf_correction.
 /// Method normal_equations: J_t (free dofs × q) is assembled per frame and JᵀJ accumulated by
 /// symmetric rank updates, in parallel over fixed blocks of frames summed in order

@@ -19,12 +19,12 @@ namespace elastolearn::learn {
 /// Accumulates, frame by frame, the stretch range a trajectory visits and, given a training
 /// range, how many (element, frame) samples leave it.
 class StretchCoverage {
-public:
+  public:
   /// \param trained    the training range to compare with (none: only the visited range)
   /// \param tolerance  a sample counts as outside when a sorted stretch leaves `trained` by
   ///                   more than this [-] (default 10⁻³: 0.1 % strain, far above round-off)
-  explicit StretchCoverage(const mesh::TetMesh& mesh, std::optional<material::StretchRange> trained = std::nullopt,
-                           double tolerance = 1e-3);
+  explicit StretchCoverage(const mesh::TetMesh& mesh,
+      std::optional<material::StretchRange> trained = std::nullopt, double tolerance = 1e-3);
 
   /// One frame of positions, flat 3n. Elements in parallel, no allocation per element.
   /// Throws InputError if x is not 3n long.
@@ -36,9 +36,11 @@ public:
   long samples() const { return m_samples; }
   long samples_outside() const { return m_outside; }
   /// samples_outside / samples (0 before any frame).
-  double fraction_outside() const { return m_samples > 0 ? double(m_outside) / double(m_samples) : 0.0; }
+  double fraction_outside() const {
+    return m_samples > 0 ? double(m_outside) / double(m_samples) : 0.0;
+  }
 
-private:
+  private:
   Tets m_tets; ///< a copy: the coverage may outlive the mesh it was built from
   Eigen::Index m_dofs; ///< 3n
   std::vector<fem::TetRestData> m_rest;
@@ -49,15 +51,16 @@ private:
 };
 
 /// The stretch range of a whole trajectory (frames flat 3n).
-material::StretchRange trajectory_stretch_range(const mesh::TetMesh& mesh, const std::vector<VecX>& frames);
+material::StretchRange trajectory_stretch_range(
+    const mesh::TetMesh& mesh, const std::vector<VecX>& frames);
 
 /// The training range of a learned correction: the stretch range of the training scene
 /// simulated with it (the model that fits the observations; the observed vertices alone cannot
 /// give the interior's stretches). Nothing if `correction` is null or that simulation does not
 /// complete (it did when the loop chose the correction; a caller must not lose a learned
 /// correction over its metadata).
-std::optional<material::StretchRange> training_stretch_range(const sim::Scene& training,
-                                                             std::shared_ptr<const material::Correction> correction);
+std::optional<material::StretchRange> training_stretch_range(
+    const sim::Scene& training, std::shared_ptr<const material::Correction> correction);
 
 /// "s₁ 0.978–1.022, s₂ 0.990–1.010, s₃ 0.973–1.000" (three decimals).
 std::string describe(const material::StretchRange& range);

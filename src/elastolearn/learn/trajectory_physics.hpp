@@ -16,7 +16,7 @@
 namespace elastolearn::learn {
 
 class TrajectoryPhysics {
-public:
+  public:
   /// Forces (elastic + correction + damping + gravity + loads) of `scene`'s material, with the
   /// scene's fixed and keyframed vertices prescribed. Lumped mass only (the paper's).
   /// Throws InputError for a consistent-mass scene.
@@ -47,7 +47,7 @@ public:
   /// x_{−1} = x_0 − h v_0.
   VecX state_before_start(const VecX& x0, const VecX& v0) const { return x0 - m_dt * v0; }
 
-private:
+  private:
   sim::Scene m_scene;
   fem::DofMap m_dofs;
   double m_dt = 0;
@@ -60,6 +60,7 @@ private:
 };
 
 /// Velocities v_i = (x_i − x_{i−1})/h of a trajectory of T + 1 states (v_0 given).
-std::vector<VecX> finite_difference_velocities(const std::vector<VecX>& positions, const VecX& v0, double dt);
+std::vector<VecX> finite_difference_velocities(
+    const std::vector<VecX>& positions, const VecX& v0, double dt);
 
 } // namespace elastolearn::learn

@@ -14,18 +14,18 @@ namespace elastolearn::material {
 /// Implementations must be thread-safe and allocation-free in `correction`, `correction_gradient`
 /// and `correction_with_gradient`.
 class Correction {
-public:
+  public:
   virtual ~Correction() = default;
   virtual std::string name() const = 0;
   /// N(F̂, Ḟ̂).
   virtual Vec3 correction(const Vec3& stretches, const Vec3& stretch_rates) const = 0;
   /// ∂N/∂F̂ (3×3, row = output) and ∂N/∂Ḟ̂ (3×3).
   virtual void correction_gradient(const Vec3& stretches, const Vec3& stretch_rates,
-                                   Mat3& d_stretches, Mat3& d_stretch_rates) const = 0;
+      Mat3& d_stretches, Mat3& d_stretch_rates) const = 0;
   /// N and both gradients in one call, what the element loops need; the default calls the two
   /// above, an implementation may share their work (the RBF evaluates each kernel once).
-  virtual Vec3 correction_with_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
-                                        Mat3& d_stretch_rates) const {
+  virtual Vec3 correction_with_gradient(const Vec3& stretches, const Vec3& stretch_rates,
+      Mat3& d_stretches, Mat3& d_stretch_rates) const {
     correction_gradient(stretches, stretch_rates, d_stretches, d_stretch_rates);
     return correction(stretches, stretch_rates);
   }
@@ -44,7 +44,8 @@ public:
 /// An element's stiffness-damping coefficient with a correction: α₁ + Δα₁(F̂), kept ≥ 0 (a
 /// negative total would feed energy in); α₁ itself without a correction. The one rule that
 /// fem::ElasticForce and the learning's correction forces share.
-inline double corrected_stiffness_damping(double alpha1, const Correction* correction, const Vec3& stretches) {
+inline double corrected_stiffness_damping(
+    double alpha1, const Correction* correction, const Vec3& stretches) {
   return correction ? std::max(0.0, alpha1 + correction->stiffness_damping(stretches)) : alpha1;
 }
 

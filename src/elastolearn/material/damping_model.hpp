@@ -15,7 +15,7 @@ struct RayleighCoefficients {
 
 /// Rayleigh coefficients of one element as a function of its largest principal stretch.
 class DampingModel {
-public:
+  public:
   virtual ~DampingModel() = default;
   virtual std::string name() const = 0;
   virtual RayleighCoefficients coefficients(double max_stretch) const = 0;

@@ -21,7 +21,7 @@ struct Lame {
 /// and its 3×3 derivative ∂P̂/∂σ (symmetric). All are symmetric functions of σ.
 /// Implementations must be thread-safe (const, no mutable state) and allocation-free.
 class ElasticModel {
-public:
+  public:
   virtual ~ElasticModel() = default;
   /// Short identifier used in JSON and the CLI ("corotated", "stvk", "neohookean", ...).
   virtual std::string name() const = 0;

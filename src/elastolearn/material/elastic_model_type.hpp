@@ -15,7 +15,7 @@ enum class ElasticModelType { Corotated, StVK, NeoHookean, SplineEdited };
 /// Every model type, in table order.
 inline constexpr std::array<ElasticModelType, 4> all_elastic_model_types
     = { ElasticModelType::Corotated, ElasticModelType::StVK, ElasticModelType::NeoHookean,
-          ElasticModelType::SplineEdited };
+        ElasticModelType::SplineEdited };
 
 /// "corotated", "stvk", "neohookean", "spline_edited" (the same strings as ElasticModel::name()).
 std::string to_string(ElasticModelType type);

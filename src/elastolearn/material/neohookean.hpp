@@ -14,29 +14,29 @@ namespace elastolearn::material {
 /// are finite, consistent (P̂ = ∂Ψ/∂σ exactly) and continuous for every σ, including σ3 ≤ 0
 /// (J ≤ 0), and the element is pushed back towards the uninverted state.
 class NeoHookeanModel final : public ElasticModel {
-public:
-    /// Default threshold ε of the ln extension (a stretch below 0.1 is already extreme
-    /// compression).
-    static constexpr double default_inversion_threshold = 0.1;
+  public:
+  /// Default threshold ε of the ln extension (a stretch below 0.1 is already extreme
+  /// compression).
+  static constexpr double default_inversion_threshold = 0.1;
 
-    /// Throws InputError unless 0 < inversion_threshold < 1.
-    explicit NeoHookeanModel(
-        const Lame& lame, double inversion_threshold = default_inversion_threshold);
-    std::string name() const override { return "neohookean"; }
-    double energy(const Vec3& stretches) const override;
-    Vec3 principal_stress(const Vec3& stretches) const override;
-    Mat3 principal_stress_derivative(const Vec3& stretches) const override;
-    std::unique_ptr<ElasticModel> clone() const override;
-    const Lame& lame() const { return m_lame; }
-    double inversion_threshold() const { return m_eps; }
+  /// Throws InputError unless 0 < inversion_threshold < 1.
+  explicit NeoHookeanModel(
+      const Lame& lame, double inversion_threshold = default_inversion_threshold);
+  std::string name() const override { return "neohookean"; }
+  double energy(const Vec3& stretches) const override;
+  Vec3 principal_stress(const Vec3& stretches) const override;
+  Mat3 principal_stress_derivative(const Vec3& stretches) const override;
+  std::unique_ptr<ElasticModel> clone() const override;
+  const Lame& lame() const { return m_lame; }
+  double inversion_threshold() const { return m_eps; }
 
-    /// The extended logarithm ℓ(x) and its first two derivatives.
-    void extended_log(double x, double& l, double& dl, double& ddl) const;
+  /// The extended logarithm ℓ(x) and its first two derivatives.
+  void extended_log(double x, double& l, double& dl, double& ddl) const;
 
-private:
-    Lame m_lame;
-    double m_eps;
-    double m_log_eps;
+  private:
+  Lame m_lame;
+  double m_eps;
+  double m_log_eps;
 };
 
 } // namespace elastolearn::material

@@ -72,8 +72,8 @@ NnCorrection::NnCorrection(Parameters p)
     const bool last = k + 1 == m_p.layers.size();
     if (l.weight.cols() != inputs) {
       fail(layer_field(k, "weight"),
-          "has " + std::to_string(l.weight.cols()) + " columns, expected "
-              + std::to_string(inputs) + " (the previous layer's outputs)");
+          "has " + std::to_string(l.weight.cols()) + " columns, expected " + std::to_string(inputs)
+              + " (the previous layer's outputs)");
     }
     if (last && l.weight.rows() != 1) {
       fail(layer_field(k, "weight"),
@@ -165,14 +165,14 @@ Vec3 NnCorrection::correction(const Vec3& stretches, const Vec3& stretch_rates) 
   return n;
 }
 
-void NnCorrection::correction_gradient(const Vec3& s, const Vec3& f, Mat3& d_stretches,
-    Mat3& d_stretch_rates) const {
+void NnCorrection::correction_gradient(
+    const Vec3& s, const Vec3& f, Mat3& d_stretches, Mat3& d_stretch_rates) const {
   for (int k = 0; k < 3; ++k) {
     NnInput g;
     evaluate(nn_input(s, f, k), &g);
-    // Chain rule through x_k = (σ_k, σ_a + σ_b, ½(σ_a − σ_b)², ḟ_k, ḟ_a + ḟ_b, (σ_a − σ_b)(ḟ_a − ḟ_b)).
-    // Direction b is written like a with the differences negated, so that swapping a and b gives
-    // the same bits.
+    // Chain rule through x_k = (σ_k, σ_a + σ_b, ½(σ_a − σ_b)², ḟ_k, ḟ_a + ḟ_b, (σ_a − σ_b)(ḟ_a −
+    // ḟ_b)). Direction b is written like a with the differences negated, so that swapping a and b
+    // gives the same bits.
     const auto [a, b] = others(k);
     const double ds = s[a] - s[b], df = f[a] - f[b];
     d_stretches(k, k) = g[0];

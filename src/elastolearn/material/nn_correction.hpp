@@ -39,8 +39,8 @@ NnInput nn_input(const Vec3& stretches, const Vec3& stretch_rates, int k);
 /// repeated stretches. The paper's 6 → 6 → 6 → 3 map of sorted stretches becomes a 6 → 6 → 6 → 1
 /// map shared by the three directions.
 /// N is C¹ in (σ, ḟ) (ELU is C¹, the inputs C∞). `correction` and `correction_gradient` are
-/// exact (reverse-mode differentiation through ELU), allocation-free (stack buffers; hidden widths ≤ max_width, ≤ max_hidden_layers hidden layers)
-/// and thread-safe.
+/// exact (reverse-mode differentiation through ELU), allocation-free (stack buffers; hidden widths
+/// ≤ max_width, ≤ max_hidden_layers hidden layers) and thread-safe.
 class NnCorrection final : public Correction {
   public:
   /// Largest hidden-layer width evaluation supports without allocating.

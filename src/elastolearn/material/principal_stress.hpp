@@ -35,9 +35,10 @@ struct PrincipalTangent {
   Vec3 flip;
 };
 PrincipalTangent principal_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,
-                                   const Mat3& principal_stress_derivative, bool project_psd);
+    const Mat3& principal_stress_derivative, bool project_psd);
 /// The same for an uncorrected model at the frame's stretches.
-PrincipalTangent principal_tangent(const ElasticModel& model, const PrincipalFrame& frame, bool project_psd);
+PrincipalTangent principal_tangent(
+    const ElasticModel& model, const PrincipalFrame& frame, bool project_psd);
 /// The tangent with its block made symmetric PSD and its twist and flip eigenvalues ≥ 0 (what
 /// `project_psd` does, for a tangent formed otherwise, e.g. as a weighted sum).
 PrincipalTangent projected(const PrincipalTangent& tangent);
@@ -46,7 +47,7 @@ Mat3 symmetric_psd(const Mat3& a);
 /// The stiffness that Rayleigh damping scales (fem::ElasticForce): the exact tangent of P̂ without
 /// its flip eigenvalues. Linear in (P̂, ∂P̂/∂σ).
 PrincipalTangent damping_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,
-                                 const Mat3& principal_stress_derivative);
+    const Mat3& principal_stress_derivative);
 /// The same for an uncorrected model at the frame's stretches.
 PrincipalTangent damping_tangent(const ElasticModel& model, const PrincipalFrame& frame);
 /// The 9×9 dP/dF of an eigen-form tangent (symmetric if the tangent was projected).
@@ -54,7 +55,8 @@ Mat9 first_piola_derivative(const PrincipalFrame& frame, const PrincipalTangent&
 /// dP = (dP/dF) : dF without forming the 9×9: dP = U dP̂ Vᵀ with, for dF̂ = Uᵀ dF V,
 /// dP̂ᵢᵢ = Σⱼ block(i,j) dF̂ⱼⱼ and per pair dP̂ᵢⱼ = ½(twist s + flip d), dP̂ⱼᵢ = ½(twist s − flip d),
 /// s = dF̂ᵢⱼ + dF̂ⱼᵢ, d = dF̂ᵢⱼ − dF̂ⱼᵢ. About a tenth of the work of forming dP/dF.
-Mat3 first_piola_differential(const PrincipalFrame& frame, const PrincipalTangent& tangent, const Mat3& dF);
+Mat3 first_piola_differential(
+    const PrincipalFrame& frame, const PrincipalTangent& tangent, const Mat3& dF);
 
 /// dP/dF (9×9) of P = U P̂(σ(F)) Vᵀ for an isotropic diagonal stress P̂(σ) with 3×3 derivative
 /// ∂P̂/∂σ. With `project_psd` the 3×3 block and the three 2×2 twist/flip blocks are made symmetric
@@ -62,7 +64,7 @@ Mat3 first_piola_differential(const PrincipalFrame& frame, const PrincipalTangen
 /// result is symmetric positive semi-definite. Without it the exact derivative is returned
 /// (including near-equal stretches, handled by a stable limit).
 Mat9 first_piola_derivative(const PrincipalFrame& frame, const Vec3& principal_stress,
-                            const Mat3& principal_stress_derivative, bool project_psd);
+    const Mat3& principal_stress_derivative, bool project_psd);
 
 /// ∂P/∂Ḟ (9×9) of P = U N(σ, Ḟ̂) Vᵀ with respect to Ḟ, for ∂N/∂Ḟ̂ = `d_stretch_rates`
 /// (U and V depend on F only, so this is exact).
@@ -70,20 +72,20 @@ Mat9 first_piola_rate_derivative(const PrincipalFrame& frame, const Mat3& d_stre
 
 /// Elastic model plus optional correction, evaluated at one element state.
 struct CorrectedStress {
-  Vec3 stress;          ///< P̂(σ) + N(σ, Ḟ̂)
-  Mat3 d_stretches;     ///< ∂(P̂ + N)/∂σ with Ḟ̂ held fixed
+  Vec3 stress; ///< P̂(σ) + N(σ, Ḟ̂)
+  Mat3 d_stretches; ///< ∂(P̂ + N)/∂σ with Ḟ̂ held fixed
   Mat3 d_stretch_rates; ///< ∂N/∂Ḟ̂ (zero without a correction)
 };
 
 /// Evaluate P̂ + N at (σ, Ḟ̂). `correction` may be null.
 CorrectedStress corrected_principal_stress(const ElasticModel& model, const Correction* correction,
-                                           const Vec3& stretches, const Vec3& stretch_rates);
+    const Vec3& stretches, const Vec3& stretch_rates);
 
 /// The elastic part P̂ + N(σ, 0) of a corrected stress evaluated at (σ, Ḟ̂): `at_rates` itself
 /// when N does not depend on the rates (Correction::depends_on_rates), else re-evaluated into
 /// `scratch`. The stress whose stiffness Rayleigh damping scales (fem::ElasticForce).
-const CorrectedStress& elastic_part(const ElasticModel& model, const Correction* correction, const Vec3& stretches,
-                                    const CorrectedStress& at_rates, CorrectedStress& scratch);
+const CorrectedStress& elastic_part(const ElasticModel& model, const Correction* correction,
+    const Vec3& stretches, const CorrectedStress& at_rates, CorrectedStress& scratch);
 
 /// Convenience for tests and tools: P(F) of a model (no correction).
 Mat3 first_piola(const ElasticModel& model, const Mat3& F);

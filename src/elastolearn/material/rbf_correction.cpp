@@ -15,35 +15,38 @@ namespace {
 
 /// Stable descending order of three values: order[i] = index of the i-th largest.
 std::array<int, 3> descending_order(const Vec3& v) {
-  std::array<int, 3> order{0, 1, 2};
+  std::array<int, 3> order { 0, 1, 2 };
   for (int i = 1; i < 3; ++i)
-    for (int j = i; j > 0 && v[order[j]] > v[order[j - 1]]; --j) std::swap(order[j], order[j - 1]);
+    for (int j = i; j > 0 && v[order[j]] > v[order[j - 1]]; --j)
+      std::swap(order[j], order[j - 1]);
   return order;
 }
 
 /// The other two directions of k, larger stretch first (ties: lower index first).
 std::array<int, 2> others_descending(const Vec3& s, int k) {
   int a = (k + 1) % 3, b = (k + 2) % 3;
-  if (a > b) std::swap(a, b);
-  if (s[b] > s[a]) std::swap(a, b);
-  return {a, b};
+  if (a > b)
+    std::swap(a, b);
+  if (s[b] > s[a])
+    std::swap(a, b);
+  return { a, b };
 }
 
 } // namespace
 
 std::array<int, 3> stretch_view_indices(const Vec3& s, int k) {
   const auto o = others_descending(s, k);
-  return {k, o[0], o[1]};
+  return { k, o[0], o[1] };
 }
 
 Vec3 stretch_view(const Vec3& s, int k) {
   const auto i = stretch_view_indices(s, k);
-  return {s[i[0]], s[i[1]], s[i[2]]};
+  return { s[i[0]], s[i[1]], s[i[2]] };
 }
 
 Eigen::Vector4d quadratic_tail_basis(const Vec3& y) {
   const double e = y[0] - 1, s = y[1] + y[2] - 2;
-  return {e * e, e * s, s * s, (y[1] - 1) * (y[2] - 1)};
+  return { e * e, e * s, s * s, (y[1] - 1) * (y[2] - 1) };
 }
 
 Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3>* d_y) {
@@ -53,23 +56,29 @@ Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3
   const Eigen::Vector2d g(z[0] + 1 / z[0] - 2, log_j / z[0] - (z[0] + z[1] + z[2] - 3));
   if (d_y) {
     d_y->row(0) = Eigen::RowVector3d(1 - 1 / (z[0] * z[0]), 0, 0);
-    d_y->row(1) = Eigen::RowVector3d((1 - log_j) / (z[0] * z[0]) - 1, 1 / (z[0] * z[1]) - 1, 1 / (z[0] * z[2]) - 1);
+    d_y->row(1) = Eigen::RowVector3d(
+        (1 - log_j) / (z[0] * z[0]) - 1, 1 / (z[0] * z[1]) - 1, 1 / (z[0] * z[2]) - 1);
     for (int c = 0; c < 3; ++c)
-      if (y[c] < floor) d_y->col(c).setZero();
+      if (y[c] < floor)
+        d_y->col(c).setZero();
   }
   return g;
 }
 
-RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
+RbfCorrection::RbfCorrection(Parameters p)
+    : m_p(std::move(p)) {
   const Eigen::Index m = m_p.centres.rows();
   if (m_p.weights.size() != m)
-    fail("weights", "has " + std::to_string(m_p.weights.size()) + " entries, one per centre (" + std::to_string(m) +
-                        ") expected");
+    fail("weights",
+        "has " + std::to_string(m_p.weights.size()) + " entries, one per centre ("
+            + std::to_string(m) + ") expected");
   if (m_p.damping_weights.size() != 0 && m_p.damping_weights.size() != m)
-    fail("damping_weights", "has " + std::to_string(m_p.damping_weights.size()) +
-                                " entries, expected none or one per centre (" + std::to_string(m) + ")");
+    fail("damping_weights",
+        "has " + std::to_string(m_p.damping_weights.size())
+            + " entries, expected none or one per centre (" + std::to_string(m) + ")");
   const auto finite = [](const char* field, bool ok) {
-    if (!ok) fail(field, "contains a non-finite value");
+    if (!ok)
+      fail(field, "contains a non-finite value");
   };
   finite("centres", m_p.centres.allFinite());
   finite("weights", m_p.weights.allFinite());
@@ -94,15 +103,18 @@ RbfCorrection::RbfCorrection(Parameters p) : m_p(std::move(p)) {
 double RbfCorrection::elastic_tail(const Vec3& y, Vec3* d_y) const {
   const double e = y[0] - 1, s = y[1] + y[2] - 2;
   const Eigen::Vector4d& q = m_p.quadratic;
-  double h = m_p.own_slope * e + m_p.other_slope * s + m_p.constant + q.dot(quadratic_tail_basis(y));
+  double h
+      = m_p.own_slope * e + m_p.other_slope * s + m_p.constant + q.dot(quadratic_tail_basis(y));
   if (d_y) {
     const double d_other = m_p.other_slope + q[1] * e + 2 * q[2] * s;
-    *d_y = Vec3(m_p.own_slope + 2 * q[0] * e + q[1] * s, d_other + q[3] * (y[2] - 1), d_other + q[3] * (y[1] - 1));
+    *d_y = Vec3(m_p.own_slope + 2 * q[0] * e + q[1] * s, d_other + q[3] * (y[2] - 1),
+        d_other + q[3] * (y[1] - 1));
   }
   if (!m_p.neo_hookean.isZero(0)) {
     Eigen::Matrix<double, 2, 3> d_g;
     h += m_p.neo_hookean.dot(neo_hookean_tail_basis(y, d_y ? &d_g : nullptr));
-    if (d_y) *d_y += d_g.transpose() * m_p.neo_hookean;
+    if (d_y)
+      *d_y += d_g.transpose() * m_p.neo_hookean;
   }
   return h;
 }
@@ -124,18 +136,21 @@ Vec3 RbfCorrection::elastic_views(const Mat3& y, Mat3* d_y) const {
     }
   }
   h[3] = g0[3] = g1[3] = g2[3] = 0;
-  const Lanes y0(y(0, 0), y(0, 1), y(0, 2), 1), y1(y(1, 0), y(1, 1), y(1, 2), 1), y2(y(2, 0), y(2, 1), y(2, 2), 1);
+  const Lanes y0(y(0, 0), y(0, 1), y(0, 2), 1), y1(y(1, 0), y(1, 1), y(1, 2), 1),
+      y2(y(2, 0), y(2, 1), y(2, 2), 1);
   const double eps2 = m_p.epsilon * m_p.epsilon;
   for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i) {
     const double w = m_p.weights[i];
-    const Lanes d0 = y0 - m_p.centres(i, 0), d1 = y1 - m_p.centres(i, 1), d2 = y2 - m_p.centres(i, 2);
+    const Lanes d0 = y0 - m_p.centres(i, 0), d1 = y1 - m_p.centres(i, 1),
+                d2 = y2 - m_p.centres(i, 2);
     const Lanes phi = (d0 * d0 + d1 * d1 + d2 * d2 + eps2).sqrt();
     h += w * phi;
     if (d_y) {
       Lanes scale = Lanes::Constant(w) / phi;
       if (eps2 == 0) // 0 at a centre (subgradient); Eigen's select would not run packed
         for (int k = 0; k < 3; ++k)
-          if (phi[k] == 0) scale[k] = 0;
+          if (phi[k] == 0)
+            scale[k] = 0;
       g0 += scale * d0;
       g1 += scale * d1;
       g2 += scale * d2;
@@ -153,10 +168,12 @@ double RbfCorrection::stiffness_damping(const Vec3& stretches) const {
   const auto p = descending_order(stretches);
   const Vec3 s(stretches[p[0]], stretches[p[1]], stretches[p[2]]);
   const Vec3 e = s - Vec3::Ones();
-  double alpha = m_p.damping_slopes.dot(e) + m_p.damping_constant + m_p.damping_quadratic.dot(e.cwiseAbs2());
+  double alpha
+      = m_p.damping_slopes.dot(e) + m_p.damping_constant + m_p.damping_quadratic.dot(e.cwiseAbs2());
   if (m_p.damping_weights.size() > 0) {
     for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i)
-      alpha += m_p.damping_weights[i] * rbf_kernel((s - m_p.centres.row(i).transpose()).squaredNorm(), m_p.epsilon);
+      alpha += m_p.damping_weights[i]
+          * rbf_kernel((s - m_p.centres.row(i).transpose()).squaredNorm(), m_p.epsilon);
   }
   return std::max(alpha, m_p.damping_floor);
 }
@@ -165,8 +182,8 @@ Vec3 RbfCorrection::correction(const Vec3& stretches, const Vec3& /*stretch_rate
   return elastic_correction(stretches);
 }
 
-Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& /*stretch_rates*/, Mat3& d_stretches,
-                                             Mat3& d_stretch_rates) const {
+Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& /*stretch_rates*/,
+    Mat3& d_stretches, Mat3& d_stretch_rates) const {
   std::array<std::array<int, 3>, 3> views;
   Mat3 y, d_y;
   for (int k = 0; k < 3; ++k) {
@@ -176,32 +193,36 @@ Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& 
   const Vec3 n = elastic_views(y, &d_y);
   d_stretches.setZero();
   for (int k = 0; k < 3; ++k)
-    for (int c = 0; c < 3; ++c) d_stretches(k, views[k][c]) += d_y(c, k);
+    for (int c = 0; c < 3; ++c)
+      d_stretches(k, views[k][c]) += d_y(c, k);
   d_stretch_rates.setZero();
   return n;
 }
 
-void RbfCorrection::correction_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
-                                        Mat3& d_stretch_rates) const {
+void RbfCorrection::correction_gradient(const Vec3& stretches, const Vec3& stretch_rates,
+    Mat3& d_stretches, Mat3& d_stretch_rates) const {
   correction_with_gradient(stretches, stretch_rates, d_stretches, d_stretch_rates);
 }
 
-std::unique_ptr<Correction> RbfCorrection::clone() const { return std::make_unique<RbfCorrection>(*this); }
+std::unique_ptr<Correction> RbfCorrection::clone() const {
+  return std::make_unique<RbfCorrection>(*this);
+}
 
 Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
   Mat3 y;
-  for (int k = 0; k < 3; ++k) y.col(k) = stretch_view(stretches, k);
+  for (int k = 0; k < 3; ++k)
+    y.col(k) = stretch_view(stretches, k);
   return elastic_views(y, nullptr);
 }
 
 bool RbfCorrection::has_damping() const {
-  return m_p.damping_weights.size() > 0 || !m_p.damping_slopes.isZero(0) || m_p.damping_constant != 0 ||
-         !m_p.damping_quadratic.isZero(0) || m_p.damping_floor > 0;
+  return m_p.damping_weights.size() > 0 || !m_p.damping_slopes.isZero(0)
+      || m_p.damping_constant != 0 || !m_p.damping_quadratic.isZero(0) || m_p.damping_floor > 0;
 }
 
 bool RbfCorrection::has_elastic_part() const {
-  return !m_p.weights.isZero(0) || m_p.own_slope != 0 || m_p.other_slope != 0 || m_p.constant != 0 ||
-         !m_p.quadratic.isZero(0) || !m_p.neo_hookean.isZero(0);
+  return !m_p.weights.isZero(0) || m_p.own_slope != 0 || m_p.other_slope != 0 || m_p.constant != 0
+      || !m_p.quadratic.isZero(0) || !m_p.neo_hookean.isZero(0);
 }
 
 RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
@@ -209,7 +230,8 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   RbfCorrection::Parameters zero;
   zero.centres.resize(0, 3);
   const RbfCorrection::Parameters& q = b ? b->parameters() : zero;
-  if (b && q.epsilon != p.epsilon) fail("epsilon", "cannot blend corrections with different kernel smoothing");
+  if (b && q.epsilon != p.epsilon)
+    fail("epsilon", "cannot blend corrections with different kernel smoothing");
   const auto damping_weights = [](const RbfCorrection::Parameters& x) {
     return x.damping_weights.size() > 0 ? x.damping_weights : VecX(VecX::Zero(x.centres.rows()));
   };
@@ -220,7 +242,8 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   // correction) is kept once with the summed weights, so the centre count does not grow.
   for (Eigen::Index j = 0; j < q.centres.rows(); ++j) {
     Eigen::Index i = 0;
-    while (i < p.centres.rows() && p.centres.row(i) != q.centres.row(j)) ++i;
+    while (i < p.centres.rows() && p.centres.row(i) != q.centres.row(j))
+      ++i;
     if (i == p.centres.rows()) {
       p.centres.conservativeResize(i + 1, 3);
       p.centres.row(i) = q.centres.row(j);
@@ -230,9 +253,11 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
       v[i] = 0;
     }
     p.weights[i] += t * q.weights[j];
-    if (q.damping_weights.size() > 0) v[i] += t * q.damping_weights[j];
+    if (q.damping_weights.size() > 0)
+      v[i] += t * q.damping_weights[j];
   }
-  if (damped) p.damping_weights = v;
+  if (damped)
+    p.damping_weights = v;
   p.own_slope = (1 - t) * p.own_slope + t * q.own_slope;
   p.other_slope = (1 - t) * p.other_slope + t * q.other_slope;
   p.constant = (1 - t) * p.constant + t * q.constant;

@@ -20,7 +20,8 @@ inline double rbf_kernel(double squared_distance, double epsilon) {
 /// The view of the stretches seen by principal direction k: y_k = (σ_k, max(σ_a, σ_b),
 /// min(σ_a, σ_b)) with a, b the other two directions. y_k is unchanged by swapping a and b.
 Vec3 stretch_view(const Vec3& stretches, int k);
-/// The stretch indices of stretch_view: y_k = (σ[i₀], σ[i₁], σ[i₂]) for i = stretch_view_indices(σ, k).
+/// The stretch indices of stretch_view: y_k = (σ[i₀], σ[i₁], σ[i₂]) for i = stretch_view_indices(σ,
+/// k).
 std::array<int, 3> stretch_view_indices(const Vec3& stretches, int k);
 
 /// The quadratic tail's basis at a stretch view y: t(y) = (e², e s, s², p) with e = y₁ − 1,
@@ -41,7 +42,8 @@ Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3
 /// φ_i(y) = φ(‖y − c_i‖):
 ///   N_k(σ)  = h(y_k)                                                                   [Pa]
 ///   h(y)    = Σ_i w_i φ_i(y) + a (y₁ − 1) + b (y₂ + y₃ − 2) + c + qᵀ t(y) + rᵀ g(y)     (Eq. 10)
-///   Δα₁(σ)  = max(f, Σ_i v_i φ_i(s) + a_dᵀ (s − 1) + a₀ + Σ_k d_k (s_k − 1)²),  s = sort↓ σ   [s]  (Eq. 13)
+///   Δα₁(σ)  = max(f, Σ_i v_i φ_i(s) + a_dᵀ (s − 1) + a₀ + Σ_k d_k (s_k − 1)²),  s = sort↓ σ   [s]
+///   (Eq. 13)
 /// One scalar function h serves all three principal directions, each seeing the stretches from
 /// its own side. This makes N isotropic by construction: N(Pσ) = P N(σ) for every permutation P
 /// and, crucially, N_i = N_j whenever σ_i = σ_j, so that P = U diag(P̂ + N) Vᵀ is a continuous
@@ -57,29 +59,29 @@ Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3
 /// strong compression beyond the training's is extrapolated the way hyperelastic models behave.
 /// Δα₁ is the stiffness-damping correction (Correction::stiffness_damping): the element's
 /// Rayleigh damping force becomes −α₁ K_e v_e − Δα₁ K_e^nom v_e, K_e the corrected and K_e^nom
-/// the nominal model's stiffness, as in paper Eq. (13) (fem::ElasticForce). A positive Δα₁ adds damping; the floor f (damping_floor) bounds how much
-/// it may remove (fem::ElasticForce also keeps α₁ + Δα₁ ≥ 0).
-/// N does not depend on the stretch rates. `correction`, `correction_gradient` and
+/// the nominal model's stiffness, as in paper Eq. (13) (fem::ElasticForce). A positive Δα₁ adds
+/// damping; the floor f (damping_floor) bounds how much it may remove (fem::ElasticForce also keeps
+/// α₁ + Δα₁ ≥ 0). N does not depend on the stretch rates. `correction`, `correction_gradient` and
 /// `stiffness_damping` are exact (subgradients at ties of max/min and, for ε = 0, at a centre),
 /// allocation-free and thread-safe.
 class RbfCorrection final : public Correction {
-public:
+  public:
   using Centres = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
   struct Parameters {
-    Centres centres;              ///< m × 3 centres c_i [-] (m ≥ 0), in stretch-view space
-    VecX weights;                 ///< m elastic weights w_i [Pa]
-    double own_slope = 0;         ///< a [Pa]
-    double other_slope = 0;       ///< b [Pa]
-    double constant = 0;          ///< c [Pa]
+    Centres centres; ///< m × 3 centres c_i [-] (m ≥ 0), in stretch-view space
+    VecX weights; ///< m elastic weights w_i [Pa]
+    double own_slope = 0; ///< a [Pa]
+    double other_slope = 0; ///< b [Pa]
+    double constant = 0; ///< c [Pa]
     Eigen::Vector4d quadratic = Eigen::Vector4d::Zero(); ///< q [Pa] (see quadratic_tail_basis)
     Eigen::Vector2d neo_hookean = Eigen::Vector2d::Zero(); ///< r [Pa] (see neo_hookean_tail_basis)
-    VecX damping_weights;         ///< m damping weights v_i [s], or empty for no damping RBF
+    VecX damping_weights; ///< m damping weights v_i [s], or empty for no damping RBF
     /// a_d [s]: Δα₁'s slope along each sorted stretch s₁ ≥ s₂ ≥ s₃. A linear function of the
     /// sorted stretches is symmetric (isotropic) like the kernels, and spans damping that grows
     /// with the largest stretch only, which a slope along the trace Σσ − 3 (all three equal)
     /// cannot: in bending, σ₁ − 1 is of one size on both sides while the trace nearly vanishes.
     Vec3 damping_slopes = Vec3::Zero();
-    double damping_constant = 0;  ///< a₀ [s]
+    double damping_constant = 0; ///< a₀ [s]
     /// d [s]: Δα₁'s curvature along each sorted stretch, Σ_k d_k (s_k − 1)². Damping that grows
     /// (or saturates) with strain is convex (concave) in it; the kernels grow only linearly away
     /// from their centres, so beyond the training's stretches only this term carries the curvature.
@@ -87,7 +89,7 @@ public:
     /// Δα₁ is clamped below at this value [s] when evaluated: set it to −α₁ of the nominal
     /// model so that the total stiffness damping never turns negative (energy would grow).
     double damping_floor = -std::numeric_limits<double>::infinity();
-    double epsilon = 1e-3;        ///< kernel smoothing ε [-] (≥ 0)
+    double epsilon = 1e-3; ///< kernel smoothing ε [-] (≥ 0)
   };
 
   /// Throws InputError("rbf_correction.<field>", ...) if sizes disagree (weights ≠ m entries,
@@ -97,9 +99,9 @@ public:
   std::string name() const override { return "rbf"; }
   Vec3 correction(const Vec3& stretches, const Vec3& stretch_rates) const override;
   Vec3 correction_with_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
-                                Mat3& d_stretch_rates) const override;
+      Mat3& d_stretch_rates) const override;
   void correction_gradient(const Vec3& stretches, const Vec3& stretch_rates, Mat3& d_stretches,
-                           Mat3& d_stretch_rates) const override;
+      Mat3& d_stretch_rates) const override;
   std::unique_ptr<Correction> clone() const override;
 
   /// Δα₁(σ) (its gradient is not needed: the Jacobian treats α₁ as constant, as for Rayleigh).
@@ -110,15 +112,17 @@ public:
   Vec3 elastic_correction(const Vec3& stretches) const;
   /// True if Δα₁ is not identically zero.
   bool has_damping() const;
-  /// True if N is not identically zero (a weight, slope, constant, quadratic or neo-Hookean term ≠ 0).
+  /// True if N is not identically zero (a weight, slope, constant, quadratic or neo-Hookean term ≠
+  /// 0).
   bool has_elastic_part() const;
   int num_centres() const { return static_cast<int>(m_p.centres.rows()); }
   const Parameters& parameters() const { return m_p; }
 
-private:
+  private:
   /// The tails' part of h(y) (all but the kernels) and, if d_y is non-null, its ∂/∂y.
   double elastic_tail(const Vec3& y, Vec3* d_y) const;
-  /// h(y_k) of the three views y_k = column k of `y` and, if d_y is non-null, column k of *d_y = ∂h/∂y at y_k.
+  /// h(y_k) of the three views y_k = column k of `y` and, if d_y is non-null, column k of *d_y =
+  /// ∂h/∂y at y_k.
   Vec3 elastic_views(const Mat3& y, Mat3* d_y) const;
   Parameters m_p;
 };

@@ -17,29 +17,29 @@ namespace elastolearn::material {
 /// - With a single knot the spline is the constant y_0.
 /// Evaluation is allocation-free and thread-safe (binary search over the knots).
 class CubicSpline {
-public:
-    /// Builds the spline. `where` names the input (JSON field, CLI option) in error messages.
-    /// Throws InputError if there are no knots, the sizes differ, a value is not finite, or the
-    /// x_k are not strictly increasing.
-    CubicSpline(std::vector<double> x, std::vector<double> y, std::string where = "spline");
+  public:
+  /// Builds the spline. `where` names the input (JSON field, CLI option) in error messages.
+  /// Throws InputError if there are no knots, the sizes differ, a value is not finite, or the
+  /// x_k are not strictly increasing.
+  CubicSpline(std::vector<double> x, std::vector<double> y, std::string where = "spline");
 
-    /// s(x); constant extrapolation outside the knot range.
-    double value(double x) const;
-    /// s′(x); zero outside the knot range.
-    double derivative(double x) const;
-    /// s(x) and s′(x) together.
-    void evaluate(double x, double& value, double& derivative) const;
+  /// s(x); constant extrapolation outside the knot range.
+  double value(double x) const;
+  /// s′(x); zero outside the knot range.
+  double derivative(double x) const;
+  /// s(x) and s′(x) together.
+  void evaluate(double x, double& value, double& derivative) const;
 
-    const std::vector<double>& knots_x() const { return m_x; }
-    const std::vector<double>& knots_y() const { return m_y; }
-    /// Hermite tangents s′(x_k) at the knots.
-    const std::vector<double>& tangents() const { return m_m; }
-    /// Smallest and largest knot value (bounds of the spline, by monotonicity of each piece).
-    double min_value() const;
-    double max_value() const;
+  const std::vector<double>& knots_x() const { return m_x; }
+  const std::vector<double>& knots_y() const { return m_y; }
+  /// Hermite tangents s′(x_k) at the knots.
+  const std::vector<double>& tangents() const { return m_m; }
+  /// Smallest and largest knot value (bounds of the spline, by monotonicity of each piece).
+  double min_value() const;
+  double max_value() const;
 
-private:
-    std::vector<double> m_x, m_y, m_m;
+  private:
+  std::vector<double> m_x, m_y, m_m;
 };
 
 } // namespace elastolearn::material

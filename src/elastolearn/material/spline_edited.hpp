@@ -36,36 +36,36 @@ SplineEditRegion spline_edit_region_from_string(
 /// s > 1 stiffens either region; for neo-Hookean f′ = μσ > 0, so s > 1 stiffens tension while in
 /// compression s < 1 stiffens (less of the positive f′ offsets the compressive ln term).
 class SplineEditedModel final : public ElasticModel {
-public:
-    /// Throws InputError(where, ...) if `base` is not Corotated or NeoHookean, if a knot lies
-    /// outside the region, if the knot nearest σ = 1 does not have value 1, or if a knot value is
-    /// not positive.
-    SplineEditedModel(ElasticModelType base, const Lame& lame, SplineEditRegion region,
-        CubicSpline spline, const std::string& where = "spline_edited");
-    std::string name() const override { return "spline_edited"; }
-    double energy(const Vec3& stretches) const override;
-    Vec3 principal_stress(const Vec3& stretches) const override;
-    Mat3 principal_stress_derivative(const Vec3& stretches) const override;
-    std::unique_ptr<ElasticModel> clone() const override;
+  public:
+  /// Throws InputError(where, ...) if `base` is not Corotated or NeoHookean, if a knot lies
+  /// outside the region, if the knot nearest σ = 1 does not have value 1, or if a knot value is
+  /// not positive.
+  SplineEditedModel(ElasticModelType base, const Lame& lame, SplineEditRegion region,
+      CubicSpline spline, const std::string& where = "spline_edited");
+  std::string name() const override { return "spline_edited"; }
+  double energy(const Vec3& stretches) const override;
+  Vec3 principal_stress(const Vec3& stretches) const override;
+  Mat3 principal_stress_derivative(const Vec3& stretches) const override;
+  std::unique_ptr<ElasticModel> clone() const override;
 
-    ElasticModelType base_type() const { return m_base_type; }
-    const Lame& lame() const { return m_lame; }
-    SplineEditRegion region() const { return m_region; }
-    const CubicSpline& spline() const { return m_spline; }
-    /// The base's 1-D term derivative f′(x) and f″(x).
-    double f_prime(double x) const;
-    double f_second(double x) const;
-    /// Δ(x) = ∫₁ˣ (s(t) − 1) f′(t) dt, the energy added per stretch.
-    double edit_energy(double x) const;
+  ElasticModelType base_type() const { return m_base_type; }
+  const Lame& lame() const { return m_lame; }
+  SplineEditRegion region() const { return m_region; }
+  const CubicSpline& spline() const { return m_spline; }
+  /// The base's 1-D term derivative f′(x) and f″(x).
+  double f_prime(double x) const;
+  double f_second(double x) const;
+  /// Δ(x) = ∫₁ˣ (s(t) − 1) f′(t) dt, the energy added per stretch.
+  double edit_energy(double x) const;
 
-private:
-    double integrate(double a, double b) const; // ∫ₐᵇ (s − 1) f′, a ≤ b
+  private:
+  double integrate(double a, double b) const; // ∫ₐᵇ (s − 1) f′, a ≤ b
 
-    ElasticModelType m_base_type;
-    Lame m_lame;
-    SplineEditRegion m_region;
-    CubicSpline m_spline;
-    std::unique_ptr<ElasticModel> m_base;
+  ElasticModelType m_base_type;
+  Lame m_lame;
+  SplineEditRegion m_region;
+  CubicSpline m_spline;
+  std::unique_ptr<ElasticModel> m_base;
 };
 
 } // namespace elastolearn::material

@@ -9,7 +9,7 @@
 namespace elastolearn::material {
 
 struct StretchRange {
-  Vec3 min = Vec3::Constant(std::numeric_limits<double>::infinity());  ///< least s₁, s₂, s₃ [-]
+  Vec3 min = Vec3::Constant(std::numeric_limits<double>::infinity()); ///< least s₁, s₂, s₃ [-]
   Vec3 max = Vec3::Constant(-std::numeric_limits<double>::infinity()); ///< greatest s₁, s₂, s₃ [-]
 
   /// True until a sample is included.

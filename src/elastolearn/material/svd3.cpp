@@ -36,8 +36,8 @@ constexpr double kSmallAngle = 1e-3;
   const double alpha = bp.squaredNorm();
   const double beta = bq.squaredNorm();
   const double gamma = bp.dot(bq);
-  if (gamma * gamma <= kCosineTolerance2 * (alpha * beta) || alpha < kTinySquaredNorm ||
-      beta < kTinySquaredNorm)
+  if (gamma * gamma <= kCosineTolerance2 * (alpha * beta) || alpha < kTinySquaredNorm
+      || beta < kTinySquaredNorm)
     return false;
   // Rotation [c s; −s c] zeroing the off-diagonal of [α γ; γ β], the smaller angle (|θ| ≤ π/4):
   // tan θ = z / (1 + √(1 + z²)) with z = y / x, x = β − α, y = 2γ.
@@ -114,7 +114,8 @@ PrincipalFrame svd3(const Mat3& F, Svd3Info* info) {
     return { Mat3::Constant(nan), Vec3::Constant(nan), Mat3::Constant(nan) };
   }
   const double m = F.cwiseAbs().maxCoeff();
-  if (m == 0) return { Mat3::Identity(), Vec3::Zero(), Mat3::Identity() };
+  if (m == 0)
+    return { Mat3::Identity(), Vec3::Zero(), Mat3::Identity() };
   // Power-of-two scaling (exact) for extreme magnitudes only.
   double scale = 1, unscale = 1;
   if (m < 0x1p-100 || m > 0x1p100) {
@@ -145,9 +146,12 @@ PrincipalFrame svd3(const Mat3& F, Svd3Info* info) {
 
   // Sort by column norm, descending (singular values are the column norms).
   double n[3] = { b[0].squaredNorm(), b[1].squaredNorm(), b[2].squaredNorm() };
-  if (n[0] < n[1]) swap_columns(b, v, n, 0, 1);
-  if (n[0] < n[2]) swap_columns(b, v, n, 0, 2);
-  if (n[1] < n[2]) swap_columns(b, v, n, 1, 2);
+  if (n[0] < n[1])
+    swap_columns(b, v, n, 0, 1);
+  if (n[0] < n[2])
+    swap_columns(b, v, n, 0, 2);
+  if (n[1] < n[2])
+    swap_columns(b, v, n, 1, 2);
 
   PrincipalFrame frame;
   const double s0 = std::sqrt(n[0]); // n[0] ≥ m² scale² > 0

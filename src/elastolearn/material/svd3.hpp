@@ -12,9 +12,9 @@ struct PrincipalFrame;
 
 /// Diagnostics of one svd3 call (for tests and benchmarks).
 struct Svd3Info {
-  int sweeps = 0;          ///< Jacobi sweeps over the 3 column pairs, including the final check
-  int rotations = 0;       ///< plane rotations applied
-  bool fallback = false;   ///< true if Jacobi did not converge and Eigen::JacobiSVD was used
+  int sweeps = 0; ///< Jacobi sweeps over the 3 column pairs, including the final check
+  int rotations = 0; ///< plane rotations applied
+  bool fallback = false; ///< true if Jacobi did not converge and Eigen::JacobiSVD was used
 };
 
 /// F = U diag(σ) Vᵀ with U, V proper rotations, |σ| sorted descending, σ₀, σ₁ ≥ 0 and σ₂ < 0

@@ -9,12 +9,12 @@ namespace elastolearn::mesh {
 
 /// Element quality summary (rest shape).
 struct MeshQuality {
-  double min_volume = 0;          ///< smallest tet volume [m³]
-  double max_volume = 0;          ///< largest tet volume [m³]
-  double min_dihedral_deg = 0;    ///< smallest dihedral angle over all tets [degrees]
-  double max_dihedral_deg = 0;    ///< largest dihedral angle over all tets [degrees]
-  double max_radius_ratio = 0;    ///< max circumradius / (3·inradius) (1 = regular tet)
-  int num_degenerate = 0;         ///< tets with |6V| below 1e-12 · (longest edge)³
+  double min_volume = 0; ///< smallest tet volume [m³]
+  double max_volume = 0; ///< largest tet volume [m³]
+  double min_dihedral_deg = 0; ///< smallest dihedral angle over all tets [degrees]
+  double max_dihedral_deg = 0; ///< largest dihedral angle over all tets [degrees]
+  double max_radius_ratio = 0; ///< max circumradius / (3·inradius) (1 = regular tet)
+  int num_degenerate = 0; ///< tets with |6V| below 1e-12 · (longest edge)³
 };
 
 /// A linear tetrahedral mesh in its rest configuration.
@@ -25,7 +25,7 @@ struct MeshQuality {
 /// Surface faces are the tet faces that belong to exactly one tet, oriented outward
 /// (counter-clockwise seen from outside).
 class TetMesh {
-public:
+  public:
   TetMesh() = default;
   /// \param rest  n×3 rest positions [m]
   /// \param tets  m×4 vertex indices
@@ -53,7 +53,7 @@ public:
   /// Quality statistics of the rest tets.
   MeshQuality quality() const;
 
-private:
+  private:
   Positions m_rest;
   Tets m_tets;
   Faces m_surface_faces;

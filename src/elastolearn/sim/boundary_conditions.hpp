@@ -1,5 +1,6 @@
 #pragma once
-/// \file Boundary and initial conditions of a scene: keyframed vertices, point loads, initial state.
+/// \file Boundary and initial conditions of a scene: keyframed vertices, point loads, initial
+/// state.
 #include <elastolearn/core/types.hpp>
 #include <elastolearn/fem/force_term.hpp>
 
@@ -17,10 +18,10 @@ struct KeyframeMotion {
   std::vector<int> vertices;
   Kind kind = Kind::Sinusoid;
   Vec3 amplitude = Vec3::Zero();
-  double frequency = 1;                                         ///< [Hz]
-  double until = std::numeric_limits<double>::infinity();       ///< [s]
-  std::vector<double> times;                                    ///< piecewise-linear knots [s]
-  std::vector<Vec3> offsets;                                    ///< piecewise-linear values [m]
+  double frequency = 1; ///< [Hz]
+  double until = std::numeric_limits<double>::infinity(); ///< [s]
+  std::vector<double> times; ///< piecewise-linear knots [s]
+  std::vector<Vec3> offsets; ///< piecewise-linear values [m]
 
   Vec3 offset_at(double t) const;
   /// Throws InputError (field "keyframes") if inconsistent.
@@ -32,10 +33,10 @@ struct KeyframeMotion {
 /// Frame k holds the positions at time start_time + k·dt; between frames they are interpolated
 /// linearly, outside the recording they are held.
 struct TrackedVertices {
-  std::vector<int> vertices;        ///< k vertex indices
+  std::vector<int> vertices; ///< k vertex indices
   std::vector<Positions> positions; ///< frames, each k×3 [m]
-  double dt = 0;                    ///< [s]
-  double start_time = 0;            ///< [s]
+  double dt = 0; ///< [s]
+  double start_time = 0; ///< [s]
   /// Position of tracked vertex j (row of `positions`) at time t.
   Vec3 position_at(int j, double t) const;
   /// Throws InputError (field "tracked") if inconsistent.
@@ -45,7 +46,7 @@ struct TrackedVertices {
 /// A force spread evenly over a vertex group, active while t < release_time.
 struct PointLoad {
   std::vector<int> vertices;
-  Vec3 total_force = Vec3::Zero();                               ///< [N], split evenly
+  Vec3 total_force = Vec3::Zero(); ///< [N], split evenly
   double release_time = std::numeric_limits<double>::infinity(); ///< [s]
 };
 
@@ -53,23 +54,24 @@ struct PointLoad {
 struct InitialCondition {
   enum class Kind { Rest, Velocity, StaticLoad };
   Kind kind = Kind::Rest;
-  Vec3 velocity = Vec3::Zero();         ///< Velocity: v(X) = velocity + angular_velocity × (X − center)
+  Vec3 velocity = Vec3::Zero(); ///< Velocity: v(X) = velocity + angular_velocity × (X − center)
   Vec3 angular_velocity = Vec3::Zero(); ///< [rad/s]
-  Vec3 center = Vec3::Zero();           ///< [m]
-  std::vector<PointLoad> static_loads;  ///< StaticLoad: equilibrium under gravity + these, then released
-  int load_steps = 5;                   ///< StaticLoad: load increments of the static solve
+  Vec3 center = Vec3::Zero(); ///< [m]
+  std::vector<PointLoad>
+      static_loads; ///< StaticLoad: equilibrium under gravity + these, then released
+  int load_steps = 5; ///< StaticLoad: load increments of the static solve
 };
 
 /// The loads of a scene as one force term: gravity M g plus point loads until their release.
 class ExternalLoads final : public fem::ForceTerm {
-public:
+  public:
   /// \param dof_masses  lumped masses per dof (3n) for gravity [kg]
   ExternalLoads(const VecX& dof_masses, const Vec3& gravity, std::vector<PointLoad> loads);
   void add_force(const fem::ForceState& state, VecX& f) override;
   /// Scale applied to all loads (load stepping of the static solve); default 1.
   void set_scale(double scale) { m_scale = scale; }
 
-private:
+  private:
   VecX m_gravity_force;
   std::vector<PointLoad> m_loads;
   double m_scale = 1;

@@ -19,7 +19,7 @@ std::string to_string(LinearSolverType type);
 LinearSolverType linear_solver_type_from_string(const std::string& name);
 
 class LinearSolver {
-public:
+  public:
   virtual ~LinearSolver() = default;
   /// Symbolic analysis of A's pattern (fill-reducing ordering). Call once per pattern.
   virtual void analyze(const fem::SparseMatrix& A) = 0;

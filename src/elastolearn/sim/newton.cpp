@@ -8,11 +8,14 @@ namespace elastolearn::sim {
 
 void NewtonOptions::validate() const {
   if (!(relative_tolerance > 0 && relative_tolerance < 1))
-    throw InputError("newton.relative_tolerance", "must be in (0, 1), got " + std::to_string(relative_tolerance));
+    throw InputError("newton.relative_tolerance",
+        "must be in (0, 1), got " + std::to_string(relative_tolerance));
   if (!(absolute_tolerance >= 0))
     throw InputError("newton.absolute_tolerance", "must be >= 0");
-  if (max_iterations < 1) throw InputError("newton.max_iterations", "must be >= 1");
-  if (max_line_search < 0) throw InputError("newton.max_line_search", "must be >= 0");
+  if (max_iterations < 1)
+    throw InputError("newton.max_iterations", "must be >= 1");
+  if (max_line_search < 0)
+    throw InputError("newton.max_line_search", "must be >= 0");
   if (!(jacobian_reuse_contraction == 0 || jacobian_reuse_contraction > 1))
     throw InputError("newton.jacobian_reuse_contraction", "must be 0 (off) or > 1");
 }
@@ -32,7 +35,7 @@ double seconds_since(Clock::time_point t0) {
 } // namespace
 
 NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatrix& A,
-                          LinearSolver& solver, const NewtonOptions& options) {
+    LinearSolver& solver, const NewtonOptions& options) {
   NewtonReport report;
   VecX g(u.size()), du = VecX::Zero(u.size()), u_prev(u.size());
   // Reuse the Jacobian only after a full step that contracted the residual enough.
@@ -49,8 +52,8 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
   double norm = evaluate(u);
   report.initial_residual = norm;
   bool reuse_jacobian = false; // the first iteration always assembles
-  const double target =
-      std::max(options.relative_tolerance * report.initial_residual, options.absolute_tolerance);
+  const double target
+      = std::max(options.relative_tolerance * report.initial_residual, options.absolute_tolerance);
   for (;;) {
     report.residual = norm;
     if (!std::isfinite(norm)) {
@@ -62,9 +65,9 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
       return report;
     }
     if (report.iterations == options.max_iterations) {
-      report.message = "no convergence in " + std::to_string(report.iterations) +
-                       " Newton iterations (residual " + std::to_string(norm) + ", target " +
-                       std::to_string(target) + ")";
+      report.message = "no convergence in " + std::to_string(report.iterations)
+          + " Newton iterations (residual " + std::to_string(norm) + ", target "
+          + std::to_string(target) + ")";
       return report;
     }
     ++report.iterations;
@@ -82,13 +85,15 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
       t0 = Clock::now();
     }
     const bool first = report.iterations == 1 && problem.first_increment;
-    if (first && problem.first_increment->size() == du.size()) du = *problem.first_increment;
-    else du.setZero();
+    if (first && problem.first_increment->size() == du.size())
+      du = *problem.first_increment;
+    else
+      du.setZero();
     // Inexact Newton for iterative solvers (Eisenstat–Walker style forcing term): the first
     // solve to 1e-3 (the step's nonlinearity leaves about that anyway), later ones to a tenth
     // of what the target still needs.
-    const double linear_tol =
-        std::clamp(std::max(0.3 * target / norm, 1e-3 * norm / report.initial_residual), 1e-12, 1e-2);
+    const double linear_tol = std::clamp(
+        std::max(0.3 * target / norm, 1e-3 * norm / report.initial_residual), 1e-12, 1e-2);
     const bool solved = solver.solve(-g, du, linear_tol);
     report.timings.solve += seconds_since(t0);
     report.linear_iterations += solver.last_iterations();
@@ -96,7 +101,8 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
       report.message = "linear solve failed";
       return report;
     }
-    if (first) *problem.first_increment = du;
+    if (first)
+      *problem.first_increment = du;
     u_prev = u;
     const double norm_prev = norm;
     if (problem.energy) {
@@ -108,7 +114,8 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
       for (int ls = 0; ls < options.max_line_search; ++ls, alpha *= 0.5) {
         u = u_prev + alpha * du;
         const double e = problem.energy(u);
-        if (std::isfinite(e) && e <= e0 + 1e-4 * alpha * std::min(slope, 0.0)) break;
+        if (std::isfinite(e) && e <= e0 + 1e-4 * alpha * std::min(slope, 0.0))
+          break;
       }
       report.timings.assembly += seconds_since(t0);
       norm = evaluate(u);
@@ -123,7 +130,8 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
     u = u_prev + du;
     norm = evaluate(u);
     double alpha = 0.5;
-    for (int ls = 0; ls < options.max_line_search && !(std::isfinite(norm) && norm <= 1e3 * norm_prev);
+    for (int ls = 0;
+         ls < options.max_line_search && !(std::isfinite(norm) && norm <= 1e3 * norm_prev);
          ++ls, alpha *= 0.5) {
       u = u_prev + alpha * du;
       norm = evaluate(u);

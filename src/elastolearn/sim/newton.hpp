@@ -16,9 +16,9 @@ namespace elastolearn::sim {
 
 struct NewtonOptions {
   double relative_tolerance = 1e-6; ///< stop when ‖g‖ ≤ tol · ‖g₀‖ …
-  double absolute_tolerance = 0;    ///< … or ‖g‖ ≤ this [N] (0: chosen by the caller's scale)
+  double absolute_tolerance = 0; ///< … or ‖g‖ ≤ this [N] (0: chosen by the caller's scale)
   int max_iterations = 50;
-  int max_line_search = 12;         ///< step halvings
+  int max_line_search = 12; ///< step halvings
   /// Jacobian reuse (a chord step): after an iteration that shrank ‖g‖ at least this many times,
   /// the next one solves with the same Jacobian and factorisation instead of re-assembling at
   /// the new iterate; an iteration that contracts less makes the next one assemble afresh.
@@ -41,7 +41,7 @@ struct SolverTimings {
 struct NewtonReport {
   bool converged = false;
   int iterations = 0;
-  int jacobians = 0;        ///< Jacobian assemblies (iterations minus reuses)
+  int jacobians = 0; ///< Jacobian assemblies (iterations minus reuses)
   int linear_iterations = 0;
   double initial_residual = 0;
   double residual = 0;
@@ -68,6 +68,6 @@ struct NewtonProblem {
 /// pattern. Never throws on divergence: non-finite values or no convergence give a report
 /// with `converged == false` and a message.
 NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatrix& A,
-                          LinearSolver& solver, const NewtonOptions& options);
+    LinearSolver& solver, const NewtonOptions& options);
 
 } // namespace elastolearn::sim

@@ -6,8 +6,8 @@
 
 namespace elastolearn::sim {
 
-SimulationReport run_simulation(const Scene& scene, const FrameSink& sink,
-                                const ProgressCallback& progress) {
+SimulationReport run_simulation(
+    const Scene& scene, const FrameSink& sink, const ProgressCallback& progress) {
   Simulator simulator(scene);
   const NewtonReport initial = simulator.apply_initial_condition();
   if (!initial.converged) {
@@ -21,15 +21,17 @@ SimulationReport run_simulation(const Scene& scene, const FrameSink& sink,
   return report;
 }
 
-SimulationReport run_simulation(Simulator& simulator, int frames, const FrameSink& sink,
-                                const ProgressCallback& progress) {
+SimulationReport run_simulation(
+    Simulator& simulator, int frames, const FrameSink& sink, const ProgressCallback& progress) {
   SimulationReport report;
   const auto start = std::chrono::steady_clock::now();
-  if (sink) sink(0, simulator.time(), simulator.positions(), simulator.velocities());
+  if (sink)
+    sink(0, simulator.time(), simulator.positions(), simulator.velocities());
   report.frames_written = 1;
   for (int frame = 1; frame <= frames; ++frame) {
     if (interrupt_requested()) {
-      report.message = "interrupted before frame " + std::to_string(frame) + "; kept frames 0.." + std::to_string(frame - 1);
+      report.message = "interrupted before frame " + std::to_string(frame) + "; kept frames 0.."
+          + std::to_string(frame - 1);
       break;
     }
     const NewtonReport step = simulator.step();
@@ -37,12 +39,13 @@ SimulationReport run_simulation(Simulator& simulator, int frames, const FrameSin
     report.linear_iterations += step.linear_iterations;
     report.timings += step.timings;
     if (!step.converged) {
-      report.message = "diverged at frame " + std::to_string(frame) + " (t = " +
-                       std::to_string(simulator.time() + simulator.scene().dt) + " s): " + step.message +
-                       "; kept frames 0.." + std::to_string(frame - 1);
+      report.message = "diverged at frame " + std::to_string(frame)
+          + " (t = " + std::to_string(simulator.time() + simulator.scene().dt)
+          + " s): " + step.message + "; kept frames 0.." + std::to_string(frame - 1);
       break;
     }
-    if (sink) sink(frame, simulator.time(), simulator.positions(), simulator.velocities());
+    if (sink)
+      sink(frame, simulator.time(), simulator.positions(), simulator.velocities());
     ++report.frames_written;
     if (progress) {
       char buf[96];

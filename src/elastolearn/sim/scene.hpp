@@ -19,14 +19,14 @@ struct Scene {
   mesh::TetMesh mesh;
   fem::MaterialModel material;
   fem::MassType mass = fem::MassType::Lumped;
-  Vec3 gravity = Vec3::Zero();                 ///< [m/s²]
-  std::vector<int> fixed_vertices;             ///< held at rest
-  std::vector<KeyframeMotion> keyframes;       ///< prescribed motion
-  std::vector<PointLoad> loads;                ///< during the motion
+  Vec3 gravity = Vec3::Zero(); ///< [m/s²]
+  std::vector<int> fixed_vertices; ///< held at rest
+  std::vector<KeyframeMotion> keyframes; ///< prescribed motion
+  std::vector<PointLoad> loads; ///< during the motion
   std::shared_ptr<const TrackedVertices> tracked; ///< optional: vertices following recorded data
   InitialCondition initial;
-  double dt = 1e-3;                            ///< time step [s]
-  int frames = 100;                            ///< number of steps (output has frames + 1 states)
+  double dt = 1e-3; ///< time step [s]
+  int frames = 100; ///< number of steps (output has frames + 1 states)
   NewtonOptions newton;
   LinearSolverType linear_solver = LinearSolverType::Cholmod;
 

@@ -6,18 +6,21 @@
 
 namespace elastolearn::sim {
 
-Simulator::Simulator(const Scene& scene) : m_scene(scene) {
+Simulator::Simulator(const Scene& scene)
+    : m_scene(scene) {
   m_scene.validate();
   const auto& mesh = m_scene.mesh;
   m_dofs = fem::DofMap(mesh.num_vertices(), m_scene.prescribed_vertices());
-  if (m_dofs.num_free() == 0) throw InputError("fixed", "every vertex is fixed or keyframed: nothing to simulate");
+  if (m_dofs.num_free() == 0)
+    throw InputError("fixed", "every vertex is fixed or keyframed: nothing to simulate");
   m_system = fem::SystemMatrix(mesh.tets(), m_dofs);
   m_elastic = std::make_unique<fem::ElasticForce>(mesh, m_scene.material);
   m_dof_masses = fem::lumped_dof_masses(fem::lumped_vertex_masses(
       mesh.tets(), m_elastic->rest_data(), mesh.num_vertices(), m_scene.material.density));
   m_reduced_masses = m_dofs.restrict(m_dof_masses);
   if (m_scene.mass == fem::MassType::Consistent) {
-    const auto blocks = fem::consistent_mass_blocks(m_elastic->rest_data(), m_scene.material.density);
+    const auto blocks
+        = fem::consistent_mass_blocks(m_elastic->rest_data(), m_scene.material.density);
     m_system.set_zero();
     m_system.add_element_blocks(blocks);
     m_consistent_values = m_system.values();
@@ -36,11 +39,12 @@ Simulator::Simulator(const Scene& scene) : m_scene(scene) {
     // relative target below ~1e-12 of that cannot be met once the motion has decayed.
     VecX f = VecX::Zero(m_x.size());
     m_system.set_zero();
-    m_elastic->add_force_and_jacobian({m_x, m_v, 0.0}, 1.0, 0.0, f, m_system);
+    m_elastic->add_force_and_jacobian({ m_x, m_v, 0.0 }, 1.0, 0.0, f, m_system);
     double max_diagonal = 0;
-    for (int i = 0; i < m_system.size(); ++i) max_diagonal = std::max(max_diagonal, m_system.matrix().coeff(i, i));
-    m_scene.newton.absolute_tolerance =
-        1e-12 * max_diagonal * mesh.bounding_box_diagonal() * std::sqrt(double(m_dofs.num_free()));
+    for (int i = 0; i < m_system.size(); ++i)
+      max_diagonal = std::max(max_diagonal, m_system.matrix().coeff(i, i));
+    m_scene.newton.absolute_tolerance = 1e-12 * max_diagonal * mesh.bounding_box_diagonal()
+        * std::sqrt(double(m_dofs.num_free()));
   }
 }
 
@@ -48,7 +52,8 @@ VecX Simulator::prescribed_positions(double t) const {
   VecX x = flatten(m_scene.mesh.rest_positions());
   for (const auto& k : m_scene.keyframes) {
     const Vec3 offset = k.offset_at(t);
-    for (int v : k.vertices) x.segment<3>(3 * v) += offset;
+    for (int v : k.vertices)
+      x.segment<3>(3 * v) += offset;
   }
   if (const auto& tracked = m_scene.tracked)
     for (size_t j = 0; j < tracked->vertices.size(); ++j)
@@ -64,29 +69,34 @@ void Simulator::set_state(const VecX& x, const VecX& v, double time) {
 }
 
 double Simulator::kinetic_energy() const {
-  if (m_scene.mass == fem::MassType::Consistent) return 0.5 * m_v.dot(m_consistent * m_v);
+  if (m_scene.mass == fem::MassType::Consistent)
+    return 0.5 * m_v.dot(m_consistent * m_v);
   return 0.5 * m_v.dot(m_dof_masses.cwiseProduct(m_v));
 }
 
 void Simulator::apply_mass(const VecX& dv, VecX& out) const {
-  if (m_scene.mass == fem::MassType::Consistent) out.noalias() = m_consistent * dv;
-  else out = m_dof_masses.cwiseProduct(dv);
+  if (m_scene.mass == fem::MassType::Consistent)
+    out.noalias() = m_consistent * dv;
+  else
+    out = m_dof_masses.cwiseProduct(dv);
 }
 
 void Simulator::sum_forces(const VecX& x, const VecX& v, double t, VecX& f) {
   f.setZero(x.size());
-  const fem::ForceState state{x, v, t};
+  const fem::ForceState state { x, v, t };
   m_elastic->add_force(state, f);
   m_loads->add_force(state, f);
-  for (auto* term : m_extra_terms) term->add_force(state, f);
+  for (auto* term : m_extra_terms)
+    term->add_force(state, f);
 }
 
 void Simulator::sum_jacobians(const VecX& x, const VecX& v, double t, double c_x, double c_v) {
   m_system.set_zero();
-  const fem::ForceState state{x, v, t};
+  const fem::ForceState state { x, v, t };
   m_elastic->add_jacobian(state, c_x, c_v, m_system);
   m_loads->add_jacobian(state, c_x, c_v, m_system);
-  for (auto* term : m_extra_terms) term->add_jacobian(state, c_x, c_v, m_system);
+  for (auto* term : m_extra_terms)
+    term->add_jacobian(state, c_x, c_v, m_system);
 }
 
 NewtonReport Simulator::step() {
@@ -97,7 +107,8 @@ NewtonReport Simulator::step() {
   m_v_new = (prescribed_positions(t_next) - m_x) / h;
   const auto& free = m_dofs.free_dofs();
   auto state_from = [&](const VecX& u) {
-    for (size_t i = 0; i < free.size(); ++i) m_v_new[free[i]] = u[i];
+    for (size_t i = 0; i < free.size(); ++i)
+      m_v_new[free[i]] = u[i];
     m_x_new = m_x + h * m_v_new;
   };
   auto inertia_minus_force = [&](VecX& g) {
@@ -115,13 +126,17 @@ NewtonReport Simulator::step() {
   problem.jacobian = [&](const VecX& u, fem::SystemMatrix& A) {
     state_from(u); // same u as the preceding residual: the terms reuse their cached work
     sum_jacobians(m_x_new, m_v_new, t_next, h, 1.0);
-    if (m_scene.mass == fem::MassType::Consistent) A.add_values(m_consistent_values, 1 / h);
-    else A.add_diagonal(m_reduced_masses, 1 / h);
+    if (m_scene.mass == fem::MassType::Consistent)
+      A.add_values(m_consistent_values, 1 / h);
+    else
+      A.add_diagonal(m_reduced_masses, 1 / h);
   };
-  if (m_solver->type() == LinearSolverType::ConjugateGradient) problem.first_increment = &m_first_increment;
+  if (m_solver->type() == LinearSolverType::ConjugateGradient)
+    problem.first_increment = &m_first_increment;
   VecX u = m_dofs.restrict(m_v);
   NewtonReport report = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
-  if (!report.converged) return report;
+  if (!report.converged)
+    return report;
   state_from(u);
   if (!m_x_new.allFinite()) {
     report.converged = false;
@@ -143,7 +158,8 @@ NewtonReport Simulator::solve_static(int load_steps) {
   auto state_from = [&](const VecX& u) {
     m_x_new = m_x_prescribed;
     const auto& free = m_dofs.free_dofs();
-    for (size_t i = 0; i < free.size(); ++i) m_x_new[free[i]] = u[i];
+    for (size_t i = 0; i < free.size(); ++i)
+      m_x_new[free[i]] = u[i];
   };
   NewtonProblem problem;
   problem.residual = [&](const VecX& u, VecX& g) {
@@ -159,7 +175,7 @@ NewtonReport Simulator::solve_static(int load_steps) {
     problem.energy = [&](const VecX& u) {
       state_from(u);
       m_force.setZero(m_x_new.size());
-      m_loads->add_force({m_x_new, zero, m_time}, m_force); // constant loads: potential −f·x
+      m_loads->add_force({ m_x_new, zero, m_time }, m_force); // constant loads: potential −f·x
       return m_elastic->elastic_energy(m_x_new) - m_force.dot(m_x_new);
     };
   VecX u = m_dofs.restrict(m_x);
@@ -173,10 +189,12 @@ NewtonReport Simulator::solve_static(int load_steps) {
     total.linear_iterations += r.linear_iterations;
     total.timings += r.timings;
     total.residual = r.residual;
-    if (k == 1) total.initial_residual = r.initial_residual;
+    if (k == 1)
+      total.initial_residual = r.initial_residual;
     if (!r.converged) {
       total.converged = false;
-      total.message = "static solve, load step " + std::to_string(k) + "/" + std::to_string(load_steps) + ": " + r.message;
+      total.message = "static solve, load step " + std::to_string(k) + "/"
+          + std::to_string(load_steps) + ": " + r.message;
       break;
     }
   }
@@ -203,7 +221,8 @@ NewtonReport Simulator::apply_initial_condition() {
     const auto& X = m_scene.mesh.rest_positions();
     for (int v = 0; v < m_scene.mesh.num_vertices(); ++v)
       if (!m_dofs.is_prescribed_vertex(v))
-        m_v.segment<3>(3 * v) = ic.velocity + ic.angular_velocity.cross(X.row(v).transpose() - ic.center);
+        m_v.segment<3>(3 * v)
+            = ic.velocity + ic.angular_velocity.cross(X.row(v).transpose() - ic.center);
   } else if (ic.kind == InitialCondition::Kind::StaticLoad) {
     // Equilibrium under gravity and the initial loads; the scene's own loads are not applied.
     auto scene_loads = std::move(m_loads);

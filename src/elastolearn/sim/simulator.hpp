@@ -19,7 +19,7 @@
 namespace elastolearn::sim {
 
 class Simulator {
-public:
+  public:
   /// Precompute everything for `scene` (validated here). Starts at rest at t = 0; call
   /// `apply_initial_condition()` to set the scene's initial state.
   explicit Simulator(const Scene& scene);
@@ -32,11 +32,12 @@ public:
   /// left unchanged and the report says why.
   NewtonReport step();
 
-  /// Static equilibrium f(x) = 0 under the current loads scaled by 1/load_steps … 1 (load stepping).
+  /// Static equilibrium f(x) = 0 under the current loads scaled by 1/load_steps … 1 (load
+  /// stepping).
   NewtonReport solve_static(int load_steps = 1);
 
-  const VecX& positions() const { return m_x; }   ///< flat 3n [m]
-  const VecX& velocities() const { return m_v; }  ///< flat 3n [m/s]
+  const VecX& positions() const { return m_x; } ///< flat 3n [m]
+  const VecX& velocities() const { return m_v; } ///< flat 3n [m/s]
   double time() const { return m_time; }
   int step_index() const { return m_step; }
   void set_state(const VecX& x, const VecX& v, double time);
@@ -54,7 +55,7 @@ public:
   /// Add a force term (e.g. control forces, position pulls). Not owned; must outlive the simulator.
   void add_force_term(fem::ForceTerm* term) { m_extra_terms.push_back(term); }
 
-private:
+  private:
   void sum_forces(const VecX& x, const VecX& v, double t, VecX& f);
   void sum_jacobians(const VecX& x, const VecX& v, double t, double c_x, double c_v);
   void apply_mass(const VecX& dv, VecX& out) const; ///< out = M dv (full 3n)
@@ -66,10 +67,10 @@ private:
   std::unique_ptr<ExternalLoads> m_loads;
   std::vector<fem::ForceTerm*> m_extra_terms;
   std::unique_ptr<LinearSolver> m_solver;
-  VecX m_dof_masses;               ///< lumped, full 3n
-  VecX m_reduced_masses;           ///< lumped, free dofs
-  fem::SparseMatrix m_consistent;  ///< full 3n×3n consistent mass (empty when lumped)
-  VecX m_consistent_values;        ///< consistent mass values in the system pattern
+  VecX m_dof_masses; ///< lumped, full 3n
+  VecX m_reduced_masses; ///< lumped, free dofs
+  fem::SparseMatrix m_consistent; ///< full 3n×3n consistent mass (empty when lumped)
+  VecX m_consistent_values; ///< consistent mass values in the system pattern
   VecX m_x, m_v;
   double m_time = 0;
   int m_step = 0;

@@ -12,9 +12,12 @@ std::string_view to_string(FeatureKind kind) {
 }
 
 FeatureKind feature_kind_from_string(const std::string& name, const std::string& where) {
-  if (name == "polynomial") return FeatureKind::polynomial;
-  if (name == "spline") return FeatureKind::spline;
-  throw InputError(where, "unknown feature map '" + name + "' (expected one of: polynomial, spline)");
+  if (name == "polynomial")
+    return FeatureKind::polynomial;
+  if (name == "spline")
+    return FeatureKind::spline;
+  throw InputError(
+      where, "unknown feature map '" + name + "' (expected one of: polynomial, spline)");
 }
 
 void FeatureMap::validate() const {
@@ -25,19 +28,22 @@ void FeatureMap::validate() const {
     if (knots.size() < 2)
       throw InputError("features.knots", "a spline needs at least 2 knots");
     for (std::size_t i = 0; i < knots.size(); ++i) {
-      if (!std::isfinite(knots[i])) throw InputError("features.knots", "non-finite knot");
+      if (!std::isfinite(knots[i]))
+        throw InputError("features.knots", "non-finite knot");
       if (i > 0 && !(knots[i] > knots[i - 1]))
-        throw InputError("features.knots", "knots must be strictly increasing (knot " +
-                                               std::to_string(i) + ")");
+        throw InputError(
+            "features.knots", "knots must be strictly increasing (knot " + std::to_string(i) + ")");
     }
   }
   if (size() > k_max_features)
-    throw InputError("features", "too many features (" + std::to_string(size()) + " > " +
-                                     std::to_string(k_max_features) + ")");
+    throw InputError("features",
+        "too many features (" + std::to_string(size()) + " > " + std::to_string(k_max_features)
+            + ")");
 }
 
 int FeatureMap::size() const {
-  if (kind == FeatureKind::polynomial) return (degree + 1) * (degree + 2) / 2 - 1;
+  if (kind == FeatureKind::polynomial)
+    return (degree + 1) * (degree + 2) / 2 - 1;
   return static_cast<int>(knots.size()) + 1; // hats 1..n−1 (hat 0 = intercept − Σ others), v, e v
 }
 
@@ -61,7 +67,8 @@ void FeatureMap::evaluate(double e, double v, double* out) const {
     }
     int f = 0;
     for (int d = 1; d <= degree; ++d)
-      for (int b = 0; b <= d; ++b) out[f++] = pe[d - b] * pv[b];
+      for (int b = 0; b <= d; ++b)
+        out[f++] = pe[d - b] * pv[b];
     return;
   }
   // Hats sum to one, so hat 0 is left out (the intercept spans it): feature j−1 is hat j.
@@ -69,7 +76,8 @@ void FeatureMap::evaluate(double e, double v, double* out) const {
   std::fill(out, out + n - 1, 0.0);
   const int i = spline_interval(knots, e);
   const double t = (e - knots[i]) / (knots[i + 1] - knots[i]);
-  if (i > 0) out[i - 1] = 1.0 - t;
+  if (i > 0)
+    out[i - 1] = 1.0 - t;
   out[i] = t;
   out[n - 1] = v;
   out[n] = e * v;
@@ -98,7 +106,8 @@ void FeatureMap::evaluate_derivatives(double e, double v, double* de, double* dv
   std::fill(dv, dv + n + 1, 0.0);
   const int i = spline_interval(knots, e);
   const double inv_h = 1.0 / (knots[i + 1] - knots[i]);
-  if (i > 0) de[i - 1] = -inv_h;
+  if (i > 0)
+    de[i - 1] = -inv_h;
   de[i] = inv_h;
   dv[n - 1] = 1.0;
   de[n] = v;
@@ -108,7 +117,8 @@ void FeatureMap::evaluate_derivatives(double e, double v, double* de, double* dv
 std::vector<std::string> FeatureMap::names() const {
   std::vector<std::string> out;
   auto power = [](const char* s, int p) {
-    if (p == 0) return std::string();
+    if (p == 0)
+      return std::string();
     return p == 1 ? std::string(s) : std::string(s) + "^" + std::to_string(p);
   };
   if (kind == FeatureKind::polynomial) {
@@ -119,7 +129,8 @@ std::vector<std::string> FeatureMap::names() const {
         out.push_back(name.empty() ? vp : (vp.empty() ? name : name + " " + vp));
       }
   } else {
-    for (std::size_t i = 1; i < knots.size(); ++i) out.push_back("hat(e; " + std::to_string(knots[i]) + ")");
+    for (std::size_t i = 1; i < knots.size(); ++i)
+      out.push_back("hat(e; " + std::to_string(knots[i]) + ")");
     out.emplace_back("v");
     out.emplace_back("e v");
   }
@@ -128,14 +139,17 @@ std::vector<std::string> FeatureMap::names() const {
 
 Eigen::MatrixXd FeatureMap::evaluate_all(const Eigen::Ref<const Eigen::MatrixXd>& states) const {
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> phi(states.rows(), size());
-  for (Eigen::Index r = 0; r < states.rows(); ++r) evaluate(states(r, 0), states(r, 1), phi.row(r).data());
+  for (Eigen::Index r = 0; r < states.rows(); ++r)
+    evaluate(states(r, 0), states(r, 1), phi.row(r).data());
   return phi;
 }
 
 std::vector<double> uniform_knots(double lo, double hi, int count) {
-  if (count < 2 || !(hi > lo)) throw InputError("features.knots", "need count >= 2 and hi > lo");
+  if (count < 2 || !(hi > lo))
+    throw InputError("features.knots", "need count >= 2 and hi > lo");
   std::vector<double> knots(static_cast<std::size_t>(count));
-  for (int i = 0; i < count; ++i) knots[static_cast<std::size_t>(i)] = lo + (hi - lo) * i / (count - 1);
+  for (int i = 0; i < count; ++i)
+    knots[static_cast<std::size_t>(i)] = lo + (hi - lo) * i / (count - 1);
   return knots;
 }
 

@@ -13,8 +13,8 @@ namespace elastolearn::springs {
 /// Kind of feature map; one name table for CLI and JSON.
 enum class FeatureKind {
   polynomial, ///< all monomials e^a v^b with 1 ≤ a + b ≤ degree (degree 1: the paper's (e, v))
-  spline,     ///< hat functions of e on `knots` (piecewise-linear in e; the first hat is
-              ///< left out because the intercept spans it) plus v and e·v
+  spline, ///< hat functions of e on `knots` (piecewise-linear in e; the first hat is
+          ///< left out because the intercept spans it) plus v and e·v
 };
 
 /// "polynomial", "spline".
@@ -28,8 +28,8 @@ inline constexpr int k_max_features = 64;
 /// A feature map φ(e, v) ∈ R^p, evaluated without allocation.
 struct FeatureMap {
   FeatureKind kind = FeatureKind::polynomial;
-  int degree = 1;              ///< polynomial: total degree (1..8)
-  std::vector<double> knots;   ///< spline: strictly increasing elongations [m], at least 2
+  int degree = 1; ///< polynomial: total degree (1..8)
+  std::vector<double> knots; ///< spline: strictly increasing elongations [m], at least 2
 
   /// Throws InputError("features.<field>", ...) for an invalid degree or knot vector.
   void validate() const;

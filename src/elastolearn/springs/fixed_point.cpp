@@ -10,9 +10,12 @@
 namespace elastolearn::springs {
 
 void FixedPointOptions::validate() const {
-  if (max_iterations < 1) throw InputError("fixed point.max_iterations", "must be >= 1");
-  if (!(tolerance > 0.0)) throw InputError("fixed point.tolerance", "must be > 0");
-  if (!(fd_step > 0.0)) throw InputError("fixed point.fd_step", "must be > 0");
+  if (max_iterations < 1)
+    throw InputError("fixed point.max_iterations", "must be >= 1");
+  if (!(tolerance > 0.0))
+    throw InputError("fixed point.tolerance", "must be > 0");
+  if (!(fd_step > 0.0))
+    throw InputError("fixed point.fd_step", "must be > 0");
   if (!components[0] && !components[1] && !components[2])
     throw InputError("fixed point.components", "at least one component must be active");
 }
@@ -31,9 +34,11 @@ Unknowns make_unknowns(const SpringSystem& sys, const std::array<bool, 3>& compo
   Unknowns u;
   u.first.assign(static_cast<std::size_t>(sys.node_count()), -1);
   for (int kind = 0; kind < 2; ++kind)
-    for (int c = 0; c < 3; ++c) u.per_node += components[c] ? 1 : 0;
+    for (int c = 0; c < 3; ++c)
+      u.per_node += components[c] ? 1 : 0;
   for (int a = 0; a < sys.node_count(); ++a) {
-    if (sys.pinned[a]) continue;
+    if (sys.pinned[a])
+      continue;
     u.first[a] = u.size();
     for (int kind = 0; kind < 2; ++kind)
       for (int c = 0; c < 3; ++c)
@@ -58,8 +63,8 @@ VecX residual(SpringStepper& stepper, const SpringState& s, const Unknowns& u, d
   for (int k = 0; k < u.size(); ++k) {
     const double scale = u.kind[k] == 0 ? 1.0 / ell : stepper.dt() / ell;
     g[k] = (u.kind[k] == 0 ? next.x(u.node[k], u.comp[k]) - s.x(u.node[k], u.comp[k])
-                           : next.v(u.node[k], u.comp[k]) - s.v(u.node[k], u.comp[k])) *
-           scale;
+                           : next.v(u.node[k], u.comp[k]) - s.v(u.node[k], u.comp[k]))
+        * scale;
   }
   return g;
 }
@@ -78,14 +83,17 @@ std::vector<int> distance2_colouring(const SpringSystem& sys, int& colours) {
     mark.assign(static_cast<std::size_t>(colours + 1), 0);
     for (int p = sys.incident_offsets[a]; p < sys.incident_offsets[a + 1]; ++p) {
       const int b = neighbour(a, p);
-      if (colour[b] >= 0) mark[colour[b]] = 1;
+      if (colour[b] >= 0)
+        mark[colour[b]] = 1;
       for (int q = sys.incident_offsets[b]; q < sys.incident_offsets[b + 1]; ++q) {
         const int c = neighbour(b, q);
-        if (colour[c] >= 0) mark[colour[c]] = 1;
+        if (colour[c] >= 0)
+          mark[colour[c]] = 1;
       }
     }
     int col = 0;
-    while (mark[col]) ++col;
+    while (mark[col])
+      ++col;
     colour[a] = col;
     colours = std::max(colours, col + 1);
   }
@@ -94,8 +102,8 @@ std::vector<int> distance2_colouring(const SpringSystem& sys, int& colours) {
 
 } // namespace
 
-FixedPointResult solve_fixed_point(SpringStepper& stepper, SpringState& state,
-                                   const FixedPointOptions& options) {
+FixedPointResult solve_fixed_point(
+    SpringStepper& stepper, SpringState& state, const FixedPointOptions& options) {
   options.validate();
   const SpringSystem& sys = stepper.system();
   const Unknowns u = make_unknowns(sys, options.components);
@@ -108,8 +116,8 @@ FixedPointResult solve_fixed_point(SpringStepper& stepper, SpringState& state,
   const double ell = 1.0 + state.x.cwiseAbs().maxCoeff();
   const double dt = stepper.dt();
   int colours = 0;
-  const std::vector<int> colour = stepper.is_local() ? distance2_colouring(sys, colours)
-                                                     : std::vector<int>();
+  const std::vector<int> colour
+      = stepper.is_local() ? distance2_colouring(sys, colours) : std::vector<int>();
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
 
   VecX g = residual(stepper, state, u, ell);
@@ -120,19 +128,22 @@ FixedPointResult solve_fixed_point(SpringStepper& stepper, SpringState& state,
     std::vector<Eigen::Triplet<double>> triplets;
     auto add_columns = [&](const std::vector<int>& group) {
       SpringState perturbed = state;
-      for (int k : group) entry(perturbed, u, k) += options.fd_step * (u.kind[k] == 0 ? ell : ell / dt);
+      for (int k : group)
+        entry(perturbed, u, k) += options.fd_step * (u.kind[k] == 0 ? ell : ell / dt);
       const VecX gp = residual(stepper, perturbed, u, ell);
       for (int k : group) {
         const double h = options.fd_step * (u.kind[k] == 0 ? ell : ell / dt);
         if (colour.empty()) {
           for (int r = 0; r < u.size(); ++r)
-            if (gp[r] != g[r]) triplets.emplace_back(r, k, (gp[r] - g[r]) / h);
+            if (gp[r] != g[r])
+              triplets.emplace_back(r, k, (gp[r] - g[r]) / h);
           continue;
         }
         // Rows of node k's closed neighbourhood belong to column k alone (distance-2 colouring).
         const int a = u.node[k];
         auto add_rows_of = [&](int b) {
-          if (u.first[b] < 0) return;
+          if (u.first[b] < 0)
+            return;
           for (int r = u.first[b]; r < u.first[b] + u.per_node; ++r)
             triplets.emplace_back(r, k, (gp[r] - g[r]) / h);
         };
@@ -144,14 +155,17 @@ FixedPointResult solve_fixed_point(SpringStepper& stepper, SpringState& state,
       }
     };
     if (colour.empty()) {
-      for (int k = 0; k < u.size(); ++k) add_columns({k});
+      for (int k = 0; k < u.size(); ++k)
+        add_columns({ k });
     } else {
       for (int col = 0; col < colours; ++col)
         for (int slot = 0; slot < u.per_node; ++slot) {
           std::vector<int> group;
           for (int a = 0; a < sys.node_count(); ++a)
-            if (colour[a] == col && u.first[a] >= 0) group.push_back(u.first[a] + slot);
-          if (!group.empty()) add_columns(group);
+            if (colour[a] == col && u.first[a] >= 0)
+              group.push_back(u.first[a] + slot);
+          if (!group.empty())
+            add_columns(group);
         }
     }
     Eigen::SparseMatrix<double> jac(u.size(), u.size());
@@ -186,8 +200,10 @@ FixedPointResult solve_fixed_point(SpringStepper& stepper, SpringState& state,
   }
   result.residual = norm;
   result.converged = norm <= options.tolerance;
-  if (result.converged) result.message = "converged";
-  else if (result.message.empty()) result.message = "iteration limit reached";
+  if (result.converged)
+    result.message = "converged";
+  else if (result.message.empty())
+    result.message = "iteration limit reached";
   return result;
 }
 

@@ -20,7 +20,7 @@ struct FixedPointOptions {
   double fd_step = 1e-7;
   /// Components (x, y, z) that are unknowns. A component that is constant in the state and
   /// receives no load stays constant by symmetry and can be frozen (e.g. z of a planar cloth).
-  std::array<bool, 3> components = {true, true, true};
+  std::array<bool, 3> components = { true, true, true };
   /// Throws InputError("fixed point.<field>", ...).
   void validate() const;
 };
@@ -38,7 +38,7 @@ struct FixedPointResult {
 /// differences of the step map: column groups of a distance-2 colouring of the spring graph when
 /// the stepper is local (a few dozen steps per Jacobian at any size), one column at a time
 /// otherwise. Linear systems are solved with Eigen::SparseLU. Backtracking on ‖G‖∞.
-FixedPointResult solve_fixed_point(SpringStepper& stepper, SpringState& state,
-                                   const FixedPointOptions& options = {});
+FixedPointResult solve_fixed_point(
+    SpringStepper& stepper, SpringState& state, const FixedPointOptions& options = {});
 
 } // namespace elastolearn::springs

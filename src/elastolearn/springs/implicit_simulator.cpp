@@ -18,25 +18,29 @@ double dot(const Positions& x, const Positions& y) {
   const int per = (n + chunks - 1) / chunks;
   auto body = [&](int c) {
     double s = 0.0;
-    for (int a = c * per; a < std::min(n, (c + 1) * per); ++a) s += x.row(a).dot(y.row(a));
+    for (int a = c * per; a < std::min(n, (c + 1) * per); ++a)
+      s += x.row(a).dot(y.row(a));
     partial[c] = s;
   };
   if (n < detail::k_parallel_threshold) {
-    for (int c = 0; c < chunks; ++c) body(c);
+    for (int c = 0; c < chunks; ++c)
+      body(c);
   } else {
     tbb::parallel_for(0, chunks, body);
   }
   double sum = 0.0;
-  for (double p : partial) sum += p;
+  for (double p : partial)
+    sum += p;
   return sum;
 }
 } // namespace
 
 ImplicitLearnedSimulator::ImplicitLearnedSimulator(SpringSystem system, LearnedSpring spring,
-                                                   double dt,
-                                                   const LearnedSimulatorOptions& options,
-                                                   const Loads& loads)
-    : m_system(std::move(system)), m_spring(std::move(spring)), m_dt(dt), m_options(options) {
+    double dt, const LearnedSimulatorOptions& options, const Loads& loads)
+    : m_system(std::move(system))
+    , m_spring(std::move(spring))
+    , m_dt(dt)
+    , m_options(options) {
   m_options.validate();
   if (!(dt > 0.0) || !std::isfinite(dt))
     throw InputError("simulation.dt", "must be > 0, got " + std::to_string(dt));
@@ -44,9 +48,10 @@ ImplicitLearnedSimulator::ImplicitLearnedSimulator(SpringSystem system, LearnedS
   m_free_index.assign(static_cast<std::size_t>(n), -1);
   int free = 0;
   for (int a = 0; a < n; ++a)
-    if (!m_system.pinned[a]) m_free_index[a] = free++;
-  m_direct = m_options.solver == LinearSolverKind::direct ||
-             (m_options.solver == LinearSolverKind::automatic && 3 * free <= m_options.direct_max_dofs);
+    if (!m_system.pinned[a])
+      m_free_index[a] = free++;
+  m_direct = m_options.solver == LinearSolverKind::direct
+      || (m_options.solver == LinearSolverKind::automatic && 3 * free <= m_options.direct_max_dofs);
   m_u.resize(s, 3);
   m_force.resize(s);
   m_alpha.resize(s);
@@ -54,8 +59,10 @@ ImplicitLearnedSimulator::ImplicitLearnedSimulator(SpringSystem system, LearnedS
   m_a.resize(s);
   m_b.resize(s);
   m_diag_inverse.resize(static_cast<std::size_t>(n));
-  for (Positions* p : {&m_rhs, &m_dv, &m_r, &m_z, &m_p, &m_q}) *p = Positions::Zero(n, 3);
-  if (m_direct) setup_direct();
+  for (Positions* p : { &m_rhs, &m_dv, &m_r, &m_z, &m_p, &m_q })
+    *p = Positions::Zero(n, 3);
+  if (m_direct)
+    setup_direct();
   set_loads(loads);
 }
 
@@ -66,15 +73,17 @@ void ImplicitLearnedSimulator::set_loads(const Loads& loads) {
 
 void ImplicitLearnedSimulator::setup_direct() {
   const SpringSystem& sys = m_system;
-  const int free = static_cast<int>(std::count_if(m_free_index.begin(), m_free_index.end(),
-                                                  [](int f) { return f >= 0; }));
+  const int free = static_cast<int>(
+      std::count_if(m_free_index.begin(), m_free_index.end(), [](int f) { return f >= 0; }));
   std::vector<Eigen::Triplet<double>> triplets;
   auto add_block = [&](int fi, int fj) {
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) triplets.emplace_back(3 * fi + r, 3 * fj + c, 0.0);
+      for (int c = 0; c < 3; ++c)
+        triplets.emplace_back(3 * fi + r, 3 * fj + c, 0.0);
   };
   for (int f : m_free_index)
-    if (f >= 0) add_block(f, f);
+    if (f >= 0)
+      add_block(f, f);
   for (int s = 0; s < sys.spring_count(); ++s) {
     const int fi = m_free_index[sys.springs(s, 0)], fj = m_free_index[sys.springs(s, 1)];
     if (fi >= 0 && fj >= 0) {
@@ -94,11 +103,13 @@ void ImplicitLearnedSimulator::setup_direct() {
   };
   auto block_slots = [&](int fi, int fj, int* out) {
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) out[3 * r + c] = slot(3 * fi + r, 3 * fj + c);
+      for (int c = 0; c < 3; ++c)
+        out[3 * r + c] = slot(3 * fi + r, 3 * fj + c);
   };
   m_diag_slot.assign(static_cast<std::size_t>(9 * sys.node_count()), -1);
   for (int a = 0; a < sys.node_count(); ++a)
-    if (m_free_index[a] >= 0) block_slots(m_free_index[a], m_free_index[a], &m_diag_slot[9 * a]);
+    if (m_free_index[a] >= 0)
+      block_slots(m_free_index[a], m_free_index[a], &m_diag_slot[9 * a]);
   m_offdiag_slot.assign(static_cast<std::size_t>(18 * sys.spring_count()), -1);
   for (int s = 0; s < sys.spring_count(); ++s) {
     const int fi = m_free_index[sys.springs(s, 0)], fj = m_free_index[sys.springs(s, 1)];
@@ -159,7 +170,8 @@ void ImplicitLearnedSimulator::build_rhs(const SpringState& state) {
       m_diag_inverse[a] = diag.inverse();
       if (m_direct) {
         const int* slots = &m_diag_slot[9 * a];
-        for (int k = 0; k < 9; ++k) m_matrix.valuePtr()[slots[k]] = diag(k / 3, k % 3);
+        for (int k = 0; k < 9; ++k)
+          m_matrix.valuePtr()[slots[k]] = diag(k / 3, k % 3);
       }
     }
   });
@@ -192,9 +204,11 @@ void ImplicitLearnedSimulator::solve_direct() {
   detail::parallel_blocks(sys.spring_count(), [&](int begin, int end) {
     for (int s = begin; s < end; ++s) {
       const int* slots = &m_offdiag_slot[18 * s];
-      if (slots[0] < 0) continue;
+      if (slots[0] < 0)
+        continue;
       const Vec3 u = m_u.row(s).transpose();
-      const Mat3 block = -(m_beta[s] * Mat3::Identity() + (m_alpha[s] - m_beta[s]) * u * u.transpose());
+      const Mat3 block
+          = -(m_beta[s] * Mat3::Identity() + (m_alpha[s] - m_beta[s]) * u * u.transpose());
       for (int k = 0; k < 9; ++k) {
         m_matrix.valuePtr()[slots[k]] = block(k / 3, k % 3);
         m_matrix.valuePtr()[slots[9 + k]] = block(k % 3, k / 3);
@@ -203,15 +217,18 @@ void ImplicitLearnedSimulator::solve_direct() {
   });
   m_ldlt.factorize(m_matrix);
   ELASTOLEARN_CHECK(m_ldlt.info() == Eigen::Success,
-                    "implicit step: factorisation of the SPD system matrix failed");
+      "implicit step: factorisation of the SPD system matrix failed");
   for (int a = 0; a < sys.node_count(); ++a)
-    if (m_free_index[a] >= 0) m_flat_rhs.segment<3>(3 * m_free_index[a]) = m_rhs.row(a).transpose();
+    if (m_free_index[a] >= 0)
+      m_flat_rhs.segment<3>(3 * m_free_index[a]) = m_rhs.row(a).transpose();
   m_flat_solution = m_ldlt.solve(m_flat_rhs);
   for (int a = 0; a < sys.node_count(); ++a) {
-    if (m_free_index[a] >= 0) m_dv.row(a) = m_flat_solution.segment<3>(3 * m_free_index[a]).transpose();
-    else m_dv.row(a).setZero();
+    if (m_free_index[a] >= 0)
+      m_dv.row(a) = m_flat_solution.segment<3>(3 * m_free_index[a]).transpose();
+    else
+      m_dv.row(a).setZero();
   }
-  m_stats = {true, 0, 0.0, true};
+  m_stats = { true, 0, 0.0, true };
 }
 
 void ImplicitLearnedSimulator::solve_cg() {
@@ -221,8 +238,10 @@ void ImplicitLearnedSimulator::solve_cg() {
   auto precondition = [&](const Positions& r, Positions& z) {
     detail::parallel_blocks(n, [&](int begin, int end) {
       for (int a = begin; a < end; ++a) {
-        if (sys.pinned[a]) z.row(a).setZero();
-        else z.row(a) = (m_diag_inverse[a] * r.row(a).transpose()).transpose();
+        if (sys.pinned[a])
+          z.row(a).setZero();
+        else
+          z.row(a) = (m_diag_inverse[a] * r.row(a).transpose()).transpose();
       }
     });
   };
@@ -242,13 +261,14 @@ void ImplicitLearnedSimulator::solve_cg() {
     m_r -= alpha * m_q;
     r_norm = std::sqrt(dot(m_r, m_r));
     ++it;
-    if (r_norm <= target) break;
+    if (r_norm <= target)
+      break;
     precondition(m_r, m_z);
     const double rz_new = dot(m_r, m_z);
     m_p = m_z + (rz_new / rz) * m_p;
     rz = rz_new;
   }
-  m_stats = {false, it, b_norm > 0.0 ? r_norm / b_norm : 0.0, r_norm <= target};
+  m_stats = { false, it, b_norm > 0.0 ? r_norm / b_norm : 0.0, r_norm <= target };
 }
 
 void ImplicitLearnedSimulator::step(SpringState& state) {
@@ -257,7 +277,7 @@ void ImplicitLearnedSimulator::step(SpringState& state) {
   build_rhs(state);
   if (dot(m_rhs, m_rhs) == 0.0) {
     m_dv.setZero(); // exactly at a static equilibrium: nothing moves
-    m_stats = {m_direct, 0, 0.0, true};
+    m_stats = { m_direct, 0, 0.0, true };
   } else if (m_direct) {
     solve_direct();
   } else {

@@ -17,20 +17,20 @@ namespace elastolearn::springs {
 
 /// Statistics of the last implicit step.
 struct ImplicitStepStats {
-  bool direct = true;      ///< solver used
-  int cg_iterations = 0;   ///< CG only
+  bool direct = true; ///< solver used
+  int cg_iterations = 0; ///< CG only
   double relative_residual = 0.0; ///< CG only: ‖b − A Δv‖/‖b‖
-  bool converged = true;   ///< CG reached its tolerance (direct: factorisation succeeded)
+  bool converged = true; ///< CG reached its tolerance (direct: factorisation succeeded)
 };
 
 /// See the file comment. The sparsity pattern and the symbolic Cholesky analysis are computed
 /// once at construction; each step refactorises numerically (direct) or runs warm-started
 /// block-Jacobi PCG with a matrix-free product (cg). Parallel with oneTBB on large systems.
 class ImplicitLearnedSimulator final : public SpringStepper {
-public:
+  public:
   /// Throws InputError for invalid options, dt ≤ 0 or malformed loads.
   ImplicitLearnedSimulator(SpringSystem system, LearnedSpring spring, double dt,
-                           const LearnedSimulatorOptions& options, const Loads& loads = {});
+      const LearnedSimulatorOptions& options, const Loads& loads = {});
   void step(SpringState& state) override;
   void set_loads(const Loads& loads) override;
   const SpringSystem& system() const override { return m_system; }
@@ -41,7 +41,7 @@ public:
   /// True if this simulator solves with the direct (Cholesky) solver.
   bool uses_direct_solver() const { return m_direct; }
 
-private:
+  private:
   void compute_spring_terms(const SpringState& state);
   void build_rhs(const SpringState& state);
   void apply(const Positions& x, Positions& y) const; // y = A x on free nodes
@@ -69,8 +69,9 @@ private:
   // Direct solver: free-dof numbering, CSC matrix with a fixed pattern, value slots.
   std::vector<int> m_free_index; // node → free index or −1
   Eigen::SparseMatrix<double> m_matrix;
-  std::vector<int> m_diag_slot;      // per free node: 9 value indices (row-major 3×3)
-  std::vector<int> m_offdiag_slot;   // per spring with two free nodes: 9 indices of block (i, j) and 9 of (j, i); −1 otherwise
+  std::vector<int> m_diag_slot; // per free node: 9 value indices (row-major 3×3)
+  std::vector<int> m_offdiag_slot; // per spring with two free nodes: 9 indices of block (i, j) and
+                                   // 9 of (j, i); −1 otherwise
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_ldlt;
   VecX m_flat_rhs, m_flat_solution;
 };

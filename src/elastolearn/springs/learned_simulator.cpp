@@ -10,43 +10,56 @@ namespace elastolearn::springs {
 
 std::string_view to_string(LearnedMode mode) {
   switch (mode) {
-  case LearnedMode::paper: return "paper";
-  case LearnedMode::corrected_explicit: return "explicit";
-  case LearnedMode::corrected_implicit: return "implicit";
+  case LearnedMode::paper:
+    return "paper";
+  case LearnedMode::corrected_explicit:
+    return "explicit";
+  case LearnedMode::corrected_implicit:
+    return "implicit";
   }
   return "unknown";
 }
 
 LearnedMode learned_mode_from_string(const std::string& name, const std::string& where) {
-  for (LearnedMode m : {LearnedMode::paper, LearnedMode::corrected_explicit,
-                        LearnedMode::corrected_implicit})
-    if (to_string(m) == name) return m;
-  throw InputError(where, "unknown mode '" + name + "' (expected one of: paper, explicit, implicit)");
+  for (LearnedMode m :
+      { LearnedMode::paper, LearnedMode::corrected_explicit, LearnedMode::corrected_implicit })
+    if (to_string(m) == name)
+      return m;
+  throw InputError(
+      where, "unknown mode '" + name + "' (expected one of: paper, explicit, implicit)");
 }
 
 std::string_view to_string(LinearSolverKind kind) {
   switch (kind) {
-  case LinearSolverKind::automatic: return "auto";
-  case LinearSolverKind::direct: return "direct";
-  case LinearSolverKind::cg: return "cg";
+  case LinearSolverKind::automatic:
+    return "auto";
+  case LinearSolverKind::direct:
+    return "direct";
+  case LinearSolverKind::cg:
+    return "cg";
   }
   return "unknown";
 }
 
 LinearSolverKind linear_solver_from_string(const std::string& name, const std::string& where) {
-  for (LinearSolverKind k : {LinearSolverKind::automatic, LinearSolverKind::direct, LinearSolverKind::cg})
-    if (to_string(k) == name) return k;
+  for (LinearSolverKind k :
+      { LinearSolverKind::automatic, LinearSolverKind::direct, LinearSolverKind::cg })
+    if (to_string(k) == name)
+      return k;
   throw InputError(where, "unknown solver '" + name + "' (expected one of: auto, direct, cg)");
 }
 
 void LearnedSimulatorOptions::validate() const {
   if (!(dt >= 0.0) || !std::isfinite(dt))
-    throw InputError("simulation.dt", "must be > 0 (or 0 for the spring's dt), got " + std::to_string(dt));
+    throw InputError(
+        "simulation.dt", "must be > 0 (or 0 for the spring's dt), got " + std::to_string(dt));
   if (!(cg_tolerance > 0.0) || cg_tolerance >= 1.0)
-    throw InputError("simulation.cg_tolerance", "must be in (0, 1), got " + std::to_string(cg_tolerance));
+    throw InputError(
+        "simulation.cg_tolerance", "must be in (0, 1), got " + std::to_string(cg_tolerance));
   if (cg_max_iterations < 1)
     throw InputError("simulation.cg_max_iterations", "must be >= 1");
-  if (direct_max_dofs < 0) throw InputError("simulation.direct_max_dofs", "must be >= 0");
+  if (direct_max_dofs < 0)
+    throw InputError("simulation.direct_max_dofs", "must be >= 0");
 }
 
 namespace {
@@ -58,14 +71,17 @@ void check_dt(double dt) {
 
 // --- paper mode --------------------------------------------------------------------------
 
-PaperSimulator::PaperSimulator(SpringSystem system, LearnedSpring spring, double dt,
-                               const Loads& loads)
-    : m_system(std::move(system)), m_spring(std::move(spring)), m_dt(dt) {
+PaperSimulator::PaperSimulator(
+    SpringSystem system, LearnedSpring spring, double dt, const Loads& loads)
+    : m_system(std::move(system))
+    , m_spring(std::move(spring))
+    , m_dt(dt) {
   check_dt(dt);
   if (std::abs(dt - m_spring.dt()) > 1e-12 * m_spring.dt())
-    throw InputError("simulation.dt", "paper mode predicts exactly one training step: dt must equal "
-                                      "the spring's training dt " + std::to_string(m_spring.dt()) +
-                                      ", got " + std::to_string(dt));
+    throw InputError("simulation.dt",
+        "paper mode predicts exactly one training step: dt must equal "
+        "the spring's training dt "
+            + std::to_string(m_spring.dt()) + ", got " + std::to_string(dt));
   const int n = m_system.node_count(), s = m_system.spring_count();
   m_spring_dx.resize(s, 3);
   m_spring_dv.resize(s, 3);
@@ -100,7 +116,8 @@ void PaperSimulator::step(SpringState& state) {
   detail::gather(sys, m_spring_dv, m_node_dv, true);
   detail::parallel_blocks(sys.node_count(), [&](int begin, int end) {
     for (int a = begin; a < end; ++a) {
-      if (sys.pinned[a]) continue;
+      if (sys.pinned[a])
+        continue;
       state.x.row(a) += m_node_dx.row(a);
       state.v.row(a) += m_node_dv.row(a);
     }
@@ -109,9 +126,11 @@ void PaperSimulator::step(SpringState& state) {
 
 // --- corrected explicit mode ---------------------------------------------------------------
 
-ExplicitLearnedSimulator::ExplicitLearnedSimulator(SpringSystem system, LearnedSpring spring,
-                                                   double dt, const Loads& loads)
-    : m_system(std::move(system)), m_spring(std::move(spring)), m_dt(dt) {
+ExplicitLearnedSimulator::ExplicitLearnedSimulator(
+    SpringSystem system, LearnedSpring spring, double dt, const Loads& loads)
+    : m_system(std::move(system))
+    , m_spring(std::move(spring))
+    , m_dt(dt) {
   check_dt(dt);
   m_spring_forces.resize(m_system.spring_count(), 3);
   m_node_forces.resize(m_system.node_count(), 3);
@@ -127,9 +146,9 @@ void ExplicitLearnedSimulator::step(SpringState& state) {
   const LearnedSpring& spring = m_spring;
   // The learned impulse m·Δv̂ of each spring, evaluated at the start of the step, summed at the
   // nodes; position is integrated once, by the semi-implicit update.
-  detail::spring_forces(m_system, state.x, state.v,
-                        [&spring](double e, double rate) { return spring.force(e, rate); },
-                        m_spring_forces);
+  detail::spring_forces(
+      m_system, state.x, state.v,
+      [&spring](double e, double rate) { return spring.force(e, rate); }, m_spring_forces);
   detail::gather(m_system, m_spring_forces, m_node_forces);
   detail::semi_implicit_update(m_system, m_node_forces, m_external, m_gravity, m_dt, state);
 }
@@ -137,18 +156,18 @@ void ExplicitLearnedSimulator::step(SpringState& state) {
 // --- factory ---------------------------------------------------------------------------------
 
 std::unique_ptr<SpringStepper> make_learned_simulator(SpringSystem system, LearnedSpring spring,
-                                                      const LearnedSimulatorOptions& options,
-                                                      const Loads& loads) {
+    const LearnedSimulatorOptions& options, const Loads& loads) {
   options.validate();
   const double dt = options.dt > 0.0 ? options.dt : spring.dt();
   switch (options.mode) {
   case LearnedMode::paper:
     return std::make_unique<PaperSimulator>(std::move(system), std::move(spring), dt, loads);
   case LearnedMode::corrected_explicit:
-    return std::make_unique<ExplicitLearnedSimulator>(std::move(system), std::move(spring), dt, loads);
+    return std::make_unique<ExplicitLearnedSimulator>(
+        std::move(system), std::move(spring), dt, loads);
   case LearnedMode::corrected_implicit:
-    return std::make_unique<ImplicitLearnedSimulator>(std::move(system), std::move(spring), dt,
-                                                      options, loads);
+    return std::make_unique<ImplicitLearnedSimulator>(
+        std::move(system), std::move(spring), dt, options, loads);
   }
   throw InternalError("unknown learned mode");
 }

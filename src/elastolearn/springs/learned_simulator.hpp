@@ -35,16 +35,16 @@ struct LearnedSimulatorOptions {
   LearnedMode mode = LearnedMode::corrected_explicit;
   double dt = 0.0; ///< [s]; 0 = the learned spring's training dt (paper mode requires it)
   LinearSolverKind solver = LinearSolverKind::automatic; ///< implicit mode only
-  double cg_tolerance = 1e-10;  ///< relative residual ‖r‖/‖b‖
+  double cg_tolerance = 1e-10; ///< relative residual ‖r‖/‖b‖
   int cg_max_iterations = 2000;
-  int direct_max_dofs = 20000;  ///< "auto" uses the direct solver up to this many unknowns
+  int direct_max_dofs = 20000; ///< "auto" uses the direct solver up to this many unknowns
   /// Throws InputError("simulation.<field>", ...).
   void validate() const;
 };
 
 /// The paper's learned simulator (§2, §6): see the file comment.
 class PaperSimulator final : public SpringStepper {
-public:
+  public:
   /// Throws InputError if dt differs from the spring's training dt (the learned map is a map
   /// over exactly one training step) or loads are malformed.
   PaperSimulator(SpringSystem system, LearnedSpring spring, double dt, const Loads& loads = {});
@@ -55,7 +55,7 @@ public:
   bool is_local() const override { return true; }
   std::string_view name() const override { return "paper"; }
 
-private:
+  private:
   SpringSystem m_system;
   LearnedSpring m_spring;
   double m_dt;
@@ -67,10 +67,10 @@ private:
 
 /// Corrected explicit learned simulator: see the file comment.
 class ExplicitLearnedSimulator final : public SpringStepper {
-public:
+  public:
   /// Throws InputError for dt ≤ 0 or malformed loads.
-  ExplicitLearnedSimulator(SpringSystem system, LearnedSpring spring, double dt,
-                           const Loads& loads = {});
+  ExplicitLearnedSimulator(
+      SpringSystem system, LearnedSpring spring, double dt, const Loads& loads = {});
   void step(SpringState& state) override;
   void set_loads(const Loads& loads) override;
   const SpringSystem& system() const override { return m_system; }
@@ -78,7 +78,7 @@ public:
   bool is_local() const override { return true; }
   std::string_view name() const override { return "explicit"; }
 
-private:
+  private:
   SpringSystem m_system;
   LearnedSpring m_spring;
   double m_dt;
@@ -89,7 +89,6 @@ private:
 
 /// Build the simulator of `options.mode`. Throws InputError for invalid options.
 std::unique_ptr<SpringStepper> make_learned_simulator(SpringSystem system, LearnedSpring spring,
-                                                      const LearnedSimulatorOptions& options,
-                                                      const Loads& loads = {});
+    const LearnedSimulatorOptions& options, const Loads& loads = {});
 
 } // namespace elastolearn::springs

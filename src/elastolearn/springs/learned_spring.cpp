@@ -8,19 +8,21 @@ namespace elastolearn::springs {
 
 void LearnOptions::validate() const {
   features.validate();
-  RegressionOptions{true, ridge}.validate();
+  RegressionOptions { true, ridge }.validate();
 }
 
-LearnedSpring::LearnedSpring(FeatureMap features, MatX coefficients, double dt, double mass,
-                             FitReport report)
-    : m_features(std::move(features)), m_coefficients(std::move(coefficients)), m_dt(dt),
-      m_mass(mass), m_report(std::move(report)) {
+LearnedSpring::LearnedSpring(
+    FeatureMap features, MatX coefficients, double dt, double mass, FitReport report)
+    : m_features(std::move(features))
+    , m_coefficients(std::move(coefficients))
+    , m_dt(dt)
+    , m_mass(mass)
+    , m_report(std::move(report)) {
   m_features.validate();
   if (m_coefficients.rows() != m_features.size() + 1 || m_coefficients.cols() != 2)
     throw InputError("learned spring.coefficients",
-                     "expected " + std::to_string(m_features.size() + 1) + "x2 coefficients, got " +
-                         std::to_string(m_coefficients.rows()) + "x" +
-                         std::to_string(m_coefficients.cols()));
+        "expected " + std::to_string(m_features.size() + 1) + "x2 coefficients, got "
+            + std::to_string(m_coefficients.rows()) + "x" + std::to_string(m_coefficients.cols()));
   if (!m_coefficients.allFinite())
     throw InputError("learned spring.coefficients", "non-finite coefficient");
   if (!(dt > 0.0) || !std::isfinite(dt))
@@ -30,7 +32,8 @@ LearnedSpring::LearnedSpring(FeatureMap features, MatX coefficients, double dt, 
   m_linear = m_features.kind == FeatureKind::polynomial && m_features.degree == 1;
   m_b0 = m_coefficients(0, 1);
   m_dv_coefficients.resize(static_cast<std::size_t>(m_features.size()));
-  for (int j = 0; j < m_features.size(); ++j) m_dv_coefficients[j] = m_coefficients(j + 1, 1);
+  for (int j = 0; j < m_features.size(); ++j)
+    m_dv_coefficients[j] = m_coefficients(j + 1, 1);
   if (m_linear)
     for (int i = 0; i < 3; ++i) {
       m_a[i] = m_coefficients(i, 0);
@@ -39,7 +42,8 @@ LearnedSpring::LearnedSpring(FeatureMap features, MatX coefficients, double dt, 
 }
 
 Vec2 LearnedSpring::predict(double e, double v) const {
-  if (m_linear) return {m_a[0] + m_a[1] * e + m_a[2] * v, m_b[0] + m_b[1] * e + m_b[2] * v};
+  if (m_linear)
+    return { m_a[0] + m_a[1] * e + m_a[2] * v, m_b[0] + m_b[1] * e + m_b[2] * v };
   double phi[k_max_features];
   m_features.evaluate(e, v, phi);
   Vec2 y(m_coefficients(0, 0), m_coefficients(0, 1));
@@ -51,7 +55,8 @@ Vec2 LearnedSpring::predict(double e, double v) const {
 }
 
 double LearnedSpring::force(double e, double v) const {
-  if (m_linear) return (m_b[0] + m_b[1] * e + m_b[2] * v) * (m_mass / m_dt);
+  if (m_linear)
+    return (m_b[0] + m_b[1] * e + m_b[2] * v) * (m_mass / m_dt);
   const double* b = m_dv_coefficients.data();
   double y = m_b0;
   if (m_features.kind == FeatureKind::polynomial) {
@@ -64,17 +69,19 @@ double LearnedSpring::force(double e, double v) const {
       pv[i] = pv[i - 1] * v;
     }
     for (int d = 1; d <= degree; ++d)
-      for (int k = 0; k <= d; ++k) y += *b++ * pe[d - k] * pv[k];
+      for (int k = 0; k <= d; ++k)
+        y += *b++ * pe[d - k] * pv[k];
     return y * (m_mass / m_dt);
   }
   double phi[k_max_features];
   m_features.evaluate(e, v, phi);
-  for (int j = 0, p = m_features.size(); j < p; ++j) y += b[j] * phi[j];
+  for (int j = 0, p = m_features.size(); j < p; ++j)
+    y += b[j] * phi[j];
   return y * (m_mass / m_dt);
 }
 
-void LearnedSpring::force_slopes(double e, double v, double& f, double& df_de,
-                                 double& df_dv) const {
+void LearnedSpring::force_slopes(
+    double e, double v, double& f, double& df_de, double& df_dv) const {
   const double scale = m_mass / m_dt;
   if (m_linear) {
     f = (m_b[0] + m_b[1] * e + m_b[2] * v) * scale;
@@ -100,8 +107,8 @@ void LearnedSpring::force_slopes(double e, double v, double& f, double& df_de,
 LearnedSpring learn_spring(const TrainingSet& data, const LearnOptions& options) {
   options.validate();
   const MatX phi = options.features.evaluate_all(data.inputs);
-  const LinearRegression fit =
-      fit_linear_regression(phi, data.outputs, RegressionOptions{true, options.ridge});
+  const LinearRegression fit
+      = fit_linear_regression(phi, data.outputs, RegressionOptions { true, options.ridge });
   FitReport report;
   report.r_squared = fit.r_squared;
   report.rms_residual = fit.rms_residual;

@@ -9,15 +9,15 @@ namespace elastolearn::springs {
 
 /// Options of `learn_spring`.
 struct LearnOptions {
-  FeatureMap features;  ///< default: polynomial degree 1 = the paper's linear model (e, v)
-  double ridge = 0.0;   ///< ridge penalty λ (0: ordinary least squares, the paper)
+  FeatureMap features; ///< default: polynomial degree 1 = the paper's linear model (e, v)
+  double ridge = 0.0; ///< ridge penalty λ (0: ordinary least squares, the paper)
   /// Throws InputError for invalid features or ridge.
   void validate() const;
 };
 
 /// Quality of the fit on its training data (the regression's own report).
 struct FitReport {
-  std::vector<double> r_squared;    ///< per output (Δe, Δv)
+  std::vector<double> r_squared; ///< per output (Δe, Δv)
   std::vector<double> rms_residual; ///< per output [m, m/s]
   std::vector<double> max_residual; ///< per output, max |y − ŷ|
   int samples = 0;
@@ -30,11 +30,11 @@ struct FitReport {
 /// The learned force is the impulse the spring gave the training particle over one step,
 /// f(e, v) = m·Δv̂(e, v)/dt — exact for data from semi-implicit Euler, whose Δv = dt·f(e, v)/m.
 class LearnedSpring {
-public:
+  public:
   LearnedSpring() = default;
   /// Throws InputError if the coefficient shape does not match the features or dt, mass ≤ 0.
-  LearnedSpring(FeatureMap features, MatX coefficients, double dt, double mass,
-                FitReport report = {});
+  LearnedSpring(
+      FeatureMap features, MatX coefficients, double dt, double mass, FitReport report = {});
 
   /// Predicted (Δe, Δv) over one training step dt (paper Eq. 3 when linear).
   Vec2 predict(double e, double v) const;
@@ -52,7 +52,7 @@ public:
   /// True for degree-1 polynomial features (the paper's linear model).
   bool is_linear() const { return m_linear; }
 
-private:
+  private:
   FeatureMap m_features;
   MatX m_coefficients;
   double m_dt = 0.01;
@@ -60,8 +60,8 @@ private:
   FitReport m_report;
   bool m_linear = true;
   // Linear fast path: Δe = a0 + a1 e + a2 v, Δv = b0 + b1 e + b2 v.
-  double m_a[3] = {0, 0, 0};
-  double m_b[3] = {0, 0, 0};
+  double m_a[3] = { 0, 0, 0 };
+  double m_b[3] = { 0, 0, 0 };
   // Δv coefficients of the features (column 1 without the intercept), contiguous.
   std::vector<double> m_dv_coefficients;
   double m_b0 = 0.0; // Δv intercept

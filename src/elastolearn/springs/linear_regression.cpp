@@ -11,8 +11,8 @@ namespace elastolearn::springs {
 
 void RegressionOptions::validate() const {
   if (!(ridge >= 0.0) || !std::isfinite(ridge))
-    throw InputError("regression options", "ridge must be a finite value >= 0, got " +
-                                               std::to_string(ridge));
+    throw InputError(
+        "regression options", "ridge must be a finite value >= 0, got " + std::to_string(ridge));
 }
 
 MatX LinearRegression::predict(ConstRef<MatX> x) const {
@@ -22,20 +22,20 @@ MatX LinearRegression::predict(ConstRef<MatX> x) const {
   return y;
 }
 
-LinearRegression fit_linear_regression(ConstRef<MatX> x, ConstRef<MatX> y,
-                                       const RegressionOptions& options) {
+LinearRegression fit_linear_regression(
+    ConstRef<MatX> x, ConstRef<MatX> y, const RegressionOptions& options) {
   options.validate();
   const Eigen::Index n = x.rows(), p = x.cols(), q = y.cols();
   if (y.rows() != n)
-    throw InputError("regression data", "feature rows (" + std::to_string(n) +
-                                            ") and output rows (" + std::to_string(y.rows()) +
-                                            ") differ");
+    throw InputError("regression data",
+        "feature rows (" + std::to_string(n) + ") and output rows (" + std::to_string(y.rows())
+            + ") differ");
   if (!x.allFinite() || !y.allFinite())
     throw InputError("regression data", "non-finite value (NaN or inf) in the samples");
   const Eigen::Index unknowns = p + (options.intercept ? 1 : 0);
   if (n < unknowns && options.ridge == 0.0)
-    throw InputError("regression data", std::to_string(n) + " samples for " +
-                                            std::to_string(unknowns) + " unknowns");
+    throw InputError("regression data",
+        std::to_string(n) + " samples for " + std::to_string(unknowns) + " unknowns");
 
   // Centre (intercept) and scale (ridge) the columns; the fit is done on the transformed design
   // and mapped back, so the intercept is never penalised and the ridge acts on standardised β.
@@ -64,15 +64,15 @@ LinearRegression fit_linear_regression(ConstRef<MatX> x, ConstRef<MatX> y,
   LinearRegression fit;
   fit.rank = static_cast<int>(qr.rank());
   if (qr.rank() < p)
-    throw InputError("regression data", "design matrix is rank deficient (rank " +
-                                            std::to_string(qr.rank()) + " of " +
-                                            std::to_string(p) +
-                                            "): the samples do not determine the model");
+    throw InputError("regression data",
+        "design matrix is rank deficient (rank " + std::to_string(qr.rank()) + " of "
+            + std::to_string(p) + "): the samples do not determine the model");
   const MatX beta = qr.solve(rhs); // p×q on standardised columns
   fit.coefficients.resize(p + 1, q);
-  for (Eigen::Index j = 0; j < p; ++j) fit.coefficients.row(j + 1) = beta.row(j) / scale[j];
-  fit.coefficients.row(0) =
-      mean_y.transpose() - mean_x.transpose() * fit.coefficients.bottomRows(p);
+  for (Eigen::Index j = 0; j < p; ++j)
+    fit.coefficients.row(j + 1) = beta.row(j) / scale[j];
+  fit.coefficients.row(0)
+      = mean_y.transpose() - mean_x.transpose() * fit.coefficients.bottomRows(p);
 
   fit.residuals = y - fit.predict(x);
   for (Eigen::Index o = 0; o < q; ++o) {

@@ -11,7 +11,7 @@ namespace elastolearn::springs {
 /// Options of `fit_linear_regression`.
 struct RegressionOptions {
   bool intercept = true; ///< learn β₀ (paper Eq. 4); never penalised by the ridge term
-  double ridge = 0.0;    ///< λ ≥ 0: minimise ‖y − β₀ − Xβ‖² + λ‖β‖² on standardised columns
+  double ridge = 0.0; ///< λ ≥ 0: minimise ‖y − β₀ − Xβ‖² + λ‖β‖² on standardised columns
   /// Throws InputError("regression options", ...) if ridge is negative or not finite.
   void validate() const;
 };
@@ -20,11 +20,12 @@ struct RegressionOptions {
 /// Storage: `coefficients` is (p+1)×q; row 0 is the intercept β₀ (zero if no intercept), row j+1
 /// multiplies feature j; column o belongs to output o.
 struct LinearRegression {
-  MatX coefficients;             ///< (p+1)×q, intercept in row 0
-  MatX residuals;                ///< N×q, y − ŷ on the training data
-  std::vector<double> r_squared; ///< q values: 1 − SS_res / SS_tot (1 when SS_tot = 0 and the fit is exact)
+  MatX coefficients; ///< (p+1)×q, intercept in row 0
+  MatX residuals; ///< N×q, y − ŷ on the training data
+  std::vector<double>
+      r_squared; ///< q values: 1 − SS_res / SS_tot (1 when SS_tot = 0 and the fit is exact)
   std::vector<double> rms_residual; ///< q values: sqrt(SS_res / N)
-  int rank = 0;                  ///< numerical rank of the (augmented) design matrix
+  int rank = 0; ///< numerical rank of the (augmented) design matrix
 
   /// Number of features p.
   Eigen::Index features() const { return coefficients.rows() - 1; }
@@ -39,7 +40,7 @@ struct LinearRegression {
 /// and the system is augmented with sqrt(λ)·I rows (no penalty on the intercept).
 /// Throws InputError("regression data", ...) for mismatched rows, fewer samples than unknowns,
 /// non-finite values, or a rank-deficient design without ridge.
-LinearRegression fit_linear_regression(ConstRef<MatX> x, ConstRef<MatX> y,
-                                       const RegressionOptions& options = {});
+LinearRegression fit_linear_regression(
+    ConstRef<MatX> x, ConstRef<MatX> y, const RegressionOptions& options = {});
 
 } // namespace elastolearn::springs

@@ -7,9 +7,11 @@
 
 namespace elastolearn::springs {
 
-ReferenceSimulator::ReferenceSimulator(SpringSystem system, SpringLaw law, double dt,
-                                       const Loads& loads)
-    : m_system(std::move(system)), m_law(law), m_dt(dt) {
+ReferenceSimulator::ReferenceSimulator(
+    SpringSystem system, SpringLaw law, double dt, const Loads& loads)
+    : m_system(std::move(system))
+    , m_law(law)
+    , m_dt(dt) {
   m_law.validate();
   if (!(dt > 0.0) || !std::isfinite(dt))
     throw InputError("simulation.dt", "must be > 0, got " + std::to_string(dt));
@@ -25,9 +27,9 @@ void ReferenceSimulator::set_loads(const Loads& loads) {
 
 void ReferenceSimulator::step(SpringState& state) {
   const SpringLaw& law = m_law;
-  detail::spring_forces(m_system, state.x, state.v,
-                        [&law](double e, double rate) { return law.force(e, rate); },
-                        m_spring_forces);
+  detail::spring_forces(
+      m_system, state.x, state.v, [&law](double e, double rate) { return law.force(e, rate); },
+      m_spring_forces);
   detail::gather(m_system, m_spring_forces, m_node_forces);
   detail::semi_implicit_update(m_system, m_node_forces, m_external, m_gravity, m_dt, state);
 }

@@ -10,7 +10,7 @@ namespace elastolearn::springs {
 /// Semi-implicit Euler mass-spring simulator: v⁺ = v + dt M⁻¹(Σ f_s(e, ė) u_s + F_ext) + dt g,
 /// x⁺ = x + dt v⁺, with f_s from a `SpringLaw` and u_s the spring direction.
 class ReferenceSimulator final : public SpringStepper {
-public:
+  public:
   /// Throws InputError for an invalid law, dt ≤ 0 or loads of the wrong shape.
   ReferenceSimulator(SpringSystem system, SpringLaw law, double dt, const Loads& loads = {});
 
@@ -22,14 +22,14 @@ public:
   std::string_view name() const override { return "reference"; }
   const SpringLaw& law() const { return m_law; }
 
-private:
+  private:
   SpringSystem m_system;
   SpringLaw m_law;
   double m_dt;
   Positions m_external;
   Vec3 m_gravity = Vec3::Zero();
   Positions m_spring_forces; // s×3 scratch
-  Positions m_node_forces;   // n×3 scratch
+  Positions m_node_forces; // n×3 scratch
 };
 
 } // namespace elastolearn::springs

@@ -5,10 +5,11 @@
 namespace elastolearn::springs {
 
 SimulationRecord run_simulation(SpringStepper& stepper, const SpringState& initial, int steps,
-                                int every, const ProgressCallback& progress,
-                                double divergence_factor) {
-  if (steps < 0) throw InputError("simulation.steps", "must be >= 0, got " + std::to_string(steps));
-  if (every < 1) throw InputError("simulation.every", "must be >= 1, got " + std::to_string(every));
+    int every, const ProgressCallback& progress, double divergence_factor) {
+  if (steps < 0)
+    throw InputError("simulation.steps", "must be >= 0, got " + std::to_string(steps));
+  if (every < 1)
+    throw InputError("simulation.every", "must be >= 1, got " + std::to_string(every));
   const Positions& rest = stepper.system().rest;
   const double size = (rest.colwise().maxCoeff() - rest.colwise().minCoeff()).norm();
   const double bound = divergence_factor * (size + 1.0);
@@ -24,15 +25,18 @@ SimulationRecord run_simulation(SpringStepper& stepper, const SpringState& initi
     stepper.step(state);
     if (!state.x.allFinite() || (state.x - rest).rowwise().norm().maxCoeff() > bound) {
       record.diverged = true;
-      record.message = "simulation diverged at step " + std::to_string(step) + " (t = " +
-                       std::to_string(step * stepper.dt()) + " s); frames before it are kept";
+      record.message = "simulation diverged at step " + std::to_string(step)
+          + " (t = " + std::to_string(step * stepper.dt()) + " s); frames before it are kept";
       break;
     }
     record.steps_done = step;
-    if (step % every == 0 || step == steps) keep(state, step);
-    if (progress && (step % 50 == 0 || step == steps)) progress(step, steps, "simulating");
+    if (step % every == 0 || step == steps)
+      keep(state, step);
+    if (progress && (step % 50 == 0 || step == steps))
+      progress(step, steps, "simulating");
   }
-  if (!record.diverged) record.message = "completed";
+  if (!record.diverged)
+    record.message = "completed";
   return record;
 }
 

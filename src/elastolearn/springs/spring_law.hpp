@@ -10,8 +10,8 @@ namespace elastolearn::springs {
 /// Kind of elastic term. One name table (`to_string` / `spring_law_kind_from_string`) serves
 /// the CLI and the JSON files.
 enum class SpringLawKind {
-  linear,   ///< f = −k e − c v (paper 004 §2)
-  cubic,    ///< hardening: f = −k e − k3 e³ − c v
+  linear, ///< f = −k e − c v (paper 004 §2)
+  cubic, ///< hardening: f = −k e − k3 e³ − c v
   bilinear, ///< tension/compression asymmetry: f = −(e > 0 ? k : k_compression) e − c v
 };
 
@@ -23,9 +23,9 @@ SpringLawKind spring_law_kind_from_string(const std::string& name, const std::st
 /// A 1-D spring force law f(e, v) with elongation e [m] and elongation rate v [m/s].
 struct SpringLaw {
   SpringLawKind kind = SpringLawKind::linear;
-  double k = 100.0;          ///< stiffness [N/m] (tension stiffness for bilinear)
-  double c = 0.0;            ///< viscous damping [N s/m]
-  double k3 = 0.0;           ///< cubic coefficient [N/m³] (cubic only)
+  double k = 100.0; ///< stiffness [N/m] (tension stiffness for bilinear)
+  double c = 0.0; ///< viscous damping [N s/m]
+  double k3 = 0.0; ///< cubic coefficient [N/m³] (cubic only)
   double k_compression = 0.0; ///< stiffness for e < 0 [N/m] (bilinear only)
 
   /// Throws InputError("spring law", ...) for negative or non-finite coefficients.

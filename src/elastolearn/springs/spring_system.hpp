@@ -11,12 +11,12 @@ namespace elastolearn::springs {
 
 /// Topology and rest state of a mass-spring system. Call `finalize()` after filling it.
 struct SpringSystem {
-  Positions rest;            ///< n×3 rest positions [m]
-  Edges springs;             ///< s×2 node pairs (i, j), i ≠ j, no duplicates
-  VecX rest_lengths;         ///< s rest lengths [m] (finalize fills it from `rest` if empty)
-  VecX masses;               ///< n masses [kg] (finalize fills ones if empty)
-  std::vector<char> pinned;  ///< n flags: pinned nodes never move (finalize fills zeros if empty)
-  Faces faces;               ///< triangles for viewing (cloth), may be empty
+  Positions rest; ///< n×3 rest positions [m]
+  Edges springs; ///< s×2 node pairs (i, j), i ≠ j, no duplicates
+  VecX rest_lengths; ///< s rest lengths [m] (finalize fills it from `rest` if empty)
+  VecX masses; ///< n masses [kg] (finalize fills ones if empty)
+  std::vector<char> pinned; ///< n flags: pinned nodes never move (finalize fills zeros if empty)
+  Faces faces; ///< triangles for viewing (cloth), may be empty
 
   /// Node → incident springs (CSR): springs of node a are incident[offsets[a] .. offsets[a+1]).
   std::vector<int> incident_offsets;
@@ -33,7 +33,7 @@ struct SpringSystem {
 
 /// Where a cloth lies at rest.
 enum class ClothPlane {
-  vertical,   ///< x–y plane, row 0 at the top (y = 0), rows going down −y
+  vertical, ///< x–y plane, row 0 at the top (y = 0), rows going down −y
   horizontal, ///< x–z plane (y = 0), row 0 is the pinned edge; it swings down under −y gravity
 };
 /// Which cloth nodes are pinned.
@@ -48,13 +48,13 @@ ClothPins cloth_pins_from_string(const std::string& name, const std::string& whe
 
 /// Options of `make_cloth`.
 struct ClothOptions {
-  int columns = 5;          ///< nodes per row (x)
-  int rows = 5;             ///< rows
-  double spacing = 1.0;     ///< structural rest length [m] (paper: unit rest length)
-  bool shear = true;        ///< 8-neighbour springs (paper §5): add both diagonals of each quad
+  int columns = 5; ///< nodes per row (x)
+  int rows = 5; ///< rows
+  double spacing = 1.0; ///< structural rest length [m] (paper: unit rest length)
+  bool shear = true; ///< 8-neighbour springs (paper §5): add both diagonals of each quad
   ClothPlane plane = ClothPlane::vertical;
   ClothPins pins = ClothPins::top_corners;
-  double node_mass = 1.0;   ///< [kg] (paper: unit mass)
+  double node_mass = 1.0; ///< [kg] (paper: unit mass)
 };
 
 /// Rope of `nodes` nodes along +x with spacing `rest_length`, node 0 pinned (paper §4).
@@ -83,7 +83,7 @@ SpringState rest_state(const SpringSystem& system);
 /// One time step of a mass-spring simulator. Implemented by the reference semi-implicit Euler
 /// simulator and by the learned simulators (paper, explicit, implicit modes).
 class SpringStepper {
-public:
+  public:
   virtual ~SpringStepper() = default;
   /// Advance `state` by dt() in place. Pinned nodes keep their position and zero velocity.
   virtual void step(SpringState& state) = 0;

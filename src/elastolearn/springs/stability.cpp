@@ -8,14 +8,14 @@
 namespace elastolearn::springs {
 
 StabilityCase single_spring_case(double stretch) {
-  StabilityCase c{"single spring", make_rope(2), {}, {}};
+  StabilityCase c { "single spring", make_rope(2), {}, {} };
   c.initial = rest_state(c.system);
   c.initial.x(1, 0) += stretch;
   return c;
 }
 
 StabilityCase rope_case(int nodes, double gravity) {
-  StabilityCase c{"rope " + std::to_string(nodes), make_rope(nodes), {}, {}};
+  StabilityCase c { "rope " + std::to_string(nodes), make_rope(nodes), {}, {} };
   c.initial = rest_state(c.system);
   c.loads.gravity = Vec3(0.0, -gravity, 0.0);
   return c;
@@ -26,7 +26,7 @@ StabilityCase hanging_cloth_case(int n, double gravity) {
   o.columns = o.rows = n;
   o.plane = ClothPlane::horizontal;
   o.pins = ClothPins::top_corners;
-  StabilityCase c{"cloth " + std::to_string(n) + "x" + std::to_string(n), make_cloth(o), {}, {}};
+  StabilityCase c { "cloth " + std::to_string(n) + "x" + std::to_string(n), make_cloth(o), {}, {} };
   c.initial = rest_state(c.system);
   c.loads.gravity = Vec3(0.0, -gravity, 0.0);
   return c;
@@ -35,8 +35,10 @@ StabilityCase hanging_cloth_case(int n, double gravity) {
 void StabilityOptions::validate() const {
   if (!(k_min > 0.0) || !(k_max > k_min))
     throw InputError("stability.k_min", "need 0 < k_min < k_max");
-  if (steps < 1) throw InputError("stability.steps", "must be >= 1");
-  if (!(resolution > 1.0)) throw InputError("stability.resolution", "must be > 1");
+  if (steps < 1)
+    throw InputError("stability.steps", "must be >= 1");
+  if (!(resolution > 1.0))
+    throw InputError("stability.resolution", "must be > 1");
 }
 
 bool run_is_stable(SpringStepper& stepper, const StabilityCase& test, int steps) {
@@ -47,14 +49,16 @@ bool run_is_stable(SpringStepper& stepper, const StabilityCase& test, int steps)
   SpringState state = test.initial;
   for (int s = 0; s < steps; ++s) {
     stepper.step(state);
-    if (!state.x.allFinite()) return false;
-    if ((state.x - test.initial.x).rowwise().norm().maxCoeff() > bound) return false;
+    if (!state.x.allFinite())
+      return false;
+    if ((state.x - test.initial.x).rowwise().norm().maxCoeff() > bound)
+      return false;
   }
   return true;
 }
 
 StabilityResult find_stability_limit(const std::function<StepperFactory(double k)>& model,
-                                     const StabilityCase& test, const StabilityOptions& options) {
+    const StabilityCase& test, const StabilityOptions& options) {
   options.validate();
   StabilityResult result;
   auto stable = [&](double k) {

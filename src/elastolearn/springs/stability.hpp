@@ -26,9 +26,9 @@ StabilityCase hanging_cloth_case(int n, double gravity = 9.81);
 
 /// Options of `find_stability_limit`.
 struct StabilityOptions {
-  double k_min = 10.0;     ///< [N/m] lower end of the search
-  double k_max = 1e7;      ///< [N/m] upper end of the search
-  int steps = 500;         ///< steps per run
+  double k_min = 10.0; ///< [N/m] lower end of the search
+  double k_max = 1e7; ///< [N/m] upper end of the search
+  int steps = 500; ///< steps per run
   double resolution = 1.05; ///< stop when k_unstable / k_stable < resolution
   /// Throws InputError("stability.<field>", ...).
   void validate() const;
@@ -36,7 +36,7 @@ struct StabilityOptions {
 
 /// Outcome: the bracket [largest_stable, smallest_unstable] of the stability limit.
 struct StabilityResult {
-  double largest_stable = 0.0;    ///< 0 if even k_min is unstable
+  double largest_stable = 0.0; ///< 0 if even k_min is unstable
   double smallest_unstable = 0.0; ///< +inf if k_max is stable
   int runs = 0;
 };
@@ -48,7 +48,6 @@ bool run_is_stable(SpringStepper& stepper, const StabilityCase& test, int steps)
 
 /// Bisection in log k over [k_min, k_max] with `model(k)` building the scheme for stiffness k.
 StabilityResult find_stability_limit(const std::function<StepperFactory(double k)>& model,
-                                     const StabilityCase& test,
-                                     const StabilityOptions& options = {});
+    const StabilityCase& test, const StabilityOptions& options = {});
 
 } // namespace elastolearn::springs

@@ -20,7 +20,7 @@ StepperFactory learned_factory(const LearnedSpring& spring, const LearnedSimulat
 
 /// Options of the stiffness measurements.
 struct StiffnessOptions {
-  std::vector<double> forces = {5, 10, 15, 20, 25, 30, 35, 40, 45, 50}; ///< [N] (paper §4)
+  std::vector<double> forces = { 5, 10, 15, 20, 25, 30, 35, 40, 45, 50 }; ///< [N] (paper §4)
   FixedPointOptions fixed_point;
   /// Throws InputError("stiffness.forces", ...) for an empty list or non-positive forces.
   void validate() const;
@@ -28,13 +28,13 @@ struct StiffnessOptions {
 
 /// One stiffness measurement: per force the measured displacement and F/displacement·series.
 struct StiffnessMeasurement {
-  std::vector<double> forces;        ///< [N]
+  std::vector<double> forces; ///< [N]
   std::vector<double> displacements; ///< measured displacement along the force [m]
-  std::vector<double> stiffness;     ///< per force [N/m]
-  double mean = 0.0;                 ///< mean stiffness [N/m]
-  double stddev = 0.0;               ///< sample standard deviation [N/m]
-  bool converged = true;             ///< every equilibrium converged
-  std::string message;               ///< why not, if not
+  std::vector<double> stiffness; ///< per force [N/m]
+  double mean = 0.0; ///< mean stiffness [N/m]
+  double stddev = 0.0; ///< sample standard deviation [N/m]
+  bool converged = true; ///< every equilibrium converged
+  std::string message; ///< why not, if not
 };
 
 /// A loaded structure: forces `direction`·F on `load_nodes`, displacement of `measure_node`
@@ -45,7 +45,7 @@ struct LoadCase {
   int measure_node = 0;
   Vec3 direction = Vec3::UnitX();
   double series = 1.0;
-  std::array<bool, 3> components = {true, true, true}; ///< unknowns of the fixed point
+  std::array<bool, 3> components = { true, true, true }; ///< unknowns of the fixed point
 };
 
 /// Rope of `nodes` nodes (paper §4, Table 2): node 0 fixed, force on the last node along the
@@ -57,14 +57,13 @@ LoadCase cloth_load_case(int columns = 5, int rows = 5, double spacing = 1.0);
 
 /// Measure: for each force (continuation from the previous equilibrium, with the load step
 /// halved where Newton fails) find the fixed point and record the displacement.
-StiffnessMeasurement measure_stiffness(const StepperFactory& factory, const LoadCase& load,
-                                       const StiffnessOptions& options = {});
+StiffnessMeasurement measure_stiffness(
+    const StepperFactory& factory, const LoadCase& load, const StiffnessOptions& options = {});
 
 /// Equilibrium of `stepper` under `loads`, reached from `state` by load continuation (the
 /// load factor goes 0 → 1, halving steps on failure). Returns the fixed-point result of the last
 /// solve; `state` holds the equilibrium when it converged.
 FixedPointResult equilibrium_with_continuation(SpringStepper& stepper, const Loads& from,
-                                               const Loads& to, SpringState& state,
-                                               const FixedPointOptions& options);
+    const Loads& to, SpringState& state, const FixedPointOptions& options);
 
 } // namespace elastolearn::springs

@@ -12,10 +12,12 @@ std::string_view to_string(SamplingKind kind) {
 }
 
 SamplingKind sampling_kind_from_string(const std::string& name, const std::string& where) {
-  if (name == "trajectories") return SamplingKind::trajectories;
-  if (name == "phase-grid") return SamplingKind::phase_grid;
-  throw InputError(where, "unknown sampling '" + name +
-                              "' (expected one of: trajectories, phase-grid)");
+  if (name == "trajectories")
+    return SamplingKind::trajectories;
+  if (name == "phase-grid")
+    return SamplingKind::phase_grid;
+  throw InputError(
+      where, "unknown sampling '" + name + "' (expected one of: trajectories, phase-grid)");
 }
 
 namespace {
@@ -23,7 +25,8 @@ namespace {
 double max_stiffness(const TrainingOptions& o) {
   double kmax = 0.0;
   for (double e : o.elongations)
-    kmax = std::max({kmax, -o.law.force_derivative_e(e, 0.0), -o.law.force_derivative_e(0.0, 0.0)});
+    kmax = std::max(
+        { kmax, -o.law.force_derivative_e(e, 0.0), -o.law.force_derivative_e(0.0, 0.0) });
   return kmax;
 }
 } // namespace
@@ -37,25 +40,29 @@ void TrainingOptions::validate() const {
   if (elongations.empty())
     throw InputError("training options.elongations", "needs at least one value");
   for (double e : elongations)
-    if (!std::isfinite(e)) throw InputError("training options.elongations", "non-finite value");
-  if (steps < 2) throw InputError("training options.steps", "must be >= 2, got " + std::to_string(steps));
-  if (!(max_speed >= 0.0)) throw InputError("training options.max_speed", "must be >= 0");
+    if (!std::isfinite(e))
+      throw InputError("training options.elongations", "non-finite value");
+  if (steps < 2)
+    throw InputError("training options.steps", "must be >= 2, got " + std::to_string(steps));
+  if (!(max_speed >= 0.0))
+    throw InputError("training options.max_speed", "must be >= 0");
   if (sampling == SamplingKind::trajectories) {
     const double kappa = max_stiffness(*this) * dt * dt / mass;
     if (kappa >= 4.0)
       throw InputError("training options.dt",
-                       "semi-implicit Euler trajectories diverge for k*dt^2/m = " +
-                           std::to_string(kappa) + " >= 4; use phase-grid sampling or a smaller dt");
+          "semi-implicit Euler trajectories diverge for k*dt^2/m = " + std::to_string(kappa)
+              + " >= 4; use phase-grid sampling or a smaller dt");
   }
   const double lo = *std::min_element(elongations.begin(), elongations.end());
   const double hi = *std::max_element(elongations.begin(), elongations.end());
   if (sampling == SamplingKind::phase_grid && !(hi > lo))
-    throw InputError("training options.elongations", "phase-grid sampling needs a range (min < max)");
+    throw InputError(
+        "training options.elongations", "phase-grid sampling needs a range (min < max)");
 }
 
 Vec2 semi_implicit_step_1d(const SpringLaw& law, double dt, double mass, double e, double v) {
   const double dv = dt * law.force(e, v) / mass; // Eq. (1)
-  return {dt * (v + dv), dv};                     // Eq. (2): Δe = dt v(t+dt)
+  return { dt * (v + dv), dv }; // Eq. (2): Δe = dt v(t+dt)
 }
 
 TrainingSet generate_training_set(const TrainingOptions& options) {
@@ -81,8 +88,8 @@ TrainingSet generate_training_set(const TrainingOptions& options) {
     const double hi = *std::max_element(options.elongations.begin(), options.elongations.end());
     const double amplitude = std::max(std::abs(lo), std::abs(hi));
     const double vmax = options.max_speed > 0.0
-                            ? options.max_speed
-                            : amplitude * std::sqrt(std::max(max_stiffness(options), 1e-12) / options.mass);
+        ? options.max_speed
+        : amplitude * std::sqrt(std::max(max_stiffness(options), 1e-12) / options.mass);
     const int n = options.steps;
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) {
