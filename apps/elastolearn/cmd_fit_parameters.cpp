@@ -98,8 +98,11 @@ void run_fit(const FitOptions& o) {
   m["young"] = report.fitted.young;
   m["poisson"] = report.fitted.poisson;
   const bool fits_damping = o.fit.find("alpha") != std::string::npos;
-  if (m.contains("damping") || fits_damping)
-    m["damping"] = { { "alpha0", report.fitted.alpha0 }, { "alpha1", report.fitted.alpha1 } };
+  if (m.contains("damping") || fits_damping) {
+    nlohmann::json& damping = m["damping"]; // keeps its other keys (the damping tangent)
+    damping["alpha0"] = report.fitted.alpha0;
+    damping["alpha1"] = report.fitted.alpha1;
+  }
   nlohmann::json history = nlohmann::json::array();
   for (const auto& it : report.history)
     history.push_back({ { "iteration", it.iteration }, { "parameters", to_json(it.parameters) },

@@ -1,4 +1,5 @@
 // Inversion-safe SVD, stretch rates and the world-frame stress of principal_stress.hpp.
+#include <elastolearn/core/error.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 
 #include <support/material_states.hpp>
@@ -105,14 +106,41 @@ TEST(DampingTangent, IsTheExactTangentWithoutItsFlipPart) {
   d1 << 5e4, 1e4, -2e4, 3e3, 4e4, 1e4, -1e4, 2e4, 6e4; // not symmetric (as an RBF's ∂N/∂σ)
   d2 << -3e4, 2e3, 1e3, 5e3, -2e4, 0, 1e3, 4e3, -1e4;
   const PrincipalTangent exact = principal_tangent(frame, p1, d1, false);
-  const PrincipalTangent t1 = damping_tangent(frame, p1, d1);
+  const PrincipalTangent t1 = damping_tangent(frame, p1, d1, DampingTangent::FlipFree);
   EXPECT_EQ(t1.block, exact.block);
   EXPECT_EQ(t1.twist, exact.twist);
   EXPECT_EQ(t1.flip, Vec3::Zero());
   // Linear: T(a p1 + b p2) = a T(p1) + b T(p2), including the negative (unprojected) parts.
-  const PrincipalTangent t2 = damping_tangent(frame, p2, d2);
-  const PrincipalTangent sum = damping_tangent(frame, 2 * p1 - 3 * p2, 2 * d1 - 3 * d2);
+  const PrincipalTangent t2 = damping_tangent(frame, p2, d2, DampingTangent::FlipFree);
+  const PrincipalTangent sum
+      = damping_tangent(frame, 2 * p1 - 3 * p2, 2 * d1 - 3 * d2, DampingTangent::FlipFree);
   EXPECT_LE((sum.block - (2 * t1.block - 3 * t2.block)).norm(), 1e-9 * sum.block.norm());
   EXPECT_LE((sum.twist - (2 * t1.twist - 3 * t2.twist)).norm(), 1e-9 * sum.twist.norm());
   EXPECT_LT(t2.block.minCoeff(), 0.0); // the test does exercise an indefinite tangent
+}
+
+TEST(DampingTangent, ExactIsTheFullUnprojectedTangent) {
+  const PrincipalFrame frame = principal_frame(rotated_stretch(Vec3(1.2, 0.9, 0.75), 7));
+  const Vec3 p(3e3, -1e3, -4e3);
+  Mat3 d;
+  d << 5e4, 1e4, -2e4, 3e3, 4e4, 1e4, -1e4, 2e4, 6e4;
+  const PrincipalTangent exact = principal_tangent(frame, p, d, false);
+  const PrincipalTangent t = damping_tangent(frame, p, d, DampingTangent::Exact);
+  EXPECT_EQ(t.block, exact.block);
+  EXPECT_EQ(t.twist, exact.twist);
+  EXPECT_EQ(t.flip, exact.flip);
+  EXPECT_NE(t.flip, Vec3::Zero());
+}
+
+TEST(DampingTangent, NamesRoundTripAndUnknownNamesAreRefused) {
+  for (DampingTangent t : all_damping_tangents)
+    EXPECT_EQ(damping_tangent_from_string(to_string(t)), t);
+  try {
+    damping_tangent_from_string("projected", "s.json: material.damping.tangent");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("s.json: material.damping.tangent"), std::string::npos) << what;
+    EXPECT_NE(what.find("flip-free, exact"), std::string::npos) << what;
+  }
 }

@@ -18,10 +18,13 @@ material::PrincipalTangent weighted_sum(
 
 } // namespace
 
-ElasticForce::ElasticForce(const mesh::TetMesh& mesh, MaterialModel material)
+ElasticForce::ElasticForce(const mesh::TetMesh& mesh, MaterialModel material, MassType mass)
     : m_tets(mesh.tets())
     , m_rest(precompute_rest_data(mesh))
-    , m_material(std::move(material)) {
+    , m_material(std::move(material))
+    , m_mass(mass)
+    , m_damping_tangent(
+          m_material.damping ? m_material.damping->tangent() : material::DampingTangent::FlipFree) {
   ELASTOLEARN_CHECK(m_material.elastic != nullptr, "ElasticForce needs an elastic model");
   const int m = mesh.num_tets();
   const int n = mesh.num_vertices();
@@ -75,27 +78,34 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
       c.has_tangent = false;
       if (c.alpha.alpha1 != 0 || c.alpha1_change != 0) {
         // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 9×9
-        // or 12×12. K_e is the corrected model's exact stiffness, the learned Δα₁ acts on the
+        // or 12×12. K_e is the corrected model's damping stiffness, the learned Δα₁ acts on the
         // nominal one (see the class comment). Unprojected: the PSD projection is Newton's device
         // (add_jacobian), and the damping force must stay linear in the correction.
         material::CorrectedStress scratch;
         const material::CorrectedStress& elastic_stress
             = material::elastic_part(*elastic, correction, c.frame.stretches, c.stress, scratch);
-        c.tangent
-            = material::damping_tangent(c.frame, elastic_stress.stress, elastic_stress.d_stretches);
+        c.tangent = material::damping_tangent(
+            c.frame, elastic_stress.stress, elastic_stress.d_stretches, m_damping_tangent);
         c.has_tangent = true;
         if (c.alpha.alpha1 != 0)
           P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
         if (c.alpha1_change != 0) {
-          c.nominal_tangent = material::damping_tangent(*elastic, c.frame);
+          c.nominal_tangent = material::damping_tangent(*elastic, c.frame, m_damping_tangent);
           P += c.alpha1_change
               * material::first_piola_differential(c.frame, c.nominal_tangent, F_rate);
         }
       }
       Eigen::Map<Eigen::Matrix<double, 3, 4>> force(m_force_buffer.data() + 12 * e);
       force.noalias() = -rest.volume * P * rest.gradients;
-      if (c.alpha.alpha0 != 0)
-        force -= c.alpha.alpha0 * (density * rest.volume / 4.0) * ve;
+      if (c.alpha.alpha0 != 0) {
+        if (m_mass == MassType::Lumped) {
+          force -= c.alpha.alpha0 * (density * rest.volume / 4.0) * ve;
+        } else {
+          // Consistent M_e = ρ vol/20 (1 + δ_ab) I₃: (M_e v)_a = ρ vol/20 (v_a + Σ_b v_b).
+          const Vec3 sum = ve.rowwise().sum();
+          force -= c.alpha.alpha0 * (density * rest.volume / 20.0) * (ve.colwise() + sum);
+        }
+      }
     }
   });
   m_cached_x = state.x;
@@ -135,8 +145,16 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
         tangent = material::projected(tangent);
     }
     J = element_stiffness(c.frame, tangent, rest, c.has_tangent ? 1.0 : c_x);
-    if (c.alpha.alpha0 != 0)
-      J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
+    if (c.alpha.alpha0 != 0) {
+      if (m_mass == MassType::Lumped) {
+        J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
+      } else {
+        const double m = c_v * c.alpha.alpha0 * density * rest.volume / 20.0;
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b)
+            J.block<3, 3>(3 * a, 3 * b).diagonal().array() += (a == b ? 2 : 1) * m;
+      }
+    }
     if (correction && c_v != 0 && !c.stress.d_stretch_rates.isZero(0)) {
       // Project the damping tangent as a whole: the Rayleigh part α₁·block plus the correction's
       // rate part may be PSD together even where the rate part alone is not; projecting them

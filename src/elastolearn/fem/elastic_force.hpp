@@ -2,6 +2,7 @@
 /// \file The elastic force of a tet mesh with the corrected stress of paper 000 Eq. (1) and
 /// Rayleigh damping f_d = −(α₀ M + α₁ K(x)) v, evaluated at the end-of-step state (Eq. 2).
 #include <elastolearn/fem/force_term.hpp>
+#include <elastolearn/fem/mass.hpp>
 #include <elastolearn/fem/tet_element.hpp>
 #include <elastolearn/material/correction.hpp>
 #include <elastolearn/material/damping_model.hpp>
@@ -26,25 +27,25 @@ struct MaterialModel {
 ///
 /// Per element: F = Σ x_a g_aᵀ, SVD F = U F̂ Vᵀ, P = U (P̂ + N) Vᵀ, f_a = −vol P g_a;
 /// K_e = vol Bᵀ (dP/dF) B of the corrected model (clamped PSD in the Jacobian); damping force
-///   −α₁ K_e v_e − Δα₁ K_e^nom v_e − α₀ (ρ vol/4) v_e
-/// with (α₀, α₁) the damping model's, from the element's largest stretch: the nominal Rayleigh
-/// term acts on the *corrected* stiffness (a material whose elasticity is learned right is damped
-/// as its own Rayleigh damping would), while the learned Δα₁ = Correction::stiffness_damping(F̂)
-/// (paper Eq. 13; α₁ + Δα₁ kept ≥ 0) scales the nominal stiffness K_e^nom, so that the damping
-/// force stays linear in the correction's unknowns (learn::reconstruct_rbf_correction). α₁'s
-/// K_e is material::damping_tangent of P̂ + N(σ, 0): exact, without its flip part, unprojected
-/// (a projected one would make the force nonlinear in the correction, and the learned correction
-/// diverged with it; measured in docs/learning.md, "Damping part"). Δα₁'s K_e^nom is the same
-/// damping tangent of the nominal P̂ (independent of the unknowns), so that where N = 0 a learned
-/// Δα₁ is exactly a change of α₁. The correction's rate dependence adds
-/// D_e = vol Bᵀ ∂P/∂Ḟ B
-/// (symmetrised, clamped PSD). The Jacobian drops ∂K/∂x·v (Rayleigh) and the variation of
-/// Ḟ̂ through U, V (correction): standard, and the residual is still exact.
+///   −α₁ K_e^d v_e − Δα₁ K_e^nom,d v_e − α₀ M_e v_e
+/// with (α₀, α₁) the damping model's, from the element's largest stretch, and M_e the element's
+/// lumped or consistent mass (the scene's). K_e^d is the damping stiffness the damping model
+/// names (material::DampingTangent: the exact tangent, or the exact tangent without its flip
+/// part), unprojected and evaluated at the end-of-step state, of the *corrected* stress
+/// P̂ + N(σ, 0): a material whose elasticity is learned right is damped as its own Rayleigh
+/// damping would. The learned Δα₁ = Correction::stiffness_damping(F̂) (paper Eq. 13; α₁ + Δα₁
+/// kept ≥ 0) scales the same kind of tangent of the nominal P̂ (independent of the correction's
+/// unknowns), so that the damping force stays linear in them (learn::reconstruct_rbf_correction)
+/// and, where N = 0, a learned Δα₁ is exactly a change of α₁. The correction's rate dependence
+/// adds D_e = vol Bᵀ ∂P/∂Ḟ B (symmetrised, clamped PSD). The Jacobian drops ∂K/∂x·v (Rayleigh)
+/// and the variation of Ḟ̂ through U, V (correction), and projects c_x K_e + c_v (α₁ K_e^d +
+/// Δα₁ K_e^nom,d) as a whole: standard, and the residual is still exact.
 /// Element loops run in parallel (oneTBB): forces into per-element buffers gathered without
 /// locks, element matrices straight into the SystemMatrix (SystemMatrix::add_elements).
 class ElasticForce final : public ForceTerm {
   public:
-  ElasticForce(const mesh::TetMesh& mesh, MaterialModel material);
+  /// `mass` is the mass matrix the α₀ term scales (the scene's; lumped by default).
+  ElasticForce(const mesh::TetMesh& mesh, MaterialModel material, MassType mass = MassType::Lumped);
 
   /// Forces; caches each element's SVD and stress (and tangent, when Rayleigh α₁ ≠ 0) for
   /// add_jacobian at the same state.
@@ -70,10 +71,10 @@ class ElasticForce final : public ForceTerm {
     material::RayleighCoefficients alpha; ///< the damping model's (nominal) α₀, α₁
     /// A correction's Δα₁ as applied: (α₁ + Δα₁)⁺ − α₁ ≥ −α₁ (0 without a correction).
     double alpha1_change = 0;
-    material::PrincipalTangent
-        tangent; ///< material::damping_tangent of P̂ + N; valid if has_tangent
-    material::PrincipalTangent
-        nominal_tangent; ///< material::damping_tangent of P̂; valid if alpha1_change ≠ 0
+    /// material::damping_tangent of P̂ + N; valid if has_tangent.
+    material::PrincipalTangent tangent;
+    /// material::damping_tangent of P̂; valid if alpha1_change ≠ 0.
+    material::PrincipalTangent nominal_tangent;
     bool has_tangent = false;
   };
   bool cache_matches(const ForceState& state) const;
@@ -82,6 +83,8 @@ class ElasticForce final : public ForceTerm {
   Tets m_tets;
   std::vector<TetRestData> m_rest;
   MaterialModel m_material;
+  MassType m_mass;
+  material::DampingTangent m_damping_tangent; ///< the damping model's (flip-free without one)
   std::vector<ElementCache> m_cache; ///< m, from the last add_force
   VecX m_cached_x, m_cached_v; ///< the state m_cache belongs to
   std::vector<double> m_force_buffer; ///< m·12

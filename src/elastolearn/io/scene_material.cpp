@@ -18,8 +18,8 @@ material::CubicSpline parse_spline(
   return material::CubicSpline(std::move(x), std::move(y), o.file() + ": " + o.field(x_key));
 }
 
-std::shared_ptr<const material::DampingModel> parse_damping(const JsonObject& d) {
-  d.reject_unknown_keys({ "alpha0", "alpha1" });
+/// The damping law of a "damping" object (its coefficients; the tangent is set by the caller).
+std::shared_ptr<material::DampingModel> make_damping(const JsonObject& d) {
   const bool stretch_dependent = (d.has("alpha0") && d.json().at("alpha0").is_object())
       || (d.has("alpha1") && d.json().at("alpha1").is_object());
   if (!stretch_dependent)
@@ -44,6 +44,17 @@ std::shared_ptr<const material::DampingModel> parse_damping(const JsonObject& d)
   };
   return std::make_shared<material::StretchDependentRayleigh>(
       curve("alpha0"), curve("alpha1"), d.file() + ": " + d.path());
+}
+
+/// The "damping" object: coefficients and the stiffness α₁ scales ("tangent").
+std::shared_ptr<const material::DampingModel> parse_damping(const JsonObject& d) {
+  d.reject_unknown_keys({ "alpha0", "alpha1", "tangent" });
+  const auto tangent = material::damping_tangent_from_string(
+      d.choice("tangent", { "flip-free", "exact" }, "flip-free"),
+      d.file() + ": " + d.field("tangent"));
+  std::shared_ptr<material::DampingModel> model = make_damping(d);
+  model->set_tangent(tangent);
+  return model;
 }
 
 } // namespace

@@ -4,7 +4,7 @@
 ///    "density": kg/m³,
 ///    "edit": {"base": "neohookean"|"corotated", "region": "tension"|"compression",
 ///             "stretches": [...], "scales": [...]}            (spline_edited only)
-///    "damping": {"alpha0": 1/s, "alpha1": s}
+///    "damping": {"alpha0": 1/s, "alpha1": s, "tangent": "flip-free" (default) | "exact"}
 ///            where either coefficient may instead be a function of the largest stretch σ₁:
 ///            {"stretches": [...], "values": [...]} (a monotone spline) or
 ///            {"polynomial": [c₀, c₁, ...]} (Σ cₖ (σ₁ − 1)ᵏ, clamped at 0)}

@@ -212,8 +212,10 @@ sim::Scene scene_with_parameters(
   } else {
     result.material.elastic = material::make_elastic_model(type, lame);
   }
-  result.material.damping
-      = std::make_shared<material::RayleighDamping>(parameters.alpha0, parameters.alpha1);
+  auto damping = std::make_shared<material::RayleighDamping>(parameters.alpha0, parameters.alpha1);
+  if (scene.material.damping)
+    damping->set_tangent(scene.material.damping->tangent());
+  result.material.damping = std::move(damping);
   return result;
 }
 

@@ -126,12 +126,13 @@ Vec12 stiffness_damping_force(const fem::TetRestData& rest, const ElementState& 
 } // namespace
 
 Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
-    const material::ElasticModel& elastic) {
-  return stiffness_damping_force(rest, state, material::damping_tangent(elastic, state.frame));
+    const material::ElasticModel& elastic, material::DampingTangent kind) {
+  return stiffness_damping_force(
+      rest, state, material::damping_tangent(elastic, state.frame, kind));
 }
 
 Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
-    const fem::TetRestData& rest, const ElementState& state) {
+    const fem::TetRestData& rest, const ElementState& state, material::DampingTangent kind) {
   // The exact eigen-form tangent is linear in (p̂, ∂p̂/∂σ), and so is the force: its columns are
   // the forces of the 12 unit inputs.
   Eigen::Matrix<double, 12, 12> op;
@@ -143,7 +144,7 @@ Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
     else
       derivative((c - 3) % 3, (c - 3) / 3) = 1;
     op.col(c) = stiffness_damping_force(
-        rest, state, material::damping_tangent(state.frame, stress, derivative));
+        rest, state, material::damping_tangent(state.frame, stress, derivative, kind));
   }
   return op;
 }
@@ -153,6 +154,12 @@ namespace {
 /// Nominal Rayleigh α₁ of an element (0 without a damping model).
 double nominal_alpha1(const ReconstructionMesh& mesh, const Vec3& stretches) {
   return mesh.nominal.damping ? mesh.nominal.damping->coefficients(stretches[0]).alpha1 : 0.0;
+}
+
+/// The stiffness the nominal's damping scales (fem::ElasticForce's choice without a model).
+material::DampingTangent nominal_damping_tangent(const ReconstructionMesh& mesh) {
+  return mesh.nominal.damping ? mesh.nominal.damping->tangent()
+                              : material::DampingTangent::FlipFree;
 }
 
 } // namespace
@@ -184,8 +191,8 @@ void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
   const double alpha1 = elastic != nullptr ? nominal_alpha1(m_mesh, st.frame.stretches) : 0.0;
   if (alpha1 != 0) {
     m_design.output_matrix(st.frame.stretches, outputs, gradients);
-    const Eigen::Matrix<double, 12, 12> D
-        = alpha1 * element_stiffness_damping_operator(m_mesh.rest[e], st);
+    const Eigen::Matrix<double, 12, 12> D = alpha1
+        * element_stiffness_damping_operator(m_mesh.rest[e], st, nominal_damping_tangent(m_mesh));
     rows.leftCols(u_elastic).noalias() = (G + D.leftCols<3>()) * outputs;
     rows.leftCols(u_elastic).noalias() += D.rightCols<9>() * gradients;
   } else {
@@ -194,8 +201,9 @@ void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
   }
   if (u > u_elastic) {
     m_design.damping_row(st.frame.stretches, damping_row);
-    rows.rightCols(u - u_elastic).noalias()
-        = element_stiffness_damping_force(m_mesh.rest[e], st, *elastic) * damping_row;
+    rows.rightCols(u - u_elastic).noalias() = element_stiffness_damping_force(m_mesh.rest[e], st,
+                                                  *elastic, nominal_damping_tangent(m_mesh))
+        * damping_row;
   }
 }
 
@@ -231,6 +239,7 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
   compute_element_states(mesh, x, v, states);
   std::vector<Vec12> element_forces(m);
   const material::ElasticModel* elastic = mesh.nominal.elastic.get();
+  const material::DampingTangent kind = nominal_damping_tangent(mesh);
   tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
     for (int e = r.begin(); e < r.end(); ++e) {
       const ElementState& s = states[e];
@@ -258,12 +267,13 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
         element_forces[e] += alpha1
             * (stiffness_damping_force(mesh.rest[e], s,
                    material::damping_tangent(
-                       s.frame, elastic_stress.stress, elastic_stress.d_stretches))
+                       s.frame, elastic_stress.stress, elastic_stress.d_stretches, kind))
                 - stiffness_damping_force(
-                    mesh.rest[e], s, material::damping_tangent(*elastic, s.frame)));
+                    mesh.rest[e], s, material::damping_tangent(*elastic, s.frame, kind)));
       }
       if (change != 0)
-        element_forces[e] += change * element_stiffness_damping_force(mesh.rest[e], s, *elastic);
+        element_forces[e]
+            += change * element_stiffness_damping_force(mesh.rest[e], s, *elastic, kind);
     }
   });
   VecX f = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));

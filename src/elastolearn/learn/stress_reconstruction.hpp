@@ -60,18 +60,19 @@ Eigen::Matrix<double, 12, 3> element_force_operator(
     const fem::TetRestData& rest, const material::PrincipalFrame& frame);
 
 /// The element's stiffness-damping force per unit Δα₁ [N·s]: −K_e v_e = −vol (dP/dF : Ḟ) g_a
-/// with dP/dF the damping tangent (material::damping_tangent) of the nominal model `elastic`,
-/// exactly as fem::ElasticForce applies Δα₁. Local dofs ordered x0, y0, z0, x1, ….
-Vec12 element_stiffness_damping_force(
-    const fem::TetRestData& rest, const ElementState& state, const material::ElasticModel& elastic);
+/// with dP/dF the damping tangent of kind `kind` (material::damping_tangent) of the nominal model
+/// `elastic`, exactly as fem::ElasticForce applies Δα₁. Local dofs ordered x0, y0, z0, x1, ….
+Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
+    const material::ElasticModel& elastic, material::DampingTangent kind);
 
 /// The element's stiffness-damping force per unit α₁ as a linear function of a principal stress
 /// and its stretch derivative: column c maps entry c of [p̂; vec(∂p̂/∂σ)] (3 + 9, column-major)
-/// to the nodal forces −vol (dP/dF : Ḟ) g_a of material::damping_tangent of p̂ [N·s per Pa]. Applied
+/// to the nodal forces −vol (dP/dF : Ḟ) g_a of material::damping_tangent of p̂ (of kind `kind`)
+/// [N·s per Pa]. Applied
 /// to an RBF unknown's output and gradient (RbfDesign::output_matrix) it gives that unknown's share
 /// of the nominal α₁'s action on the corrected stiffness (fem::ElasticForce).
 Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
-    const fem::TetRestData& rest, const ElementState& state);
+    const fem::TetRestData& rest, const ElementState& state, material::DampingTangent kind);
 
 /// Nodal forces [N] (flat 3n) of a correction: what fem::ElasticForce gives with it minus without
 /// it, f = Σ_e B_e N(σ_e, ḟ_e) + α₁ (−(K_e − K_e^d) v_e) + [(α₁ + Δα₁)⁺ − α₁] (−K_e^d v_e)

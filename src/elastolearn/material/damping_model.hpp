@@ -3,8 +3,10 @@
 /// coefficients may depend on the element's largest principal stretch (the "Bar Damping" cases).
 #include <elastolearn/core/types.hpp>
 
+#include <array>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace elastolearn::material {
 
@@ -13,7 +15,27 @@ struct RayleighCoefficients {
   double alpha1 = 0; ///< stiffness-proportional coefficient [s]
 };
 
-/// Rayleigh coefficients of one element as a function of its largest principal stretch.
+/// Which stiffness K(x) the α₁ term scales (docs/materials.md, "Damping"):
+/// - FlipFree: the exact tangent of the element's stress at x without its flip eigenvalues
+///   (P̂ᵢ + P̂ⱼ)/(σᵢ + σⱼ), unprojected. Linear in the stress, PSD for monotone materials, and it
+///   leaves the rigid rotation of a stressed element undamped. elastolearn's default.
+/// - Exact: the full exact tangent stiffness K(x) = −∂f/∂x at the end-of-step state,
+///   unprojected: the standard Rayleigh damping of Vega FEM, SOFA and Drake.
+enum class DampingTangent { FlipFree, Exact };
+
+/// Every damping tangent, in table order.
+inline constexpr std::array<DampingTangent, 2> all_damping_tangents
+    = { DampingTangent::FlipFree, DampingTangent::Exact };
+
+/// "flip-free", "exact" (the names of scene files' "damping.tangent").
+std::string to_string(DampingTangent tangent);
+
+/// Inverse of to_string. Throws InputError(where, ...) naming the bad string and the valid ones.
+DampingTangent damping_tangent_from_string(
+    std::string_view name, const std::string& where = "damping.tangent");
+
+/// Rayleigh coefficients of one element as a function of its largest principal stretch, and the
+/// stiffness their α₁ scales.
 class DampingModel {
   public:
   virtual ~DampingModel() = default;
@@ -22,6 +44,12 @@ class DampingModel {
   /// True if the coefficients do not depend on the stretch (lets the assembler skip work).
   virtual bool is_constant() const = 0;
   virtual std::unique_ptr<DampingModel> clone() const = 0;
+
+  DampingTangent tangent() const { return m_tangent; }
+  void set_tangent(DampingTangent tangent) { m_tangent = tangent; }
+
+  private:
+  DampingTangent m_tangent = DampingTangent::FlipFree;
 };
 
 } // namespace elastolearn::material

@@ -90,15 +90,18 @@ PrincipalTangent principal_tangent(
   return t;
 }
 
-PrincipalTangent damping_tangent(const PrincipalFrame& frame, const Vec3& P, const Mat3& dP) {
+PrincipalTangent damping_tangent(
+    const PrincipalFrame& frame, const Vec3& P, const Mat3& dP, DampingTangent kind) {
   PrincipalTangent t = principal_tangent(frame, P, dP, false);
-  t.flip.setZero();
+  if (kind == DampingTangent::FlipFree)
+    t.flip.setZero();
   return t;
 }
 
-PrincipalTangent damping_tangent(const ElasticModel& model, const PrincipalFrame& frame) {
+PrincipalTangent damping_tangent(
+    const ElasticModel& model, const PrincipalFrame& frame, DampingTangent kind) {
   return damping_tangent(frame, model.principal_stress(frame.stretches),
-      model.principal_stress_derivative(frame.stretches));
+      model.principal_stress_derivative(frame.stretches), kind);
 }
 
 Mat9 first_piola_derivative(const PrincipalFrame& frame, const PrincipalTangent& t) {

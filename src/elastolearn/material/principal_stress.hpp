@@ -4,6 +4,7 @@
 /// corrected model). 9×9 derivatives use column-major vec on both sides (see core/types.hpp).
 #include <elastolearn/core/types.hpp>
 #include <elastolearn/material/correction.hpp>
+#include <elastolearn/material/damping_model.hpp>
 #include <elastolearn/material/elastic_model.hpp>
 
 namespace elastolearn::material {
@@ -44,12 +45,14 @@ PrincipalTangent principal_tangent(
 PrincipalTangent projected(const PrincipalTangent& tangent);
 /// Symmetric part of a 3×3 matrix with its negative eigenvalues clamped to zero.
 Mat3 symmetric_psd(const Mat3& a);
-/// The stiffness that Rayleigh damping scales (fem::ElasticForce): the exact tangent of P̂ without
-/// its flip eigenvalues. Linear in (P̂, ∂P̂/∂σ).
+/// The stiffness that Rayleigh damping scales (fem::ElasticForce): the exact tangent of P̂,
+/// unprojected, with its flip eigenvalues set to zero for DampingTangent::FlipFree (see
+/// damping_model.hpp). Linear in (P̂, ∂P̂/∂σ) either way.
 PrincipalTangent damping_tangent(const PrincipalFrame& frame, const Vec3& principal_stress,
-    const Mat3& principal_stress_derivative);
+    const Mat3& principal_stress_derivative, DampingTangent kind);
 /// The same for an uncorrected model at the frame's stretches.
-PrincipalTangent damping_tangent(const ElasticModel& model, const PrincipalFrame& frame);
+PrincipalTangent damping_tangent(
+    const ElasticModel& model, const PrincipalFrame& frame, DampingTangent kind);
 /// The 9×9 dP/dF of an eigen-form tangent (symmetric if the tangent was projected).
 Mat9 first_piola_derivative(const PrincipalFrame& frame, const PrincipalTangent& tangent);
 /// dP = (dP/dF) : dF without forming the 9×9: dP = U dP̂ Vᵀ with, for dF̂ = Uᵀ dF V,

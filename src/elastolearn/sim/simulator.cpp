@@ -14,7 +14,7 @@ Simulator::Simulator(const Scene& scene)
   if (m_dofs.num_free() == 0)
     throw InputError("fixed", "every vertex is fixed or keyframed: nothing to simulate");
   m_system = fem::SystemMatrix(mesh.tets(), m_dofs);
-  m_elastic = std::make_unique<fem::ElasticForce>(mesh, m_scene.material);
+  m_elastic = std::make_unique<fem::ElasticForce>(mesh, m_scene.material, m_scene.mass);
   m_dof_masses = fem::lumped_dof_masses(fem::lumped_vertex_masses(
       mesh.tets(), m_elastic->rest_data(), mesh.num_vertices(), m_scene.material.density));
   m_reduced_masses = m_dofs.restrict(m_dof_masses);
