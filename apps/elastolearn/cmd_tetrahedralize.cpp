@@ -1,5 +1,6 @@
-// `elastolearn tetrahedralize surface.off --max-tets 3000 -o out.node`: closed surface → tet mesh
-// (TetGen run as an external program), printing counts, quality and output paths.
+// `elastolearn tetrahedralize surface.off --max-tets 3000 [--scale 0.001] -o out.node`: closed
+// surface → tet mesh (TetGen run as an external program), printing counts, quality and output
+// paths.
 #include "command.hpp"
 
 #include <elastolearn/core/error.hpp>
@@ -7,6 +8,7 @@
 #include <elastolearn/mesh/tetgen_io.hpp>
 #include <elastolearn/mesh/tetrahedralize.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -17,6 +19,7 @@ namespace {
 struct TetrahedralizeArgs {
   std::string input;
   std::string output;
+  double scale = 1; ///< applied to the surface before meshing (e.g. 0.001: millimetres → metres)
   mesh::TetrahedralizeOptions options;
 };
 
@@ -24,10 +27,17 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
   const std::filesystem::path out(args.output);
   if (out.has_extension() && out.extension() != ".node" && out.extension() != ".ele")
     throw InputError(args.output, "output must be a TetGen .node/.ele path (or their common stem)");
-  const mesh::SurfaceMesh surface = mesh::read_surface_mesh(args.input);
-  std::printf("surface   %s: %d vertices, %d faces, enclosed volume %.6g\n", args.input.c_str(),
+  if (!(args.scale > 0 && std::isfinite(args.scale)))
+    throw InputError(
+        "--scale", "must be a positive number (a negative scale would mirror the mesh)");
+  mesh::SurfaceMesh surface = mesh::read_surface_mesh(args.input);
+  surface.vertices *= args.scale;
+  char scaled[48] = "";
+  if (args.scale != 1)
+    std::snprintf(scaled, sizeof scaled, " (scaled by %g)", args.scale);
+  std::printf("surface   %s: %d vertices, %d faces, enclosed volume %.6g%s\n", args.input.c_str(),
       static_cast<int>(surface.vertices.rows()), static_cast<int>(surface.faces.rows()),
-      mesh::enclosed_volume(surface));
+      mesh::enclosed_volume(surface), scaled);
   mesh::TetrahedralizeReport report;
   const mesh::TetMesh tets = mesh::tetrahedralize(surface, args.options, &report, args.input);
   if (report.holes_filled > 0)
@@ -61,6 +71,9 @@ void add_tetrahedralize_command(CLI::App& root) {
       ->required();
   cmd->add_option("--max-tets", args->options.max_tets,
       "target tet count (not exceeded by more than 10%; 0 = no target)");
+  cmd->add_option("--scale", args->scale,
+      "scale the surface by this positive factor before meshing (e.g. 0.001: mm to m); "
+      "--max-volume is in the scaled units");
   cmd->add_option("--max-volume", args->options.max_volume, "maximum tet volume (0 = none)");
   cmd->add_option(
          "--quality", args->options.min_radius_edge_ratio, "maximum radius-edge ratio (TetGen -q)")

@@ -253,6 +253,35 @@ TEST(TrajectoryWriter, RejectedFrameLeavesTheFileConsistent) {
   EXPECT_EQ(read.positions[1], data.positions[1]);
 }
 
+TEST(TrajectoryFile, OneFrameIsReadAloneAndMatchesTheWholeFile) {
+  ScratchDir dir;
+  for (bool velocities : { true, false }) {
+    const TrajectoryData data = make_trajectory(7, 9, velocities);
+    write_trajectory_h5(dir / "t.h5", data);
+    EXPECT_EQ(read_trajectory_frame_count(dir / "t.h5"), 7);
+    for (long k : { 0L, 4L, 6L }) {
+      const TrajectoryFrame f = read_trajectory_frame(dir / "t.h5", k);
+      EXPECT_EQ(f.index, k);
+      EXPECT_EQ(f.frames, 7);
+      EXPECT_EQ(f.time, data.time[k]);
+      EXPECT_EQ(f.rest_positions, data.rest_positions);
+      EXPECT_EQ(f.positions, data.positions[k]);
+      if (velocities)
+        EXPECT_EQ(f.velocities, data.velocities[k]);
+      else
+        EXPECT_EQ(f.velocities.rows(), 0); // absent, not zero
+    }
+    for (long k : { -1L, 7L })
+      expect_input_error([&] { read_trajectory_frame(dir / "t.h5", k); },
+          { "t.h5: /positions", "frame " + std::to_string(k) + " is out of range [0, 7)" });
+  }
+  RawFile raw; // the frame's shape is checked as when reading the whole file
+  raw.f64["/velocities"] = { std::vector<double>(36, 0.0), { 3, 4, 3 } };
+  raw.write(dir / "bad.h5");
+  expect_input_error([&] { read_trajectory_frame(dir / "bad.h5", 1); },
+      { "bad.h5: /velocities", "expected shape (T, n, 3) = (3, 5, 3), got (3, 4, 3)" });
+}
+
 // --- bad files: one clear error naming the file and the dataset -----------------------------
 
 TEST(TrajectoryFileRejects, MissingDataset) {

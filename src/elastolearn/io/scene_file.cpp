@@ -1,6 +1,8 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
+#include <elastolearn/io/trajectory_file.hpp>
+#include <elastolearn/mesh/placement.hpp>
 #include <elastolearn/mesh/primitives.hpp>
 #include <elastolearn/mesh/read_tet_mesh.hpp>
 #include <elastolearn/mesh/vertex_selection.hpp>
@@ -16,9 +18,29 @@ int parse_axis(const JsonObject& o, const std::string& key) {
   return a[0] - 'x';
 }
 
-mesh::TetMesh parse_mesh(const JsonObject& o, const std::filesystem::path& base_dir) {
+/// The optional placement keys of `mesh` (scale, rotate_deg, translate).
+mesh::Placement parse_placement(const JsonObject& o) {
+  mesh::Placement p;
+  if (o.has("scale")) {
+    p.scale = o.number("scale");
+    if (!(p.scale > 0))
+      o.fail("scale",
+          "must be positive (a negative scale would mirror the mesh and invert its tets), got "
+              + describe_json(o.json().at("scale")));
+  }
+  p.rotate_deg = o.vec3("rotate_deg", Vec3::Zero());
+  p.translate = o.vec3("translate", Vec3::Zero());
+  return p;
+}
+
+mesh::TetMesh unplaced_mesh(const JsonObject& o, const std::filesystem::path& base_dir) {
+  const std::vector<std::string> placement = { "scale", "rotate_deg", "translate" };
+  auto known = [&](std::vector<std::string> keys) {
+    keys.insert(keys.end(), placement.begin(), placement.end());
+    return keys;
+  };
   if (o.has("file")) {
-    o.reject_unknown_keys({ "file" });
+    o.reject_unknown_keys(known({ "file" }));
     std::filesystem::path p = o.string("file");
     if (p.is_relative())
       p = base_dir / p;
@@ -26,7 +48,7 @@ mesh::TetMesh parse_mesh(const JsonObject& o, const std::filesystem::path& base_
   }
   const std::string type = o.choice("type", { "box", "sphere" });
   if (type == "box") {
-    o.reject_unknown_keys({ "type", "size", "cells" });
+    o.reject_unknown_keys(known({ "type", "size", "cells" }));
     const Vec3 size = o.vec3("size");
     if (!(size.minCoeff() > 0))
       o.fail("size", "all sizes must be positive");
@@ -35,11 +57,49 @@ mesh::TetMesh parse_mesh(const JsonObject& o, const std::filesystem::path& base_
       o.fail("cells", "expected three positive integers");
     return mesh::make_box_bar(size, { cells[0], cells[1], cells[2] });
   }
-  o.reject_unknown_keys({ "type", "radius", "tets" });
+  o.reject_unknown_keys(known({ "type", "radius", "tets" }));
   const int tets = o.integer("tets");
   if (tets < 8)
     o.fail("tets", "must be at least 8");
   return mesh::make_sphere(o.positive("radius"), tets);
+}
+
+/// The mesh (file or procedural), scaled, rotated and translated as the scene asks.
+mesh::TetMesh parse_mesh(const JsonObject& o, const std::filesystem::path& base_dir) {
+  const mesh::Placement placement = parse_placement(o);
+  return mesh::place(unplaced_mesh(o, base_dir), placement, o.file() + ": " + o.path());
+}
+
+/// The vertices a selection object names (possibly none).
+std::vector<int> select_vertices(const JsonObject& o, const mesh::TetMesh& mesh) {
+  o.reject_unknown_keys({ "vertices", "box", "plane", "min", "max" });
+  const int kinds = o.has("vertices") + o.has("box") + o.has("plane") + o.has("min") + o.has("max");
+  if (kinds != 1)
+    o.fail("", "a selection needs exactly one of vertices, box, plane, min, max");
+  if (o.has("vertices")) {
+    auto v = o.integers("vertices");
+    for (int i : v)
+      if (i < 0 || i >= mesh.num_vertices())
+        o.fail("vertices",
+            "index " + std::to_string(i) + " out of range [0, "
+                + std::to_string(mesh.num_vertices()) + ")");
+    return v;
+  }
+  if (o.has("box")) {
+    const JsonObject b = o.object("box");
+    b.reject_unknown_keys({ "min", "max" });
+    return mesh::vertices_in_box(mesh, Box3(b.vec3("min"), b.vec3("max")));
+  }
+  const double tol = 1e-9 * std::max(1.0, mesh.bounding_box_diagonal());
+  if (o.has("plane")) {
+    const JsonObject p = o.object("plane");
+    p.reject_unknown_keys({ "axis", "value", "tolerance" });
+    return mesh::vertices_near_plane(
+        mesh, parse_axis(p, "axis"), p.number("value"), p.number("tolerance", tol));
+  }
+  if (o.has("min"))
+    return mesh::vertices_with_min_coordinate(mesh, parse_axis(o, "min"), tol);
+  return mesh::vertices_with_max_coordinate(mesh, parse_axis(o, "max"), tol);
 }
 
 std::vector<int> parse_selection_list(
@@ -58,8 +118,6 @@ sim::KeyframeMotion parse_keyframe(const JsonObject& o, const mesh::TetMesh& mes
   o.reject_unknown_keys({ "select", "sinusoid", "piecewise_linear" });
   sim::KeyframeMotion k;
   k.vertices = parse_selection(o.object("select"), mesh);
-  if (k.vertices.empty())
-    o.fail("select", "selects no vertex");
   if (o.has("sinusoid") == o.has("piecewise_linear"))
     o.fail("sinusoid", "give exactly one of \"sinusoid\" or \"piecewise_linear\"");
   if (o.has("sinusoid")) {
@@ -95,17 +153,75 @@ sim::PointLoad parse_load(const JsonObject& o, const mesh::TetMesh& mesh) {
   o.reject_unknown_keys({ "select", "force", "release_time" });
   sim::PointLoad l;
   l.vertices = parse_selection(o.object("select"), mesh);
-  if (l.vertices.empty())
-    o.fail("select", "selects no vertex");
   l.total_force = o.vec3("force");
   l.release_time = o.number("release_time", std::numeric_limits<double>::infinity());
   return l;
 }
 
-sim::InitialCondition parse_initial(const JsonObject& o, const mesh::TetMesh& mesh) {
+/// `{"type": "trajectory", "file": F, "frame": k}`: frame k of trajectory file F (k < 0 counts
+/// from the end), which must have been recorded on the scene's mesh.
+void parse_recorded_state(const JsonObject& o, const mesh::TetMesh& mesh,
+    const std::filesystem::path& base_dir, sim::InitialCondition& ic) {
+  o.reject_unknown_keys({ "type", "file", "frame" });
+  std::filesystem::path path = o.string("file");
+  if (path.is_relative())
+    path = base_dir / path;
+  const std::string name = o.string("file");
+  const int requested = o.integer("frame");
+  // Errors inside the trajectory file name both the scene field and the file's dataset.
+  long frames = 0;
+  try {
+    frames = read_trajectory_frame_count(path);
+  } catch (const InputError& e) {
+    o.fail("file", e.what());
+  }
+  if (frames == 0)
+    o.fail("frame", name + " has no frames");
+  const long index = requested < 0 ? frames + requested : requested;
+  if (index < 0 || index >= frames) {
+    o.fail("frame",
+        std::to_string(requested) + " is out of range: " + name + " has " + std::to_string(frames)
+            + " frames (0.." + std::to_string(frames - 1) + ", or -" + std::to_string(frames)
+            + "..-1 counting from the end)");
+  }
+  TrajectoryFrame frame;
+  try {
+    frame = read_trajectory_frame(path, index);
+  } catch (const InputError& e) {
+    o.fail("file", e.what());
+  }
+  const Eigen::Index n = mesh.num_vertices();
+  if (frame.positions.rows() != n) {
+    o.fail("file",
+        name + " has " + std::to_string(frame.positions.rows())
+            + " vertices but the scene mesh has " + std::to_string(n));
+  }
+  // Same count but another mesh (or the same mesh placed differently) would start the motion
+  // from a state that does not belong to this rest shape. Files elastolearn writes hold the rest
+  // positions exactly; 1e-6 of the mesh size leaves room for single-precision copies.
+  const double tolerance = 1e-6 * mesh.bounding_box_diagonal();
+  Eigen::Index worst = 0;
+  const double distance
+      = (frame.rest_positions - mesh.rest_positions()).rowwise().norm().maxCoeff(&worst);
+  if (!(distance <= tolerance)) {
+    o.fail("file",
+        name + " was recorded on another mesh or placement: the rest position of vertex "
+            + std::to_string(worst) + " is " + describe_json(distance)
+            + " m from the scene mesh's");
+  }
+  ic.kind = sim::InitialCondition::Kind::Recorded;
+  ic.positions = std::move(frame.positions);
+  ic.velocities = std::move(frame.velocities);
+  ic.time = frame.time;
+}
+
+sim::InitialCondition parse_initial(
+    const JsonObject& o, const mesh::TetMesh& mesh, const std::filesystem::path& base_dir) {
   sim::InitialCondition ic;
-  const std::string type = o.choice("type", { "rest", "velocity", "static" }, "rest");
-  if (type == "rest") {
+  const std::string type = o.choice("type", { "rest", "velocity", "static", "trajectory" }, "rest");
+  if (type == "trajectory") {
+    parse_recorded_state(o, mesh, base_dir, ic);
+  } else if (type == "rest") {
     o.reject_unknown_keys({ "type" });
   } else if (type == "velocity") {
     o.reject_unknown_keys({ "type", "velocity", "angular_velocity", "center" });
@@ -128,34 +244,10 @@ sim::InitialCondition parse_initial(const JsonObject& o, const mesh::TetMesh& me
 } // namespace
 
 std::vector<int> parse_selection(const JsonObject& o, const mesh::TetMesh& mesh) {
-  o.reject_unknown_keys({ "vertices", "box", "plane", "min", "max" });
-  const int kinds = o.has("vertices") + o.has("box") + o.has("plane") + o.has("min") + o.has("max");
-  if (kinds != 1)
-    o.fail("", "a selection needs exactly one of vertices, box, plane, min, max");
-  if (o.has("vertices")) {
-    auto v = o.integers("vertices");
-    for (int i : v)
-      if (i < 0 || i >= mesh.num_vertices())
-        o.fail("vertices",
-            "index " + std::to_string(i) + " out of range [0, "
-                + std::to_string(mesh.num_vertices()) + ")");
-    return v;
-  }
-  if (o.has("box")) {
-    const JsonObject b = o.object("box");
-    b.reject_unknown_keys({ "min", "max" });
-    return mesh::vertices_in_box(mesh, Box3(b.vec3("min"), b.vec3("max")));
-  }
-  const double tol = 1e-9 * std::max(1.0, mesh.bounding_box_diagonal());
-  if (o.has("plane")) {
-    const JsonObject p = o.object("plane");
-    p.reject_unknown_keys({ "axis", "value", "tolerance" });
-    return mesh::vertices_near_plane(
-        mesh, parse_axis(p, "axis"), p.number("value"), p.number("tolerance", tol));
-  }
-  if (o.has("min"))
-    return mesh::vertices_with_min_coordinate(mesh, parse_axis(o, "min"), tol);
-  return mesh::vertices_with_max_coordinate(mesh, parse_axis(o, "max"), tol);
+  std::vector<int> selected = select_vertices(o, mesh);
+  if (selected.empty())
+    o.fail("", "selects no vertex");
+  return selected;
 }
 
 SceneFile parse_scene(
@@ -183,7 +275,7 @@ SceneFile parse_scene(
     for (const auto& l : root.objects("loads"))
       s.loads.push_back(parse_load(l, s.mesh));
   if (root.has("initial"))
-    s.initial = parse_initial(root.object("initial"), s.mesh);
+    s.initial = parse_initial(root.object("initial"), s.mesh, base_dir);
   const JsonObject time = root.object("time");
   time.reject_unknown_keys({ "dt", "frames" });
   s.dt = time.positive("dt");

@@ -37,6 +37,8 @@ SceneFile parse_scene(
 /// A vertex selection: {"vertices": [...]} | {"box": {"min": [..], "max": [..]}} |
 /// {"plane": {"axis": "x"|"y"|"z", "value": v, "tolerance": t}} | {"min": "x"} | {"max": "y"}
 /// (the vertices at the extreme coordinate along an axis, within 1e-9 of the bounding box).
+/// Throws InputError naming the selection object (e.g. "scene.json: fixed[0]: selects no
+/// vertex") if it selects no vertex: an empty selection is always a mistake in the scene.
 std::vector<int> parse_selection(const JsonObject& object, const mesh::TetMesh& mesh);
 
 } // namespace elastolearn::io

@@ -337,8 +337,8 @@ Table read_table(const h5::File& file, const char* dataset, Eigen::Index n) {
   return table;
 }
 
-/// Read a (T, n, 3) dataset frame by frame, checking every value is finite.
-std::vector<Positions> read_frames(
+/// Check that `dataset` has shape (frames, n, 3).
+void require_frames_shape(
     const h5::File& file, const char* dataset, hsize_t frames, Eigen::Index n) {
   const h5::Shape shape = file.shape(dataset);
   if (shape.size() == 3 && shape[0] != frames && shape[1] == hsize_t(n) && shape[2] == 3) {
@@ -346,6 +346,12 @@ std::vector<Positions> read_frames(
         "has " + std::to_string(shape[0]) + " frames but /time has " + std::to_string(frames));
   }
   require_shape(file, dataset, { frames, hsize_t(n), 3 }, "(T, n, 3)");
+}
+
+/// Read a (T, n, 3) dataset frame by frame, checking every value is finite.
+std::vector<Positions> read_frames(
+    const h5::File& file, const char* dataset, hsize_t frames, Eigen::Index n) {
+  require_frames_shape(file, dataset, frames, n);
   const h5::Dataset ds = file.dataset(dataset); // open once: its chunk cache serves every frame
   std::vector<Positions> out(frames, Positions(n, 3));
   for (hsize_t t = 0; t < frames; ++t) {
@@ -358,30 +364,61 @@ std::vector<Positions> read_frames(
 
 } // namespace
 
-TrajectoryData read_trajectory_h5(const std::filesystem::path& path) {
-  const h5::File file = h5::File::open(path);
-  check_format(file);
-  TrajectoryData data;
+namespace {
 
+/// Rest positions and times of an opened trajectory, format checked.
+struct TrajectoryHeader {
+  Positions rest_positions;
+  std::vector<double> time;
+  Eigen::Index vertices() const { return rest_positions.rows(); }
+};
+
+TrajectoryHeader read_header(const h5::File& file) {
+  check_format(file);
+  TrajectoryHeader header;
   const h5::Shape rest_shape = require_shape(file, "/rest_positions", { k_any, 3 }, "(n, 3)");
   const Eigen::Index n = Eigen::Index(rest_shape[0]);
   if (n == 0)
     file.fail("/rest_positions", "no vertices");
-  data.rest_positions.resize(n, 3);
-  file.read("/rest_positions", data.rest_positions.data());
-  check_finite(file.name() + ": /rest_positions", data.rest_positions.data(), n);
+  header.rest_positions.resize(n, 3);
+  file.read("/rest_positions", header.rest_positions.data());
+  check_finite(file.name() + ": /rest_positions", header.rest_positions.data(), n);
 
   const h5::Shape time_shape = require_shape(file, "/time", { k_any }, "(T,)");
-  data.time.resize(time_shape[0]);
-  file.read("/time", data.time.data());
-  for (std::size_t t = 0; t < data.time.size(); ++t) {
-    check_time(file.name() + ": /time", long(t), data.time[t],
-        t ? std::optional<double>(data.time[t - 1]) : std::nullopt);
+  header.time.resize(time_shape[0]);
+  file.read("/time", header.time.data());
+  for (std::size_t t = 0; t < header.time.size(); ++t) {
+    check_time(file.name() + ": /time", long(t), header.time[t],
+        t ? std::optional<double>(header.time[t - 1]) : std::nullopt);
   }
+  return header;
+}
 
-  data.positions = read_frames(file, "/positions", time_shape[0], n);
+/// Frame `index` of the (T, n, 3) dataset, shape and finiteness checked.
+Positions read_one_frame(
+    const h5::File& file, const char* dataset, hsize_t frames, Eigen::Index n, hsize_t index) {
+  require_frames_shape(file, dataset, frames, n);
+  Positions out(n, 3);
+  file.dataset(dataset).read(out.data(), index, 1);
+  check_finite(
+      file.name() + ": " + dataset, out.data(), n, "frame " + std::to_string(index) + ": ");
+  return out;
+}
+
+} // namespace
+
+TrajectoryData read_trajectory_h5(const std::filesystem::path& path) {
+  const h5::File file = h5::File::open(path);
+  TrajectoryHeader header = read_header(file);
+  const Eigen::Index n = header.vertices();
+  const hsize_t frames = header.time.size();
+  TrajectoryData data;
+  data.rest_positions = std::move(header.rest_positions);
+  data.time = std::move(header.time);
+
+  data.positions = read_frames(file, "/positions", frames, n);
   if (file.exists("/velocities"))
-    data.velocities = read_frames(file, "/velocities", time_shape[0], n);
+    data.velocities = read_frames(file, "/velocities", frames, n);
   data.tets = read_table<Tets>(file, "/tets", n);
   data.edges = read_table<Edges>(file, "/edges", n);
   data.faces = read_table<Faces>(file, "/faces", n);
@@ -389,6 +426,32 @@ TrajectoryData read_trajectory_h5(const std::filesystem::path& path) {
   data.metadata = file.attributes("/");
   data.metadata.erase("format");
   return data;
+}
+
+long read_trajectory_frame_count(const std::filesystem::path& path) {
+  const h5::File file = h5::File::open(path);
+  check_format(file);
+  return long(require_shape(file, "/time", { k_any }, "(T,)")[0]);
+}
+
+TrajectoryFrame read_trajectory_frame(const std::filesystem::path& path, long index) {
+  const h5::File file = h5::File::open(path);
+  TrajectoryHeader header = read_header(file);
+  const long frames = long(header.time.size());
+  if (index < 0 || index >= frames) {
+    file.fail("/positions",
+        "frame " + std::to_string(index) + " is out of range [0, " + std::to_string(frames) + ")");
+  }
+  TrajectoryFrame out;
+  out.index = index;
+  out.frames = frames;
+  out.time = header.time[std::size_t(index)];
+  const Eigen::Index n = header.vertices();
+  out.positions = read_one_frame(file, "/positions", hsize_t(frames), n, hsize_t(index));
+  if (file.exists("/velocities"))
+    out.velocities = read_one_frame(file, "/velocities", hsize_t(frames), n, hsize_t(index));
+  out.rest_positions = std::move(header.rest_positions);
+  return out;
 }
 
 } // namespace elastolearn::io

@@ -76,6 +76,25 @@ class TrajectoryWriter {
 /// Throws InputError naming the file and dataset on any problem.
 TrajectoryData read_trajectory_h5(const std::filesystem::path& path);
 
+/// One recorded state of a trajectory file.
+struct TrajectoryFrame {
+  long index = 0; ///< frame index in [0, frames)
+  long frames = 0; ///< T, the number of frames in the file
+  double time = 0; ///< [s]
+  Positions rest_positions; ///< n×3 [m]
+  Positions positions; ///< n×3 [m]
+  Positions velocities; ///< n×3 [m/s], or empty when the file has no /velocities
+};
+
+/// The number of frames T of a trajectory file (its format and /time checked). Throws
+/// InputError naming the file and dataset.
+long read_trajectory_frame_count(const std::filesystem::path& path);
+
+/// Read frame `index` (0 ≤ index < T) without loading the other frames. What is read is
+/// validated as by read_trajectory_h5 (format, shapes, increasing times, finite values).
+/// Throws InputError naming the file and dataset, also for an index out of range.
+TrajectoryFrame read_trajectory_frame(const std::filesystem::path& path, long index);
+
 /// Write one VTU per frame (`<stem>_NNNN.vtu`, VTK XML UnstructuredGrid, ASCII-free binary
 /// appended data not required: base64 inline) and `<stem>.pvd` indexing them with their times,
 /// into `directory`. Cells: tets (VTK_TETRA), else faces (VTK_TRIANGLE), else edges (VTK_LINE).

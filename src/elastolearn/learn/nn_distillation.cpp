@@ -223,6 +223,11 @@ std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const 
     s.initial.angular_velocity *= a;
     for (auto& l : s.initial.static_loads)
       l.total_force *= a;
+    if (s.initial.kind == sim::InitialCondition::Kind::Recorded) {
+      const Positions& rest = s.mesh.rest_positions();
+      s.initial.positions = rest + a * (s.initial.positions - rest);
+      s.initial.velocities *= a;
+    }
     for (auto& l : s.loads)
       l.total_force *= a;
     for (auto& m : s.keyframes) {

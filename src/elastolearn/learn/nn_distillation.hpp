@@ -74,8 +74,9 @@ StressSamples distillation_samples(const sim::Scene& scene, std::span<const doub
     DistillationSampleReport* report = nullptr);
 
 /// Copies of `scene` whose motion is scaled by each factor: gravity, initial velocity and angular
-/// velocity, static (initial) loads, point loads and keyframe amplitudes/offsets are multiplied
-/// by the factor (the mesh and material are kept), and the copy's name gets a "_x<factor>"
+/// velocity, static (initial) loads, point loads, keyframe amplitudes/offsets and a recorded
+/// initial state's displacement and velocities are multiplied by the factor (the mesh and
+/// material are kept), and the copy's name gets a "_x<factor>"
 /// suffix. Every driver is scaled alike, so in the linear regime the displacements scale by the
 /// factor (a scene driven by gravity alone, e.g. a droop, would otherwise not change at all).
 /// Training on several amplitudes covers more of the stretch space than the one observed motion.

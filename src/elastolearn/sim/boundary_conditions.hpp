@@ -51,8 +51,16 @@ struct PointLoad {
 };
 
 /// How the motion starts.
+/// - Rest: rest positions (prescribed vertices where their motion puts them at t = 0), zero
+///   velocity, t = 0.
+/// - Velocity: rest positions with the rigid velocity field below, t = 0.
+/// - StaticLoad: static equilibrium under gravity + static_loads, zero velocity, t = 0.
+/// - Recorded: a given state (e.g. a frame of a trajectory file) at `time`; the simulation
+///   continues from it, so keyframes and load release times keep the clock of the recording.
+///   Prescribed vertices are put at their prescribed positions at `time`; fixed vertices get
+///   zero velocity, every other vertex the given one.
 struct InitialCondition {
-  enum class Kind { Rest, Velocity, StaticLoad };
+  enum class Kind { Rest, Velocity, StaticLoad, Recorded };
   Kind kind = Kind::Rest;
   Vec3 velocity = Vec3::Zero(); ///< Velocity: v(X) = velocity + angular_velocity × (X − center)
   Vec3 angular_velocity = Vec3::Zero(); ///< [rad/s]
@@ -60,6 +68,9 @@ struct InitialCondition {
   std::vector<PointLoad>
       static_loads; ///< StaticLoad: equilibrium under gravity + these, then released
   int load_steps = 5; ///< StaticLoad: load increments of the static solve
+  Positions positions; ///< Recorded: n×3 [m]
+  Positions velocities; ///< Recorded: n×3 [m/s], or empty for zero velocities
+  double time = 0; ///< Recorded: time of the state [s], where the simulation starts
 };
 
 /// The loads of a scene as one force term: gravity M g plus point loads until their release.

@@ -52,6 +52,20 @@ void Scene::validate() const {
   };
   check_loads(loads, "loads");
   check_loads(initial.static_loads, "initial.loads");
+  if (initial.kind == InitialCondition::Kind::Recorded) {
+    const auto rows = [](const Positions& p) { return std::to_string(p.rows()); };
+    if (initial.positions.rows() != n || !initial.positions.allFinite())
+      throw InputError("initial",
+          "the recorded state must hold " + std::to_string(n) + " finite positions, got "
+              + rows(initial.positions));
+    if (initial.velocities.rows() != 0
+        && (initial.velocities.rows() != n || !initial.velocities.allFinite()))
+      throw InputError("initial",
+          "the recorded velocities must be absent or " + std::to_string(n) + " finite vectors, got "
+              + rows(initial.velocities));
+    if (!std::isfinite(initial.time))
+      throw InputError("initial", "the recorded time must be finite");
+  }
   if (initial.kind == InitialCondition::Kind::StaticLoad && prescribed_vertices().empty())
     throw InputError("initial", "a static initial state needs fixed or keyframed vertices");
   newton.validate();

@@ -66,6 +66,8 @@ void Simulator::set_state(const VecX& x, const VecX& v, double time) {
   m_x = x;
   m_v = v;
   m_time = time;
+  m_start_time = time;
+  m_step = 0;
 }
 
 double Simulator::kinetic_energy() const {
@@ -101,7 +103,8 @@ void Simulator::sum_jacobians(const VecX& x, const VecX& v, double t, double c_x
 
 NewtonReport Simulator::step() {
   const double h = m_scene.dt;
-  const double t_next = (m_step + 1) * h;
+  // From the step count rather than m_time + h, so that round-off does not accumulate.
+  const double t_next = m_start_time + (m_step + 1) * h;
   // Unknowns: free end-of-step velocities. Prescribed velocities follow the keyframes; they are
   // set once per step here (free entries are overwritten by each Newton iterate).
   m_v_new = (prescribed_positions(t_next) - m_x) / h;
@@ -211,13 +214,26 @@ NewtonReport Simulator::solve_static(int load_steps) {
 
 NewtonReport Simulator::apply_initial_condition() {
   const auto& ic = m_scene.initial;
-  m_x = prescribed_positions(0); // rest, with prescribed vertices where they are at t = 0
+  const double t0 = ic.kind == InitialCondition::Kind::Recorded ? ic.time : 0.0;
+  m_x = prescribed_positions(t0); // rest, with prescribed vertices where they are at t0
   m_v.setZero();
-  m_time = 0;
+  m_time = t0;
+  m_start_time = t0;
   m_step = 0;
   NewtonReport report;
   report.converged = true;
-  if (ic.kind == InitialCondition::Kind::Velocity) {
+  if (ic.kind == InitialCondition::Kind::Recorded) {
+    // Free vertices take the recorded state; prescribed ones stay where their motion puts them.
+    // Keyframed and tracked vertices keep their recorded velocities (with a consistent mass
+    // matrix they enter the first step's inertia), fixed vertices do not move.
+    const VecX x = flatten(ic.positions);
+    for (int dof : m_dofs.free_dofs())
+      m_x[dof] = x[dof];
+    if (ic.velocities.rows() > 0)
+      m_v = flatten(ic.velocities);
+    for (int v : m_scene.fixed_vertices)
+      m_v.segment<3>(3 * v).setZero();
+  } else if (ic.kind == InitialCondition::Kind::Velocity) {
     const auto& X = m_scene.mesh.rest_positions();
     for (int v = 0; v < m_scene.mesh.num_vertices(); ++v)
       if (!m_dofs.is_prescribed_vertex(v))

@@ -24,8 +24,9 @@ class Simulator {
   /// `apply_initial_condition()` to set the scene's initial state.
   explicit Simulator(const Scene& scene);
 
-  /// Set the scene's initial condition (rest, velocity field, or static equilibrium under a load).
-  /// Returns the static solve's report (converged = true for the other kinds).
+  /// Set the scene's initial condition (rest, velocity field, static equilibrium under a load, or
+  /// a recorded state) and its time (0, or the recorded state's). Returns the static solve's
+  /// report (converged = true for the other kinds).
   NewtonReport apply_initial_condition();
 
   /// Advance one time step. On failure (Newton did not converge, non-finite state) the state is
@@ -39,7 +40,9 @@ class Simulator {
   const VecX& positions() const { return m_x; } ///< flat 3n [m]
   const VecX& velocities() const { return m_v; } ///< flat 3n [m/s]
   double time() const { return m_time; }
+  /// Steps taken since the state was last set (initial condition or set_state()).
   int step_index() const { return m_step; }
+  /// Set the state at `time`; the following steps end at time + dt, time + 2·dt, ...
   void set_state(const VecX& x, const VecX& v, double time);
 
   double kinetic_energy() const;
@@ -73,7 +76,8 @@ class Simulator {
   VecX m_consistent_values; ///< consistent mass values in the system pattern
   VecX m_x, m_v;
   double m_time = 0;
-  int m_step = 0;
+  double m_start_time = 0; ///< time of the state that step 0 started from
+  int m_step = 0; ///< steps since m_start_time; step k ends at m_start_time + k·dt
   // Work vectors (no allocation per Newton iteration).
   VecX m_x_new, m_v_new, m_force, m_dv, m_mass_dv, m_x_prescribed;
   VecX m_first_increment; ///< previous step's first Newton increment (warm start for CG)
