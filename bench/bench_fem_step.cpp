@@ -7,6 +7,7 @@
 //
 //   ./build/bench/bench_fem_step --benchmark_filter='corotated/.*'   (subset)
 //   ./build/bench/bench_fem_step --no-jacobian-reuse ...   (every Newton iteration assembles)
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
 #include <elastolearn/mesh/primitives.hpp>
@@ -14,7 +15,6 @@
 #include <elastolearn/sim/simulator.hpp>
 
 #include <benchmark/benchmark.h>
-#include <chrono>
 #include <string>
 #include <tbb/global_control.h>
 
@@ -61,9 +61,9 @@ void step_benchmark(
   sim::SolverTimings timings;
   double seconds = 0;
   for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     const auto report = simulator.step();
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    seconds += seconds_since(t0);
     if (!report.converged)
       state.SkipWithError(report.message.c_str());
     newton += report.iterations;

@@ -1,10 +1,10 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/space_time.hpp>
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -249,7 +249,7 @@ SpaceTimeResult optimize_space_time(TrajectoryPhysics& physics, ConstRef<MatX> b
     const std::vector<VecX>& origin, const VecX& v0, const observe::Observation& observed,
     const SpaceTimeOptions& options, const ProgressCallback& progress) {
   options.validate();
-  const auto start_time = std::chrono::steady_clock::now();
+  const auto start_time = Clock::now();
   const int T = static_cast<int>(origin.size()) - 1;
   for (const auto& state : origin)
     if (state.size() != basis.rows())
@@ -312,8 +312,7 @@ SpaceTimeResult optimize_space_time(TrajectoryPhysics& physics, ConstRef<MatX> b
       ? static_cast<double>(observed.num_observed())
       : 1.0;
   result.position_rms = std::sqrt(current.position_squares / ((T + 1) * observed_points));
-  result.seconds
-      = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  result.seconds = seconds_since(start_time);
   return result;
 }
 
