@@ -74,23 +74,17 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   ASSERT_TRUE(run_learning(bar_scene(nominal, false), observed, small_options(), state));
   ASSERT_TRUE(state.best);
   ASSERT_FALSE(state.history.empty());
-  // The training fit improves by well over an order of magnitude (measured 4.3e-3 m → 1.2e-4 m
-  // RMS; a stage that stops working leaves it near the nominal's).
+  // The training fit improves by well over an order of magnitude (a stage that stops working
+  // leaves it near the nominal's).
   EXPECT_LT(state.best_error, 0.05 * state.history.front().forward_error.rms);
 
   const double nominal_error = swing_error(bar_scene(truth, true), bar_scene(nominal, true));
   const double learned_error
       = swing_error(bar_scene(truth, true), with_correction(bar_scene(nominal, true), state.best));
-  // Stored regression numbers (Release build, this configuration): nominal 4.450 %, learned
-  // 0.0312 % (140× lower). History: 0.0556 % before the learned damping scaled the nominal
-  // stiffness, then 0.138 %, 0.0938 % since the POD basis also spans the constrained simulation
-  // (nominal 4.304 %), 0.0680 % since Rayleigh's α₁ acts on the corrected stiffness without its
-  // flip part (which also changed the truth's damping, hence the new nominal figure), 0.0457 %
-  // since the reconstruction fits the forces mainly within span Φ (0.0588 % with μ = 0.3), 0.0446 %
-  // since the correction is stress-free at rest (RbfFitOptions::stress_free_rest), 0.0312 % since
-  // the learned Δα₁ scales the nominal's damping tangent, the matrix α₁ scales. The
-  // issue asks for ≥ 5× below the nominal; we assert that and that we have not regressed by more
-  // than 2× from the stored learned figure (a compiler's different rounding moves it a little; a
+  // Stored regression figures (Release build, this configuration): nominal 4.450 %, learned
+  // 0.0312 % (140× lower; how each change of the loop moved them: docs/benchmarks_learning.md).
+  // The issue asks for ≥ 5× below the nominal; the test asserts that, and that the learned figure
+  // stays within 2× of the stored one (a compiler's different rounding moves it a little; a
   // broken stage moves it by orders of magnitude).
   std::printf("[ measured ] err_L nominal %.4f %%, learned %.4f %% (best iteration %d)\n",
       nominal_error, learned_error, state.best_iteration);
@@ -99,12 +93,10 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   EXPECT_LT(learned_error, 2 * 0.0312);
 
   // The distilled network (paper §6.2, `learn --network`): N fitted on the training motion at
-  // three amplitudes, Δα₁ carried over. It must simulate the unseen swing stably and stay well
-  // below the nominal error (its fit is ~1.5 % of the teacher's output; stored figure 0.0435 %,
-  // same 2× regression margin; 0.0462 % before Δα₁ scaled the damping tangent, 0.112 % before the
-  // stress-free rest, 0.123 % before Rayleigh's α₁ acted on the corrected stiffness, 0.109 % before
-  // the projected reconstruction). Before Δα₁ was carried over instead of distilled, the network's
-  // simulation of the demo's test motion diverged.
+  // three amplitudes, Δα₁ carried over from the teacher (distilled instead, the network's
+  // simulation of the demo's test motion diverges: docs/learning.md). It must simulate the unseen
+  // swing stably and stay well below the nominal error (its fit is ~1.5 % of the teacher's
+  // output; stored figure 0.0435 %, the same 2× regression margin).
   DistillationSampleOptions so;
   so.recorded_samples = 10000;
   const std::vector<double> scales { 0.5, 1.0, 2.0 };

@@ -33,8 +33,8 @@ struct MaterialModel {
 /// (paper Eq. 13; α₁ + Δα₁ kept ≥ 0) scales the nominal stiffness K_e^nom, so that the damping
 /// force stays linear in the correction's unknowns (learn::reconstruct_rbf_correction). α₁'s
 /// K_e is material::damping_tangent of P̂ + N(σ, 0): exact, without its flip part, unprojected
-/// (a projected one would make the force nonlinear in the correction, and the learned correction
-/// diverged with it; measured in docs/learning.md, "Damping part"). Δα₁'s K_e^nom is the same
+/// (a projected one would make the force nonlinear in the correction, and learned corrections
+/// diverge with it: docs/learning.md, "Damping part"). Δα₁'s K_e^nom is the same
 /// damping tangent of the nominal P̂ (independent of the unknowns), so that where N = 0 a learned
 /// Δα₁ is exactly a change of α₁. The correction's rate dependence adds
 /// D_e = vol Bᵀ ∂P/∂Ḟ B

@@ -16,8 +16,8 @@ namespace {
 
 /// out = A B for sparse matrices A of one fixed pattern and a fixed dense B of a few columns
 /// (Φ on the free dofs), row by row: each row of A is read once for all columns of B, where
-/// Eigen's column-major sparse × dense product walks the whole of A once per column (it was 9 %
-/// of a learning run). Entry (i, j) is summed over A's columns in increasing order starting
+/// Eigen's column-major sparse × dense product walks the whole of A once per column (9 % of a
+/// learning run's time). Entry (i, j) is summed over A's columns in increasing order starting
 /// from zero, exactly as Eigen sums it, so the results are bitwise Eigen's; rows split over
 /// threads do not change any sum.
 class FixedPatternProduct {
@@ -150,8 +150,8 @@ SpaceTimeProblem::SpaceTimeProblem(TrajectoryPhysics& physics, ConstRef<MatX> ba
   const VecX free_masses = physics.dofs().restrict(physics.dof_masses());
   // Forces → the displacement they cause over 1 % of the trajectory's duration, so that the
   // balance with the position term does not depend on the time step (with h²/m̄ instead, a run
-  // at 1 ms steps weighted the physics 16× less than the same motion at 4 ms, and learning
-  // stalled: measured on a 1440-tet bar, 10.3 % → 3.7 % err_L against 10.3 % → 0.1 %).
+  // at 1 ms steps weighs the physics 16× less than the same motion at 4 ms, and learning stalls:
+  // docs/learning_loop.md).
   const double reference_time = 0.01 * steps * s.h;
   s.scale = reference_time * reference_time / free_masses.mean();
   s.inertia = s.free_basis.transpose() * free_masses.asDiagonal() * s.free_basis / (s.h * s.h);
