@@ -7,14 +7,13 @@
 //
 //   ./build/bench/bench_fem_step --benchmark_filter='corotated/.*'   (subset)
 //   ./build/bench/bench_fem_step --no-jacobian-reuse ...   (every Newton iteration assembles)
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
-#include <elastolearn/material/rayleigh_damping.hpp>
-#include <elastolearn/mesh/primitives.hpp>
-#include <elastolearn/mesh/vertex_selection.hpp>
 #include <elastolearn/sim/simulator.hpp>
 
+#include <support/bar_scene.hpp>
+
 #include <benchmark/benchmark.h>
-#include <chrono>
 #include <string>
 #include <tbb/global_control.h>
 
@@ -30,15 +29,11 @@ constexpr std::array<std::array<int, 3>, 3> kResolutions
     = { { { 16, 4, 4 }, { 32, 8, 8 }, { 52, 13, 13 } } };
 
 sim::Scene bar(material::ElasticModelType type, int resolution, sim::LinearSolverType solver) {
-  sim::Scene s;
-  s.mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), kResolutions[resolution]);
-  s.material.elastic
-      = material::make_elastic_model(type, material::Lame::from_young_poisson(3e5, 0.4));
-  s.material.damping = std::make_shared<material::RayleighDamping>(0.2, 0.005);
-  s.material.density = 1000;
-  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
-  s.gravity = Vec3(0, -9.81, 0);
-  s.dt = 1e-3;
+  sim::Scene s = test::bar_scene({ .cells = kResolutions[resolution],
+      .model = type,
+      .young = 3e5,
+      .alpha0 = 0.2,
+      .alpha1 = 0.005 });
   s.newton.relative_tolerance = 1e-6;
   if (!g_jacobian_reuse)
     s.newton.jacobian_reuse_contraction = 0;
@@ -61,9 +56,9 @@ void step_benchmark(
   sim::SolverTimings timings;
   double seconds = 0;
   for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     const auto report = simulator.step();
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    seconds += seconds_since(t0);
     if (!report.converged)
       state.SkipWithError(report.message.c_str());
     newton += report.iterations;

@@ -12,10 +12,10 @@
 // seconds to minutes. Set-up and measured numbers: docs/benchmarks_learning.md.
 #include "learning_cases.hpp"
 
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 
-#include <chrono>
 #include <cstdio>
 #include <thread>
 
@@ -23,11 +23,6 @@ namespace {
 
 using namespace elastolearn;
 using namespace bench_learning;
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 struct Row {
   std::string name;

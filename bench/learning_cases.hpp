@@ -168,18 +168,18 @@ inline LearningCase dragon(const fs::path& data, bool quick) {
   c.test = c.train;
   c.test.initial.kind = sim::InitialCondition::Kind::Velocity;
   // Test swing: deforms more than the training droop (7.3 % vs 5.4 % of the diagonal) but keeps
-  // the StVK truth's elements uninverted (smallest stretch 0.59). The former ω = (5, 0, 5)
-  // inverted some (smallest stretch −0.62), a regime where StVK itself collapses; there even the
-  // correction reconstructed from the *true* training trajectory diverged at frame 13, while
-  // at (3, 0, 3) it reaches 0.069 % (docs/benchmarks_learning.md).
+  // the StVK truth's elements uninverted (smallest stretch 0.59). A faster swing, ω = (5, 0, 5),
+  // inverts some (smallest stretch −0.62), a regime where StVK itself collapses: there even the
+  // correction reconstructed from the *true* training trajectory diverges, while at (3, 0, 3) it
+  // reaches 0.069 % (docs/benchmarks_learning.md).
   c.test.initial.angular_velocity = Vec3(3.0, 0, 3.0);
   c.truth_label = "StVK E 1e5, ν 0.40";
   c.nominal_label = "corotated E 1.2e5, ν 0.40";
   c.motion_label = "train: droop from rest under gravity; test: gravity + swing ω = (3, 0, 3) "
                    "rad/s about the base";
   c.target_err_l = 0.2;
-  // 30 POD modes instead of 20: test err_L 0.187 % instead of 0.255 % (186.8 s instead of 201 s
-  // of learning at load ~2; 20 kernels 0.248 %, regularisation 1e-7 0.254 %; measured in
+  // 30 POD modes instead of the default 20: with 20 the test error misses the 0.2 % target, and
+  // so it does with 20 kernels or a weaker regularisation instead (the comparison:
   // docs/benchmarks_learning.md).
   c.options.pod.max_modes = 30;
   return c;
@@ -231,16 +231,16 @@ inline LearningCase sphere(bool compression, bool quick) {
   c.target_err_l = 2.0;
   // Learned by the forward fit alone: at 12.7k tets the space-time loop's corrections are wrong
   // near the keyframed cap's rim (its interior is held at the current model's equilibrium) and
-  // stall at a training RMS of 0.75 % after 8 iterations, 540 s; three Levenberg–Marquardt
-  // steps on the forward error reach 0.03 %. Kernel smoothing ε = 0.03: with 10⁻³ the fitted
-  // correction's test simulation stalls Newton where the larger test stretches cross centres.
-  // docs/benchmarks_learning.md, "Update 7".
+  // stall at a training RMS of 0.75 % after 8 iterations, where three Levenberg–Marquardt steps
+  // on the forward error reach 0.03 % (docs/learning_loop.md). Kernel smoothing ε = 0.03: with
+  // 10⁻³ the fitted correction's test simulation stalls Newton where the larger test stretches
+  // cross centres (docs/benchmarks_learning.md, "the forward fit; a stress-free rest").
   c.options.max_iterations = 0;
   c.options.forward_fit.max_iterations = 3;
   c.options.rbf.epsilon = 0.03;
   // The test motion compresses and stretches beyond the training's: the neo-Hookean tail
   // extrapolates the elastic correction, and a prior on Δα₁ keeps the damping correction from
-  // extrapolating what the training stretches cannot pin down (Update 8).
+  // extrapolating what the training stretches cannot pin down (docs/learning.md, "Forward fit").
   c.options.rbf.neo_hookean_tail = true;
   c.options.forward_fit.damping_prior = 1.0;
   // The 12.7k-tet sphere: fit E and ν only (α₁ is right) and with fewer iterations, to keep the
@@ -280,10 +280,11 @@ inline LearningCase bar_damping(int variant, bool quick) {
   // Trained from rest with a twisting and bending velocity about the bar's axis at the clamp, not
   // released from a load: released, the heavily damped bar creeps back with its velocity nearly
   // proportional to its displacement, and extra damping looks like an elastic softening; from
-  // rest the displacement peaks while the velocity changes sign, which separates the two
-  // (Update 8). The twist strains the bar about twice as much per displacement as bending, so the
-  // training reaches σ₁ ≈ 1.09–1.10 (the test: 1.12) within 15 % deformation; bending alone stays
-  // below σ₁ ≈ 1.05 there, and beyond what it saw no learner knows the truth's curve (Update 12).
+  // rest the displacement peaks while the velocity changes sign, which separates the two. The
+  // twist strains the bar about twice as much per displacement as bending, so the training
+  // reaches σ₁ ≈ 1.09–1.10 (the test: 1.12) within 15 % deformation; bending alone stays below
+  // σ₁ ≈ 1.05 there, and beyond what it saw no learner knows the truth's curve
+  // (docs/benchmarks_learning.md, "Reaching the test's stretches").
   // The more damped bar-damping2 needs the faster twist for the same stretches.
   c.train.initial.kind = sim::InitialCondition::Kind::Velocity;
   c.train.initial.angular_velocity = variant == 1 ? Vec3(30, 0, 0.8) : Vec3(70, 0, 0.6);
@@ -299,7 +300,7 @@ inline LearningCase bar_damping(int variant, bool quick) {
   // elasticity is right: the forward fit alone, with a prior holding the elastic correction at 0
   // (ρ_e = 10⁶), learns Δα₁ on 10 kernels and the quadratic damping tail. The space-time loop, a
   // free elastic correction and 40 kernels let the elastic part absorb what damping explains, and
-  // test worse (Updates 11–12).
+  // test worse (docs/benchmarks_learning.md).
   c.options.max_iterations = 0;
   c.options.forward_fit.max_iterations = 6;
   c.options.forward_fit.elastic_prior = 1e6;

@@ -15,6 +15,7 @@ packages=(
   libtbb-dev               # parallel element loops
   libgtest-dev libgmock-dev libbenchmark-dev
   tetgen                   # external tetrahedralizer (AGPL: run as a program, never linked)
+  clang-format             # scripts/check-format.sh (Debian 12's is version 14, the reference)
 )
 # Real surface meshes for examples and benchmarks (optional; tests never need them).
 if [[ "${ELASTOLEARN_WITH_CGAL_DATA:-1}" == 1 ]]; then packages+=(libcgal-demo); fi

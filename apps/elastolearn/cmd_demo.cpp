@@ -6,6 +6,7 @@
 #include "demo_scenes.hpp"
 
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
@@ -15,7 +16,6 @@
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 
-#include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -40,7 +40,7 @@ std::vector<VecX> simulate_and_save(
 }
 
 void run_demo(const fs::path& out, double fraction) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   fs::create_directories(out);
   const auto train
       = io::parse_scene(nlohmann::json::parse(app::kDemoTrainScene), "built-in bar_train.json", out)
@@ -119,8 +119,7 @@ void run_demo(const fs::path& out, double fraction) {
     std::fputs(learn::coverage_report(coverage, "   ").c_str(), stdout);
   }
   std::printf("   err_L %.0fx lower with the learned correction; demo took %.0f s\n",
-      e_nominal.max / e_learned.max,
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      e_nominal.max / e_learned.max, seconds_since(start));
 }
 
 void add_demo_command(CLI::App& root) {

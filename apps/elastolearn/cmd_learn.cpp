@@ -6,6 +6,7 @@
 #include <elastolearn/core/atomic_file.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/interrupt.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/learning_checkpoint.hpp>
 #include <elastolearn/io/material_file.hpp>
@@ -16,7 +17,6 @@
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/material/nn_correction.hpp>
 
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -44,12 +44,11 @@ std::shared_ptr<const elastolearn::material::Correction> distil_network(const Le
     const elastolearn::sim::Scene& scene, const elastolearn::material::Correction& teacher,
     nlohmann::json& provenance) {
   using namespace elastolearn;
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   learn::DistillationSampleReport sampled;
   const learn::StressSamples samples = learn::distillation_samples(
       scene, o.network_motion_scales, teacher, o.network_samples, &sampled);
-  const double seconds_sampling
-      = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds_sampling = seconds_since(start);
   for (const auto& m : sampled.messages)
     std::printf("network samples: %s\n", m.c_str());
   const learn::NnDistillationResult r = learn::distill_nn_correction(samples, o.network_training);

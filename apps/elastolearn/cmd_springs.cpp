@@ -3,12 +3,12 @@
 #include "command.hpp"
 
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/io/springs_scene.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/springs/paper_tables.hpp>
 #include <elastolearn/springs/stability.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -184,11 +184,10 @@ void add_simulate(CLI::App& parent) {
     std::printf("%s: %d nodes, %d springs, mode %s, dt %g s, %d steps\n", scene.name.c_str(),
         scene.system.node_count(), scene.system.spring_count(),
         std::string(stepper->name()).c_str(), stepper->dt(), scene.steps);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     const SimulationRecord record = run_simulation(*stepper, rest_state(scene.system), scene.steps,
         scene.every, a->quiet ? ProgressCallback {} : terminal_progress("springs"));
-    const double seconds
-        = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = seconds_since(start);
     io::TrajectoryData data = io::springs_trajectory(scene.system, record);
     data.metadata["scene"] = a->scene;
     data.metadata["mode"] = std::string(stepper->name());

@@ -4,10 +4,9 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/learning_checkpoint.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
-#include <elastolearn/material/rayleigh_damping.hpp>
-#include <elastolearn/mesh/primitives.hpp>
-#include <elastolearn/mesh/vertex_selection.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+
+#include <support/bar_scene.hpp>
 
 #include <gtest/gtest.h>
 
@@ -17,16 +16,8 @@ namespace elastolearn::io {
 namespace {
 
 sim::Scene bar(material::ElasticModelType type, double young) {
-  sim::Scene s;
-  s.mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 8, 2, 2 });
-  s.material.elastic
-      = material::make_elastic_model(type, material::Lame::from_young_poisson(young, 0.43));
-  s.material.damping = std::make_shared<material::RayleighDamping>(0.0, 0.01);
-  s.gravity = Vec3(0, -9.81, 0);
-  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
-  s.dt = 4e-3;
-  s.frames = 40;
-  return s;
+  return test::bar_scene(
+      { .model = type, .young = young, .poisson = 0.43, .alpha1 = 0.01, .dt = 4e-3, .frames = 40 });
 }
 
 struct Fixture {

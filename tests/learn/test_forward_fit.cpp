@@ -6,9 +6,9 @@
 #include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
-#include <elastolearn/mesh/primitives.hpp>
-#include <elastolearn/mesh/vertex_selection.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+
+#include <support/bar_scene.hpp>
 
 #include <gtest/gtest.h>
 
@@ -23,17 +23,12 @@ namespace {
 /// A 0.3 m bar (48 tets) clamped at x = 0, sagging under gravity from rest: 40 frames of 5 ms.
 /// Mass damping only (α₁ = 0), so that the step Jacobian is the force's exact derivative.
 sim::Scene small_bar() {
-  sim::Scene s;
-  s.mesh = mesh::make_box_bar(Vec3(0.3, 0.06, 0.06), { 4, 1, 1 });
-  s.material.elastic = material::make_elastic_model(
-      material::ElasticModelType::Corotated, material::Lame::from_young_poisson(2e4, 0.4));
-  s.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.0);
-  s.material.density = 1000;
-  s.gravity = Vec3(0, -9.81, 0);
-  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
-  s.dt = 5e-3;
-  s.frames = 40;
-  return s;
+  return test::bar_scene({ .size = { 0.3, 0.06, 0.06 },
+      .cells = { 4, 1, 1 },
+      .young = 2e4,
+      .alpha0 = 0.5,
+      .dt = 5e-3,
+      .frames = 40 });
 }
 
 observe::Observation observe_run(const sim::Scene& scene) {

@@ -6,10 +6,9 @@
 #include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
-#include <elastolearn/material/rayleigh_damping.hpp>
-#include <elastolearn/mesh/primitives.hpp>
-#include <elastolearn/mesh/vertex_selection.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+
+#include <support/bar_scene.hpp>
 
 #include <gtest/gtest.h>
 
@@ -19,23 +18,21 @@
 namespace elastolearn::learn {
 namespace {
 
-fem::MaterialModel make_material(material::ElasticModelType type, double young) {
-  fem::MaterialModel m;
-  m.elastic = material::make_elastic_model(type, material::Lame::from_young_poisson(young, 0.43));
-  m.damping = std::make_shared<material::RayleighDamping>(0.0, 0.01);
-  m.density = 1000;
-  return m;
+/// A 0.4 × 0.1 × 0.1 m bar (240 tets) clamped at x = 0, 100 frames of 4 ms: elastic model `type`
+/// with Young's modulus `young`, ν = 0.43, Rayleigh α₁ = 0.01 s.
+test::BarOptions bar(material::ElasticModelType type, double young) {
+  return { .cells = { 10, 2, 2 },
+    .model = type,
+    .young = young,
+    .poisson = 0.43,
+    .alpha1 = 0.01,
+    .dt = 4e-3,
+    .frames = 100 };
 }
 
-/// 0.4 × 0.1 × 0.1 m bar, 240 tets, clamped at x = 0, 100 frames of 4 ms.
-sim::Scene bar_scene(const fem::MaterialModel& material, bool swing) {
-  sim::Scene s;
-  s.mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 10, 2, 2 });
-  s.material = material;
-  s.gravity = Vec3(0, -9.81, 0);
-  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
-  s.dt = 4e-3;
-  s.frames = 100;
+/// The bar drooping under gravity from rest or, with `swing`, also swinging up from ω = 2 rad/s.
+sim::Scene bar_scene(const test::BarOptions& bar, bool swing) {
+  sim::Scene s = test::bar_scene(bar);
   if (swing) {
     s.initial.kind = sim::InitialCondition::Kind::Velocity;
     s.initial.angular_velocity = Vec3(0, 0, 2.0);
@@ -70,30 +67,24 @@ double swing_error(const sim::Scene& truth, const sim::Scene& model) {
 }
 
 TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
-  const auto truth = make_material(material::ElasticModelType::NeoHookean, 1e6);
-  const auto nominal = make_material(material::ElasticModelType::Corotated, 1.75e6);
+  const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
+  const auto nominal = bar(material::ElasticModelType::Corotated, 1.75e6);
   const auto observed = observe_surface(bar_scene(truth, false));
   LearningState state;
   ASSERT_TRUE(run_learning(bar_scene(nominal, false), observed, small_options(), state));
   ASSERT_TRUE(state.best);
   ASSERT_FALSE(state.history.empty());
-  // The training fit improves by well over an order of magnitude (measured 4.3e-3 m → 1.2e-4 m
-  // RMS; a stage that stops working leaves it near the nominal's).
+  // The training fit improves by well over an order of magnitude (a stage that stops working
+  // leaves it near the nominal's).
   EXPECT_LT(state.best_error, 0.05 * state.history.front().forward_error.rms);
 
   const double nominal_error = swing_error(bar_scene(truth, true), bar_scene(nominal, true));
   const double learned_error
       = swing_error(bar_scene(truth, true), with_correction(bar_scene(nominal, true), state.best));
-  // Stored regression numbers (Release build, this configuration): nominal 4.450 %, learned
-  // 0.0312 % (140× lower). History: 0.0556 % before the learned damping scaled the nominal
-  // stiffness, then 0.138 %, 0.0938 % since the POD basis also spans the constrained simulation
-  // (nominal 4.304 %), 0.0680 % since Rayleigh's α₁ acts on the corrected stiffness without its
-  // flip part (which also changed the truth's damping, hence the new nominal figure), 0.0457 %
-  // since the reconstruction fits the forces mainly within span Φ (0.0588 % with μ = 0.3), 0.0446 %
-  // since the correction is stress-free at rest (RbfFitOptions::stress_free_rest), 0.0312 % since
-  // the learned Δα₁ scales the nominal's damping tangent, the matrix α₁ scales. The
-  // issue asks for ≥ 5× below the nominal; we assert that and that we have not regressed by more
-  // than 2× from the stored learned figure (a compiler's different rounding moves it a little; a
+  // Stored regression figures (Release build, this configuration): nominal 4.450 %, learned
+  // 0.0312 % (140× lower; how each change of the loop moved them: docs/benchmarks_learning.md).
+  // The issue asks for ≥ 5× below the nominal; the test asserts that, and that the learned figure
+  // stays within 2× of the stored one (a compiler's different rounding moves it a little; a
   // broken stage moves it by orders of magnitude).
   std::printf("[ measured ] err_L nominal %.4f %%, learned %.4f %% (best iteration %d)\n",
       nominal_error, learned_error, state.best_iteration);
@@ -102,12 +93,10 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   EXPECT_LT(learned_error, 2 * 0.0312);
 
   // The distilled network (paper §6.2, `learn --network`): N fitted on the training motion at
-  // three amplitudes, Δα₁ carried over. It must simulate the unseen swing stably and stay well
-  // below the nominal error (its fit is ~1.5 % of the teacher's output; stored figure 0.0435 %,
-  // same 2× regression margin; 0.0462 % before Δα₁ scaled the damping tangent, 0.112 % before the
-  // stress-free rest, 0.123 % before Rayleigh's α₁ acted on the corrected stiffness, 0.109 % before
-  // the projected reconstruction). Before Δα₁ was carried over instead of distilled, the network's
-  // simulation of the demo's test motion diverged.
+  // three amplitudes, Δα₁ carried over from the teacher (distilled instead, the network's
+  // simulation of the demo's test motion diverges: docs/learning.md). It must simulate the unseen
+  // swing stably and stay well below the nominal error (its fit is ~1.5 % of the teacher's
+  // output; stored figure 0.0435 %, the same 2× regression margin).
   DistillationSampleOptions so;
   so.recorded_samples = 10000;
   const std::vector<double> scales { 0.5, 1.0, 2.0 };
@@ -125,15 +114,13 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
 TEST(LearningLoop, FullSpaceVariantLearnsOnASmallMesh) {
   // No reduction (Φ = identity on the 72 free dofs of a 36-tet bar): the same loop, the same
   // improvement; and the variant refuses meshes too big for its dense blocks.
-  auto small = [](const fem::MaterialModel& m, bool swing) {
-    sim::Scene s = bar_scene(m, swing);
-    s.mesh = mesh::make_box_bar(Vec3(0.4, 0.1, 0.1), { 6, 1, 1 });
-    s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
-    s.frames = 40;
-    return s;
+  auto small = [](test::BarOptions o, bool swing) {
+    o.cells = { 6, 1, 1 };
+    o.frames = 40;
+    return bar_scene(o, swing);
   };
-  const auto truth = make_material(material::ElasticModelType::NeoHookean, 1e6);
-  const auto nominal = make_material(material::ElasticModelType::Corotated, 1.75e6);
+  const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
+  const auto nominal = bar(material::ElasticModelType::Corotated, 1.75e6);
   const auto observed = observe_surface(small(truth, false));
   LearningOptions options = small_options();
   options.full_space = true;
@@ -158,8 +145,7 @@ TEST(LearningLoop, DivergingCorrectionsAreHalvedBeforePatienceCountsThem) {
   // Resume at iteration 1 with a correction whose simulation diverges: a uniaxial softening of
   // 40× the nominal's stiffness (E = 1e6 Pa), so that ½ and ¼ of it diverge as well. The first
   // `free_halvings` divergences in a row are halved without counting against patience (1 here).
-  const auto material = make_material(material::ElasticModelType::Corotated, 1e6);
-  auto scene = bar_scene(material, false);
+  auto scene = bar_scene(bar(material::ElasticModelType::Corotated, 1e6), false);
   scene.frames = 20;
   const auto observed = observe_surface(scene);
   material::RbfCorrection::Parameters p;
@@ -191,8 +177,7 @@ TEST(LearningLoop, DivergingCorrectionsAreHalvedBeforePatienceCountsThem) {
 }
 
 TEST(LearningLoop, TruthEqualToNominalLearnsAlmostNothing) {
-  const auto material = make_material(material::ElasticModelType::Corotated, 1e6);
-  auto scene = bar_scene(material, false);
+  auto scene = bar_scene(bar(material::ElasticModelType::Corotated, 1e6), false);
   scene.frames = 60;
   const auto observed = observe_surface(scene);
   LearningOptions options = small_options();

@@ -4,11 +4,10 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/material/analytic_correction.hpp>
-#include <elastolearn/material/corotated.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/material/rbf_correction.hpp>
-#include <elastolearn/mesh/primitives.hpp>
-#include <elastolearn/mesh/vertex_selection.hpp>
+
+#include <support/bar_scene.hpp>
 
 #include <gtest/gtest.h>
 
@@ -238,17 +237,11 @@ namespace {
 
 /// A clamped bar (8 × 2 × 2 cells, 192 tets) swinging from an initial velocity, corotated nominal.
 sim::Scene swinging_bar() {
-  sim::Scene s;
+  sim::Scene s
+      = test::bar_scene({ .young = 5e4, .gravity = Vec3::Zero(), .dt = 5e-3, .frames = 30 });
   s.name = "bar";
-  s.mesh = mesh::make_box_bar({ 0.4, 0.1, 0.1 }, { 8, 2, 2 });
-  s.material.elastic
-      = std::make_shared<material::CorotatedModel>(material::Lame::from_young_poisson(5e4, 0.4));
-  s.material.density = 1000;
-  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
   s.initial.kind = sim::InitialCondition::Kind::Velocity;
   s.initial.velocity = Vec3(0, 0.5, 0);
-  s.dt = 5e-3;
-  s.frames = 30;
   return s;
 }
 

@@ -2,11 +2,10 @@
 // same model, and survives trial parameters whose simulation diverges.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
-#include <elastolearn/material/corotated.hpp>
-#include <elastolearn/mesh/primitives.hpp>
-#include <elastolearn/mesh/vertex_selection.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
+
+#include <support/bar_scene.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -21,16 +20,12 @@ namespace {
 /// A bar 0.2 × 0.04 × 0.04 m (10×2×2 cells, 240 tets), clamped at x = 0, sagging and swinging
 /// under gravity from rest: the tip moves ~1 cm, enough for E and α₁ to show.
 sim::Scene bar_scene(int frames) {
-  sim::Scene s;
-  s.mesh = mesh::make_box_bar({ 0.2, 0.04, 0.04 }, { 10, 2, 2 });
-  s.material.elastic
-      = std::make_shared<material::CorotatedModel>(material::Lame::from_young_poisson(1e5, 0.3));
-  s.material.density = 1000;
-  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
-  s.gravity = Vec3(0, -9.81, 0);
-  s.dt = 2e-3;
-  s.frames = frames;
-  return s;
+  return test::bar_scene({ .size = { 0.2, 0.04, 0.04 },
+      .cells = { 10, 2, 2 },
+      .young = 1e5,
+      .poisson = 0.3,
+      .dt = 2e-3,
+      .frames = frames });
 }
 
 /// Noise-free observations of 30 % of the surface vertices, simulated with `truth`.

@@ -2,12 +2,9 @@
 // objective against finite differences, and what it must recover.
 #include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/space_time.hpp>
-#include <elastolearn/material/elastic_model_type.hpp>
-#include <elastolearn/material/rayleigh_damping.hpp>
-#include <elastolearn/mesh/primitives.hpp>
-#include <elastolearn/mesh/vertex_selection.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 
+#include <support/bar_scene.hpp>
 #include <support/finite_difference.hpp>
 
 #include <gtest/gtest.h>
@@ -20,16 +17,13 @@ namespace {
 /// A small clamped bar swinging under gravity. α₁ = 0 and the exact (unprojected) tangent make
 /// the Gauss–Newton Jacobian exact, so it can be compared with finite differences.
 sim::Scene small_bar(int frames) {
-  sim::Scene s;
-  s.mesh = mesh::make_box_bar(Vec3(0.2, 0.05, 0.05), { 4, 1, 1 });
-  s.material.elastic = material::make_elastic_model(
-      material::ElasticModelType::Corotated, material::Lame::from_young_poisson(2e5, 0.35));
-  s.material.damping = std::make_shared<material::RayleighDamping>(0.5, 0.0);
-  s.material.density = 1000;
-  s.gravity = Vec3(0, -9.81, 0);
-  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
-  s.dt = 5e-3;
-  s.frames = frames;
+  sim::Scene s = test::bar_scene({ .size = { 0.2, 0.05, 0.05 },
+      .cells = { 4, 1, 1 },
+      .young = 2e5,
+      .poisson = 0.35,
+      .alpha0 = 0.5,
+      .dt = 5e-3,
+      .frames = frames });
   s.newton.relative_tolerance = 1e-10;
   return s;
 }

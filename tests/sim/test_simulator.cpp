@@ -1,12 +1,11 @@
 // The backward-Euler simulator: physics it must reproduce and contracts it must keep.
 #include <elastolearn/material/analytic_correction.hpp>
-#include <elastolearn/material/corotated.hpp>
 #include <elastolearn/material/neohookean.hpp>
-#include <elastolearn/material/rayleigh_damping.hpp>
-#include <elastolearn/mesh/primitives.hpp>
 #include <elastolearn/mesh/vertex_selection.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 #include <elastolearn/sim/simulator.hpp>
+
+#include <support/bar_scene.hpp>
 
 #include <cmath>
 #include <gtest/gtest.h>
@@ -15,22 +14,6 @@
 using namespace elastolearn;
 
 namespace {
-
-/// A clamped bar (x = 0 fixed) of 6-tet cubes, lumped mass, gravity −y.
-sim::Scene bar_scene(const Vec3& size, const std::array<int, 3>& cells, double young,
-    double poisson, double alpha0 = 0, double alpha1 = 0) {
-  sim::Scene s;
-  s.mesh = mesh::make_box_bar(size, cells);
-  s.material.elastic = std::make_shared<material::CorotatedModel>(
-      material::Lame::from_young_poisson(young, poisson));
-  if (alpha0 != 0 || alpha1 != 0)
-    s.material.damping = std::make_shared<material::RayleighDamping>(alpha0, alpha1);
-  s.material.density = 1000;
-  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
-  s.gravity = Vec3(0, -9.81, 0);
-  s.dt = 1e-3;
-  return s;
-}
 
 double mean_tip_y(const mesh::TetMesh& mesh, const VecX& x) {
   const auto tip = mesh::vertices_with_max_coordinate(mesh, 0, 1e-9);
@@ -48,7 +31,7 @@ TEST_P(SolverBackends, AllBackendsGiveTheSameDynamicSteps) {
   // Reference: CHOLMOD. Each backend converges Newton to 1e-10 relative, so states agree to
   // ~1e-9 of the displacement.
   auto run = [](sim::LinearSolverType type) {
-    auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
+    auto s = test::bar_scene({ .young = 3e5, .alpha0 = 0.2, .alpha1 = 0.005 });
     s.linear_solver = type;
     s.newton.relative_tolerance = 1e-10;
     sim::Simulator sim(s);
@@ -79,7 +62,7 @@ TEST(Newton, JacobianReuseMeetsTheSameToleranceWithFewerAssemblies) {
     int iterations = 0, jacobians = 0;
   };
   auto run = [](double reuse_contraction) {
-    auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
+    auto s = test::bar_scene({ .young = 3e5, .alpha0 = 0.2, .alpha1 = 0.005 });
     s.newton.relative_tolerance = 1e-10;
     s.newton.jacobian_reuse_contraction = reuse_contraction;
     sim::Simulator sim(s);
@@ -106,7 +89,7 @@ TEST(Newton, JacobianIsRefreshedWhenAChordStepContractsLittle) {
   // the solution contract little, so they must assemble afresh; reusing every Jacobian would
   // leave Newton crawling linearly. Reuse may cost an iteration here and there, not many.
   auto run = [](double reuse_contraction) {
-    auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 2e4, 0.3);
+    auto s = test::bar_scene({ .young = 2e4, .poisson = 0.3 });
     s.newton.jacobian_reuse_contraction = reuse_contraction;
     sim::Simulator sim(s);
     const auto report = sim.solve_static(1);
@@ -131,7 +114,11 @@ TEST(Statics, CantileverTipDeflectionConvergesToBeamTheory) {
   const double theory = q * std::pow(L, 4) / (8 * E * I) + q * L * L / (2 * kappa * G * a * a);
   double previous_error = INFINITY;
   for (int n : { 2, 4, 10 }) {
-    auto s = bar_scene({ L, a, a }, { 10 * n, n, n }, E, 0.0);
+    auto s = test::bar_scene({ .size = { L, a, a },
+        .cells = { 10 * n, n, n },
+        .young = E,
+        .poisson = 0.0,
+        .density = rho });
     sim::Simulator sim(s);
     const auto report = sim.solve_static(1);
     ASSERT_TRUE(report.converged) << report.message;
@@ -155,7 +142,12 @@ TEST(Dynamics, DampedModeDecaysAtRayleighRate) {
   // The section is rectangular (0.05 × 0.1) so the y- and z-bending modes do not share a
   // frequency and cannot trade energy; E = 3e7 puts ω near 100 rad/s.
   const double alpha0 = 1.0, alpha1 = 0.002, h = 2e-4;
-  auto s = bar_scene({ 0.4, 0.05, 0.1 }, { 8, 1, 2 }, 3e7, 0.3, alpha0, alpha1);
+  auto s = test::bar_scene({ .size = { 0.4, 0.05, 0.1 },
+      .cells = { 8, 1, 2 },
+      .young = 3e7,
+      .poisson = 0.3,
+      .alpha0 = alpha0,
+      .alpha1 = alpha1 });
   s.gravity.setZero();
   s.dt = h;
   s.initial.kind = sim::InitialCondition::Kind::StaticLoad;
@@ -195,7 +187,7 @@ TEST(Dynamics, DampedModeDecaysAtRayleighRate) {
 TEST(Dynamics, UndampedMotionNeverGainsEnergy) {
   // Backward Euler is dissipative: kinetic + elastic energy never increases without damping or
   // external work (gravity off, fixed base). Tolerance: Newton residual 1e-10 relative.
-  auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4);
+  auto s = test::bar_scene({ .young = 3e5 });
   s.gravity.setZero();
   s.material.elastic
       = std::make_shared<material::NeoHookeanModel>(material::Lame::from_young_poisson(3e5, 0.4));
@@ -216,7 +208,7 @@ TEST(Dynamics, UndampedMotionNeverGainsEnergy) {
 }
 
 TEST(Dynamics, KeyframedVerticesFollowTheirMotionAndFixedOnesStay) {
-  auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
+  auto s = test::bar_scene({ .young = 3e5, .alpha0 = 0.2, .alpha1 = 0.005 });
   sim::KeyframeMotion k;
   k.vertices = mesh::vertices_with_max_coordinate(s.mesh, 0, 1e-9);
   k.amplitude = Vec3(0, 0.02, 0);
@@ -239,7 +231,7 @@ TEST(Dynamics, KeyframedVerticesFollowTheirMotionAndFixedOnesStay) {
 
 TEST(Dynamics, ConsistentMassAgreesWithLumpedOnSmoothMotion) {
   // Same physics, different mass discretisation: tip sag after 0.1 s agrees within a few percent.
-  auto lumped = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
+  auto lumped = test::bar_scene({ .young = 3e5, .alpha0 = 0.2, .alpha1 = 0.005 });
   auto consistent = lumped;
   consistent.mass = fem::MassType::Consistent;
   sim::Simulator a(lumped), b(consistent);
@@ -255,7 +247,7 @@ TEST(Dynamics, ConsistentMassAgreesWithLumpedOnSmoothMotion) {
 
 TEST(Dynamics, CorrectionHookChangesTheMotionAndNewtonStillConverges) {
   // A stiffening correction must reduce the sag; the integrator uses its force and tangent.
-  auto base = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4, 0.2, 0.005);
+  auto base = test::bar_scene({ .young = 3e5, .alpha0 = 0.2, .alpha1 = 0.005 });
   auto corrected = base;
   material::AnalyticCorrection::Parameters p;
   p.a = 1e8; // (σ−1)³ stiffening: ~100 Pa at 1 % strain vs E·ε ≈ 3e3 Pa
@@ -277,7 +269,7 @@ TEST(Dynamics, CorrectionHookChangesTheMotionAndNewtonStillConverges) {
 
 TEST(Divergence, StopsWithAMessageNamingTheFrameAndKeepsEarlierFrames) {
   // An absurd time step on a stiff bar with a single Newton iteration allowed cannot converge.
-  auto s = bar_scene({ 0.4, 0.1, 0.1 }, { 8, 2, 2 }, 3e5, 0.4);
+  auto s = test::bar_scene({ .young = 3e5 });
   s.newton.max_iterations = 1;
   s.newton.relative_tolerance = 1e-12;
   s.frames = 50;

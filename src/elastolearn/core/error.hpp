@@ -19,6 +19,21 @@ class InputError : public std::runtime_error {
   std::string m_where;
 };
 
+/// Throws InputError for the fields of one group of inputs (an options struct, a file section):
+/// `where` is "<group>.<field>". A file that validates a group declares one, named for its use,
+///   constexpr FieldErrors fail("pod");
+/// and reports a bad field with `fail("max_modes", "must be at least 1, got 0")`.
+class FieldErrors {
+  public:
+  constexpr explicit FieldErrors(const char* group)
+      : m_group(group) { }
+  /// Throws InputError("<group>.<field>", what).
+  [[noreturn]] void operator()(const std::string& field, const std::string& what) const;
+
+  private:
+  const char* m_group;
+};
+
 /// Internal logic error: an invariant that can only fail through a bug.
 class InternalError : public std::logic_error {
   public:

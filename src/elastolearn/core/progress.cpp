@@ -1,4 +1,5 @@
 #include <elastolearn/core/progress.hpp>
+#include <elastolearn/core/timing.hpp>
 
 #include <chrono>
 #include <cstdio>
@@ -8,7 +9,6 @@
 namespace elastolearn {
 
 ProgressCallback terminal_progress(std::string label) {
-  using Clock = std::chrono::steady_clock;
   struct State {
     Clock::time_point start = Clock::now();
     Clock::time_point last {};

@@ -31,8 +31,9 @@ struct MaterialModel {
 /// with (α₀, α₁) the damping model's, from the element's largest stretch, and M_e the element's
 /// lumped or consistent mass (the scene's). K_e^d is the damping stiffness the damping model
 /// names (material::DampingTangent: the exact tangent, or the exact tangent without its flip
-/// part), unprojected and evaluated at the end-of-step state, of the *corrected* stress
-/// P̂ + N(σ, 0): a material whose elasticity is learned right is damped as its own Rayleigh
+/// part), unprojected (a projected one would make the force nonlinear in the correction:
+/// docs/learning.md, "Damping part") and evaluated at the end-of-step state, of the *corrected*
+/// stress P̂ + N(σ, 0): a material whose elasticity is learned right is damped as its own Rayleigh
 /// damping would. The learned Δα₁ = Correction::stiffness_damping(F̂) (paper Eq. 13; α₁ + Δα₁
 /// kept ≥ 0) scales the same kind of tangent of the nominal P̂ (independent of the correction's
 /// unknowns), so that the damping force stays linear in them (learn::reconstruct_rbf_correction)

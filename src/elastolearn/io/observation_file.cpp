@@ -1,11 +1,11 @@
 #include <elastolearn/core/atomic_file.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/io/hdf5_file.hpp>
 #include <elastolearn/io/observation_file.hpp>
 
 #include <charconv>
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::io {
 
@@ -16,13 +16,6 @@ constexpr int k_version = 1;
 const std::string k_ids = "/observed/vertex_ids";
 const std::string k_positions = "/observed/positions";
 const std::string k_time = "/time";
-
-std::string number(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
 
 /// A float64 scalar attribute on the root group (h5py reads it as a number).
 void set_number_attribute(h5::File& file, const char* name, double value) {
@@ -150,11 +143,13 @@ observe::Observation read_observation_h5(const std::filesystem::path& path) {
     obs.start_time = time.front();
   for (std::size_t t = 0; t < time.size(); ++t) {
     if (!std::isfinite(time[t]))
-      file.fail(k_time, "frame " + std::to_string(t) + ": non-finite time " + number(time[t]));
+      file.fail(
+          k_time, "frame " + std::to_string(t) + ": non-finite time " + to_text_exact(time[t]));
     if (t > 0 && !(std::abs(time[t] - time[t - 1] - obs.dt) <= 1e-6 * obs.dt)) {
       file.fail(k_time,
           "frames " + std::to_string(t - 1) + " and " + std::to_string(t) + " are "
-              + number(time[t] - time[t - 1]) + " s apart, but dt is " + number(obs.dt) + " s");
+              + to_text_exact(time[t] - time[t - 1]) + " s apart, but dt is "
+              + to_text_exact(obs.dt) + " s");
     }
   }
   obs.validate(file.name());

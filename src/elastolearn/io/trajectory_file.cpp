@@ -1,11 +1,11 @@
 #include <elastolearn/core/atomic_file.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/io/hdf5_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 
 #include <cmath>
 #include <optional>
-#include <sstream>
 
 namespace elastolearn::io {
 
@@ -15,13 +15,6 @@ constexpr const char* k_kind = "elastolearn-trajectory";
 constexpr int k_version = 1;
 constexpr hsize_t k_any = ~hsize_t(0);
 
-std::string format_number(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
 /// Throws InputError("<file>: <dataset>", "<frame prefix>non-finite value ...") if any of the
 /// rows×3 values is NaN or infinite.
 void check_finite(const std::string& where, const double* values, Eigen::Index rows,
@@ -29,7 +22,7 @@ void check_finite(const std::string& where, const double* values, Eigen::Index r
   for (Eigen::Index i = 0; i < rows * 3; ++i) {
     if (!std::isfinite(values[i])) {
       throw InputError(where,
-          frame_prefix + "non-finite value " + format_number(values[i]) + " at vertex "
+          frame_prefix + "non-finite value " + to_text_exact(values[i]) + " at vertex "
               + std::to_string(i / 3) + " (component " + std::to_string(i % 3) + ")");
     }
   }
@@ -51,12 +44,12 @@ void check_indices(
 void check_time(const std::string& where, long frame, double time, std::optional<double> previous) {
   if (!std::isfinite(time)) {
     throw InputError(
-        where, "frame " + std::to_string(frame) + ": non-finite time " + format_number(time));
+        where, "frame " + std::to_string(frame) + ": non-finite time " + to_text_exact(time));
   }
   if (previous && !(time > *previous)) {
     throw InputError(where,
-        "frame " + std::to_string(frame) + ": time " + format_number(time)
-            + " does not increase (previous frame at " + format_number(*previous) + ")");
+        "frame " + std::to_string(frame) + ": time " + to_text_exact(time)
+            + " does not increase (previous frame at " + to_text_exact(*previous) + ")");
   }
 }
 

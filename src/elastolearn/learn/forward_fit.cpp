@@ -4,20 +4,15 @@
 #include <elastolearn/learn/trajectory_physics.hpp>
 #include <elastolearn/sim/simulator.hpp>
 
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/sim/linear_solver.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <memory>
-#include <sstream>
 
 namespace elastolearn::learn {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 /// The observed entries among the free dofs: (free dof, observation vertex slot, component).
 struct ObservedDof {
@@ -58,7 +53,7 @@ void ForwardFitOptions::validate() const {
 ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
     const observe::Observation& observed, const ReconstructionMesh& mesh, const RbfDesign& design,
     const VecX& unknowns, Sensitivities mode, const ProgressCallback& progress) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   const bool sensitivities = mode != Sensitivities::none;
   ForwardSensitivityPass pass;
   const sim::Scene corrected = with_correction(
@@ -175,7 +170,7 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
     const ForwardFitOptions& options, const ProgressCallback& progress,
     const ForwardFitStepCallback& on_step) {
   options.validate();
-  const auto started = std::chrono::steady_clock::now();
+  const auto started = Clock::now();
   ForwardFitResult result;
   result.unknowns = start;
   ForwardSensitivityPass current = simulate_with_sensitivities(

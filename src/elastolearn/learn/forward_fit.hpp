@@ -55,23 +55,22 @@ struct ForwardFitOptions {
   /// accepted step, ×10 after a rejected one.
   double damping = 1e-2;
   /// The step Jacobian of the sensitivities. Projected (the simulator's) by default: with the
-  /// exact one the quick sphere-compression case rejected its 2nd and 3rd steps (training RMS
-  /// stuck at 0.251 %) where the projected one reached 0.016 % (docs/benchmarks_learning.md,
-  /// "Update 7"); the exact one is the derivative the tests check.
+  /// exact one, steps the projected one takes on the sphere-compression case are rejected and
+  /// the fit stalls (docs/benchmarks_learning.md, "the forward fit"); the exact one is the
+  /// derivative the tests check.
   Sensitivities sensitivities = Sensitivities::projected;
   /// Weight ρ_d of a Tikhonov prior on the damping unknowns (Δα₁): the fit minimises
   /// E(w) + ρ_d Σ_{i damping} (s_i w_i)², s_i = √(JᵀJ)_ii of the current accepted pass, so ρ_d is
   /// dimensionless like μ. Observations of a few motions constrain Δα₁ only at the stretches
-  /// they reach, and an unconstrained Δα₁ extrapolates badly: on the full-size
-  /// sphere-compression case (with the neo-Hookean tail) the test simulation diverged with
-  /// ρ_d = 0 and tests at 1.250 % with ρ_d = 1, nominal 2.294 % (docs/benchmarks_learning.md,
-  /// "Update 8"). 0 turns the prior off.
+  /// they reach, and an unconstrained Δα₁ extrapolates badly: the full-size sphere-compression
+  /// case's test simulation (with the neo-Hookean tail) diverges without the prior and tests
+  /// below the nominal with ρ_d = 1 (docs/learning.md, "Forward fit"). 0 turns the prior off.
   double damping_prior = 0;
   /// Weight ρ_e of the same prior on the elastic unknowns (N's kernels and tail): for a nominal
   /// whose elasticity is known to be right, so that only the damping is learned (ρ_e = 10⁶). A
   /// motion whose velocity stays nearly proportional to its displacement cannot tell extra
   /// stiffness damping from an elastic softening, and a free fit may split the two wrongly
-  /// (docs/benchmarks_learning.md, "Update 11"). 0 turns the prior off.
+  /// (docs/learning.md, "Forward fit"). 0 turns the prior off.
   double elastic_prior = 0;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;

@@ -1,4 +1,5 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/learn/kmeans.hpp>
 
 #include <tbb/blocked_range.h>
@@ -8,18 +9,11 @@
 #include <cmath>
 #include <limits>
 #include <random>
-#include <sstream>
 #include <type_traits>
 
 namespace elastolearn::learn {
 
 namespace {
-
-template <typename T> std::string str(T v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
@@ -291,11 +285,11 @@ MatX seed_centres(const MatX& points_t, int k, std::mt19937_64& rng) {
 
 void KMeansOptions::validate() const {
   if (clusters < 1)
-    throw InputError("kmeans.clusters", "must be at least 1, got " + str(clusters));
+    throw InputError("kmeans.clusters", "must be at least 1, got " + to_text(clusters));
   if (max_iterations < 0)
-    throw InputError("kmeans.max_iterations", "must be ≥ 0, got " + str(max_iterations));
+    throw InputError("kmeans.max_iterations", "must be ≥ 0, got " + to_text(max_iterations));
   if (!(tolerance >= 0) || !std::isfinite(tolerance))
-    throw InputError("kmeans.tolerance", "must be finite and ≥ 0, got " + str(tolerance));
+    throw InputError("kmeans.tolerance", "must be finite and ≥ 0, got " + to_text(tolerance));
 }
 
 KMeansResult kmeans(ConstRef<MatX> points, const KMeansOptions& options) {
@@ -304,8 +298,8 @@ KMeansResult kmeans(ConstRef<MatX> points, const KMeansOptions& options) {
   const Eigen::Index d = points.cols();
   const int k = options.clusters;
   if (n < k) {
-    throw InputError(
-        "kmeans.clusters", str(k) + " clusters need at least as many points, got " + str(n));
+    throw InputError("kmeans.clusters",
+        to_text(k) + " clusters need at least as many points, got " + to_text(n));
   }
   if (!points.allFinite())
     throw InputError("kmeans", "points contain a non-finite value");

@@ -1,20 +1,15 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 namespace elastolearn::learn {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 /// The scene with the observed (not already prescribed) vertices following their data.
 sim::Scene constrained_scene(const sim::Scene& scene, const observe::Observation& observed) {

@@ -40,8 +40,9 @@ struct LearningOptions {
   int patience = 2; ///< stop after this many iterations without a better forward error
   /// Divergences in a row that are halved towards the best correction without counting against
   /// patience: a step that overshoots is shortened to ½, ¼, … of itself before the loop gives up
-  /// on its direction (full-size sphere-tension: C_3 and ½ C_3 diverged, ¼ C_3 learned;
-  /// docs/benchmarks_learning.md, "Update 6"). Each halving still counts as an iteration.
+  /// on its direction, because a correction whose whole and half steps diverge can still learn
+  /// at a quarter (the full-size sphere-tension case does: docs/benchmarks_learning.md). Each
+  /// halving still counts as an iteration.
   int free_halvings = 2;
   PodOptions pod; ///< reduced basis (max_modes, frame window and stride)
   /// POD snapshots from the constrained simulation too, not only the forward one, so that span Φ
@@ -60,7 +61,7 @@ struct LearningOptions {
   /// where the reduced space-time optimisation controls the residual, instead of at every free
   /// dof (reconstruction.full_space_weight weighs the rest). The residual outside span Φ is
   /// left by the reduced trajectory's small strain errors, which grow as the mesh is refined,
-  /// and fitting it made the first correction overshoot (docs/learning.md, "Projected
+  /// and fitting it makes the first correction overshoot (docs/learning.md, "Projected
   /// reconstruction"). Not used by the full-space variant (there span Φ is everything) nor by
   /// the lsqr reconstruction method.
   bool projected_reconstruction = true;
@@ -74,8 +75,9 @@ struct LearningOptions {
   /// After the loop: Levenberg–Marquardt steps on the forward simulation's error itself, from
   /// the best correction over its centres (forward_fit.hpp; 0 = none). The space-time stages
   /// hold the unobserved interior at the current model's equilibrium; this stage moves it with
-  /// the corrected material (full-size sphere: the loop stalls at a training RMS of 0.75 %,
-  /// four steps from the nominal model reach 0.015 %; docs/learning.md, "Forward fit").
+  /// the corrected material: on the full-size sphere cases a few steps from the nominal model
+  /// fit far better than the loop's iterations (docs/learning_loop.md; docs/learning.md,
+  /// "Forward fit").
   ForwardFitOptions forward_fit;
   /// Throws InputError("learn.<field>", ...) for an out-of-range field.
   void validate() const;

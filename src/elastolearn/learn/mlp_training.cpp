@@ -1,26 +1,18 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/mlp_training.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <numeric>
 #include <random>
-#include <sstream>
 
 namespace elastolearn::learn {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError("mlp_training." + field, what);
-}
-
-template <typename T> std::string str(T v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+constexpr FieldErrors fail("mlp_training");
 
 double elu(double z) {
   return z > 0 ? z : std::expm1(z);
@@ -78,9 +70,9 @@ void check_set(const char* field, ConstRef<MatX> x, ConstRef<MatX> y, int inputs
     fail(field, "is empty");
   if (x.rows() != inputs || y.rows() != outputs || y.cols() != x.cols()) {
     fail(field,
-        "inputs " + str(x.rows()) + " × " + str(x.cols()) + " and targets " + str(y.rows()) + " × "
-            + str(y.cols()) + " do not match (" + str(inputs) + " inputs, " + str(outputs)
-            + " outputs, one column per sample)");
+        "inputs " + to_text(x.rows()) + " × " + to_text(x.cols()) + " and targets "
+            + to_text(y.rows()) + " × " + to_text(y.cols()) + " do not match (" + to_text(inputs)
+            + " inputs, " + to_text(outputs) + " outputs, one column per sample)");
   }
   if (!x.allFinite() || !y.allFinite())
     fail(field, "contains a non-finite value");
@@ -110,47 +102,48 @@ void MlpTrainingOptions::validate() const {
     fail("hidden_widths", "is empty; at least one hidden layer is required");
   if (hidden_widths.size() > std::size_t(material::NnCorrection::max_hidden_layers)) {
     fail("hidden_widths",
-        "has " + str(hidden_widths.size()) + " layers, at most "
-            + str(material::NnCorrection::max_hidden_layers) + " are supported");
+        "has " + to_text(hidden_widths.size()) + " layers, at most "
+            + to_text(material::NnCorrection::max_hidden_layers) + " are supported");
   }
   for (int w : hidden_widths) {
     if (w < 1 || w > material::NnCorrection::max_width) {
       fail("hidden_widths",
-          "width " + str(w) + " outside 1.." + str(material::NnCorrection::max_width));
+          "width " + to_text(w) + " outside 1.." + to_text(material::NnCorrection::max_width));
     }
   }
   if (batch_size < 2)
-    fail("batch_size", "must be ≥ 2, got " + str(batch_size));
+    fail("batch_size", "must be ≥ 2, got " + to_text(batch_size));
   if (max_epochs < 1)
-    fail("max_epochs", "must be ≥ 1, got " + str(max_epochs));
+    fail("max_epochs", "must be ≥ 1, got " + to_text(max_epochs));
   if (!(learning_rate > 0) || !std::isfinite(learning_rate))
-    fail("learning_rate", "must be finite and > 0, got " + str(learning_rate));
+    fail("learning_rate", "must be finite and > 0, got " + to_text(learning_rate));
   if (!(beta1 >= 0 && beta1 < 1))
-    fail("beta1", "must be in [0, 1), got " + str(beta1));
+    fail("beta1", "must be in [0, 1), got " + to_text(beta1));
   if (!(beta2 >= 0 && beta2 < 1))
-    fail("beta2", "must be in [0, 1), got " + str(beta2));
+    fail("beta2", "must be in [0, 1), got " + to_text(beta2));
   if (!(adam_epsilon > 0) || !std::isfinite(adam_epsilon))
-    fail("adam_epsilon", "must be finite and > 0, got " + str(adam_epsilon));
+    fail("adam_epsilon", "must be finite and > 0, got " + to_text(adam_epsilon));
   if (plateau_epochs < 1)
-    fail("plateau_epochs", "must be ≥ 1, got " + str(plateau_epochs));
+    fail("plateau_epochs", "must be ≥ 1, got " + to_text(plateau_epochs));
   if (patience < 1)
-    fail("patience", "must be ≥ 1, got " + str(patience));
+    fail("patience", "must be ≥ 1, got " + to_text(patience));
   if (!(min_improvement >= 0 && min_improvement < 1))
-    fail("min_improvement", "must be in [0, 1), got " + str(min_improvement));
+    fail("min_improvement", "must be in [0, 1), got " + to_text(min_improvement));
   if (!(batch_norm_momentum > 0 && batch_norm_momentum <= 1))
-    fail("batch_norm_momentum", "must be in (0, 1], got " + str(batch_norm_momentum));
+    fail("batch_norm_momentum", "must be in (0, 1], got " + to_text(batch_norm_momentum));
   if (!(batch_norm_epsilon > 0) || !std::isfinite(batch_norm_epsilon))
-    fail("batch_norm_epsilon", "must be finite and > 0, got " + str(batch_norm_epsilon));
+    fail("batch_norm_epsilon", "must be finite and > 0, got " + to_text(batch_norm_epsilon));
 }
 
 BatchNormMlp make_batch_norm_mlp(int inputs, const std::vector<int>& hidden_widths, int outputs,
     bool batch_norm, std::uint64_t seed) {
   if (inputs < 1 || outputs < 1)
-    fail("network", "needs ≥ 1 input and output, got " + str(inputs) + " and " + str(outputs));
+    fail("network",
+        "needs ≥ 1 input and output, got " + to_text(inputs) + " and " + to_text(outputs));
   for (int w : hidden_widths) {
     if (w < 1 || w > material::NnCorrection::max_width) {
       fail("hidden_widths",
-          "width " + str(w) + " outside 1.." + str(material::NnCorrection::max_width));
+          "width " + to_text(w) + " outside 1.." + to_text(material::NnCorrection::max_width));
     }
   }
   std::mt19937_64 rng(seed);
@@ -219,7 +212,7 @@ std::vector<material::NnCorrection::Layer> fold_batch_norm(const BatchNormMlp& n
 MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, ConstRef<MatX> valid_x,
     ConstRef<MatX> valid_y, const MlpTrainingOptions& o) {
   o.validate();
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   const int inputs = static_cast<int>(train_x.rows());
   const int outputs = static_cast<int>(train_y.rows());
   check_set("training", train_x, train_y, inputs, outputs);
@@ -232,7 +225,7 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
   const Eigen::Index n = train_x.cols();
   const Eigen::Index batch = std::min<Eigen::Index>(o.batch_size, n);
   if (batch < 2)
-    fail("training", "needs ≥ 2 samples, got " + str(n));
+    fail("training", "needs ≥ 2 samples, got " + to_text(n));
   const Eigen::Index batches = n / batch; // the remainder (< batch) sits out this epoch
   const std::size_t num_layers = net.layers.size();
 
@@ -333,7 +326,7 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
     const double loss = mean_squared_error(net, valid_x, valid_y);
     if (!std::isfinite(loss)) {
       fail("learning_rate",
-          "training diverged at epoch " + str(epoch) + " (validation loss " + str(loss)
+          "training diverged at epoch " + to_text(epoch) + " (validation loss " + to_text(loss)
               + "); lower the learning rate");
     }
     result.report.validation_history.push_back(loss);
@@ -357,8 +350,7 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
   }
   result.report.validation_loss = best;
   result.report.training_loss = mean_squared_error(result.network, train_x, train_y);
-  result.report.seconds
-      = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.report.seconds = seconds_since(start);
   return result;
 }
 

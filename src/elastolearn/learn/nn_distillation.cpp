@@ -1,4 +1,5 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/fem/tet_element.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/material/principal_stress.hpp>
@@ -8,21 +9,12 @@
 #include <array>
 #include <cmath>
 #include <numeric>
-#include <sstream>
 
 namespace elastolearn::learn {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError("distillation." + field, what);
-}
-
-template <typename T> std::string str(T v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+constexpr FieldErrors fail("distillation");
 
 using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
@@ -84,21 +76,21 @@ void direction_rows(
 
 void DistillationSampleOptions::validate() const {
   if (recorded_samples < 1)
-    fail("recorded_samples", "must be ≥ 1, got " + str(recorded_samples));
+    fail("recorded_samples", "must be ≥ 1, got " + to_text(recorded_samples));
   if (frame_stride < 1)
-    fail("frame_stride", "must be ≥ 1, got " + str(frame_stride));
+    fail("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
   if (jitter_copies < 0)
-    fail("jitter_copies", "must be ≥ 0, got " + str(jitter_copies));
+    fail("jitter_copies", "must be ≥ 0, got " + to_text(jitter_copies));
   if (!std::isfinite(stretch_jitter) || stretch_jitter < 0)
-    fail("stretch_jitter", "must be finite and ≥ 0, got " + str(stretch_jitter));
+    fail("stretch_jitter", "must be finite and ≥ 0, got " + to_text(stretch_jitter));
   if (!std::isfinite(rate_jitter) || rate_jitter < 0)
-    fail("rate_jitter", "must be finite and ≥ 0, got " + str(rate_jitter));
+    fail("rate_jitter", "must be finite and ≥ 0, got " + to_text(rate_jitter));
 }
 
 void NnDistillationOptions::validate() const {
   training.validate();
   if (!(validation_fraction > 0 && validation_fraction < 1))
-    fail("validation_fraction", "must be in (0, 1), got " + str(validation_fraction));
+    fail("validation_fraction", "must be in (0, 1), got " + to_text(validation_fraction));
 }
 
 StressSamples distillation_samples(std::span<const sim::Scene> scenes,
@@ -215,9 +207,9 @@ std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const 
   std::vector<sim::Scene> out;
   for (double a : scales) {
     if (!std::isfinite(a))
-      fail("motion_scales", "contains a non-finite factor " + str(a));
+      fail("motion_scales", "contains a non-finite factor " + to_text(a));
     sim::Scene s = scene;
-    s.name = scene.name + "_x" + str(a);
+    s.name = scene.name + "_x" + to_text(a);
     s.gravity *= a;
     s.initial.velocity *= a;
     s.initial.angular_velocity *= a;
@@ -246,8 +238,8 @@ NnDistillationResult distill_nn_correction(
   const Eigen::Index n = samples.stretches.rows();
   if (samples.stretch_rates.rows() != n || samples.targets.rows() != n) {
     fail("samples",
-        str(n) + " stretch samples but " + str(samples.stretch_rates.rows()) + " stretch rates and "
-            + str(samples.targets.rows()) + " targets");
+        to_text(n) + " stretch samples but " + to_text(samples.stretch_rates.rows())
+            + " stretch rates and " + to_text(samples.targets.rows()) + " targets");
   }
   if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite()
       || !samples.targets.allFinite()) {
@@ -262,8 +254,8 @@ NnDistillationResult distill_nn_correction(
   const auto n_valid = static_cast<std::size_t>(std::llround(o.validation_fraction * double(n)));
   if (n_valid < 2 || order.size() - n_valid < 2) {
     fail("samples",
-        str(n) + " samples leave fewer than 2 in the training or validation split "
-            + "(validation_fraction " + str(o.validation_fraction) + ")");
+        to_text(n) + " samples leave fewer than 2 in the training or validation split "
+            + "(validation_fraction " + to_text(o.validation_fraction) + ")");
   }
   std::vector<int> valid(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n_valid));
   std::vector<int> train(order.begin() + static_cast<std::ptrdiff_t>(n_valid), order.end());

@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/interrupt.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
 #include <elastolearn/material/spline_edited.hpp>
@@ -11,7 +12,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -22,11 +22,6 @@ namespace {
 
 constexpr double kPoissonMax = 0.49; ///< upper end of the fitted ν range (0, 0.49)
 constexpr std::array<const char*, 4> kParameterNames = { "young", "poisson", "alpha0", "alpha1" };
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 /// The change of variables u ↔ p that keeps every trial physically valid.
 struct ParameterTransform {

@@ -1,41 +1,33 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/learn/pod_basis.hpp>
 
 #include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::learn {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError("pod." + field, what);
-}
-
-template <typename T> std::string str(T v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+constexpr FieldErrors fail("pod");
 
 } // namespace
 
 void PodOptions::validate() const {
   if (max_modes < 1)
-    fail("max_modes", "must be at least 1, got " + str(max_modes));
+    fail("max_modes", "must be at least 1, got " + to_text(max_modes));
   if (!(energy_fraction > 0 && energy_fraction <= 1))
-    fail("energy_fraction", "must be in (0, 1], got " + str(energy_fraction));
+    fail("energy_fraction", "must be in (0, 1], got " + to_text(energy_fraction));
   if (first_frame < 0)
-    fail("first_frame", "must be ≥ 0, got " + str(first_frame));
+    fail("first_frame", "must be ≥ 0, got " + to_text(first_frame));
   if (frame_count < 0)
-    fail("frame_count", "must be ≥ 0 (0 = all), got " + str(frame_count));
+    fail("frame_count", "must be ≥ 0 (0 = all), got " + to_text(frame_count));
   if (frame_stride < 1)
-    fail("frame_stride", "must be at least 1, got " + str(frame_stride));
+    fail("frame_stride", "must be at least 1, got " + to_text(frame_stride));
   if (!(rank_tolerance >= 0 && rank_tolerance < 1))
-    fail("rank_tolerance", "must be in [0, 1), got " + str(rank_tolerance));
+    fail("rank_tolerance", "must be in [0, 1), got " + to_text(rank_tolerance));
 }
 
 PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> rest,
@@ -54,20 +46,20 @@ PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRe
   for (std::size_t k = 0; k < trajectories.size(); ++k) {
     if (trajectories[k].size() != frames.size()) {
       fail("frames",
-          "trajectory " + str(k) + " has " + str(trajectories[k].size()) + " frames, the first "
-              + "has " + str(frames.size()));
+          "trajectory " + to_text(k) + " has " + to_text(trajectories[k].size())
+              + " frames, the first " + "has " + to_text(frames.size()));
     }
     for (std::size_t t = 0; t < trajectories[k].size(); ++t) {
       if (trajectories[k][t].rows() != n) {
         fail("frames",
-            "frame " + str(t) + " has " + str(trajectories[k][t].rows()) + " vertices, the rest "
-                + "shape has " + str(n));
+            "frame " + to_text(t) + " has " + to_text(trajectories[k][t].rows())
+                + " vertices, the rest " + "shape has " + to_text(n));
       }
     }
   }
   for (int v : free_vertices) {
     if (v < 0 || v >= n)
-      fail("free_vertices", "vertex " + str(v) + " is out of range [0, " + str(n) + ")");
+      fail("free_vertices", "vertex " + to_text(v) + " is out of range [0, " + to_text(n) + ")");
   }
   if (free_vertices.empty())
     fail("free_vertices", "no free vertex: nothing to reduce");
@@ -76,15 +68,16 @@ PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRe
     std::sort(sorted.begin(), sorted.end());
     const auto repeated = std::adjacent_find(sorted.begin(), sorted.end());
     if (repeated != sorted.end())
-      fail("free_vertices", "vertex " + str(*repeated) + " is listed twice");
+      fail("free_vertices", "vertex " + to_text(*repeated) + " is listed twice");
   }
   if (options.mass_orthonormal) {
     if (dof_masses.size() != 3 * n)
-      fail("dof_masses", "need 3n = " + str(3 * n) + " masses, got " + str(dof_masses.size()));
+      fail("dof_masses",
+          "need 3n = " + to_text(3 * n) + " masses, got " + to_text(dof_masses.size()));
     for (int v : free_vertices) {
       for (int c = 0; c < 3; ++c) {
         if (!(dof_masses[3 * v + c] > 0))
-          fail("dof_masses", "mass of vertex " + str(v) + " is not positive");
+          fail("dof_masses", "mass of vertex " + to_text(v) + " is not positive");
       }
     }
   }
@@ -98,7 +91,8 @@ PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRe
     basis.frames.push_back(t);
   if (basis.frames.empty()) {
     fail("first_frame",
-        "selects no frame of " + str(total) + " (first_frame " + str(options.first_frame) + ")");
+        "selects no frame of " + to_text(total) + " (first_frame " + to_text(options.first_frame)
+            + ")");
   }
 
   // Snapshot matrix: row 3j + c ↔ free vertex j, component c; column s ↔ frame basis.frames[s].

@@ -1,4 +1,5 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
 
 #include <Eigen/Cholesky>
@@ -7,21 +8,12 @@
 #include <array>
 #include <cmath>
 #include <functional>
-#include <sstream>
 
 namespace elastolearn::learn {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError("rbf_fit." + field, what);
-}
-
-template <typename T> std::string str(T v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+constexpr FieldErrors fail("rbf_fit");
 
 constexpr Eigen::Index k_chunk = 2048;
 
@@ -29,13 +21,14 @@ constexpr Eigen::Index k_chunk = 2048;
 
 void RbfFitOptions::validate() const {
   if (!std::isfinite(epsilon) || epsilon < 0)
-    fail("epsilon", "must be finite and ≥ 0, got " + str(epsilon));
+    fail("epsilon", "must be finite and ≥ 0, got " + to_text(epsilon));
   if (!std::isfinite(regularization) || regularization < 0)
-    fail("regularization", "must be finite and ≥ 0, got " + str(regularization));
+    fail("regularization", "must be finite and ≥ 0, got " + to_text(regularization));
   if (!std::isfinite(damping_regularization) || damping_regularization < 0)
-    fail("damping_regularization", "must be finite and ≥ 0, got " + str(damping_regularization));
+    fail(
+        "damping_regularization", "must be finite and ≥ 0, got " + to_text(damping_regularization));
   if (std::isnan(damping_floor) || damping_floor > 0)
-    fail("damping_floor", "must be ≤ 0 (or −infinity), got " + str(damping_floor));
+    fail("damping_floor", "must be ≤ 0 (or −infinity), got " + to_text(damping_floor));
   if (damping_quadratic_tail && !damping_polynomial)
     fail("damping_quadratic_tail", "needs damping_polynomial (the linear tail)");
 }
@@ -45,7 +38,8 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options)
   options.validate();
   if (centres.rows() < 1 || centres.cols() != 3)
     fail("centres",
-        "expected m × 3 with m ≥ 1, got " + str(centres.rows()) + " × " + str(centres.cols()));
+        "expected m × 3 with m ≥ 1, got " + to_text(centres.rows()) + " × "
+            + to_text(centres.cols()));
   if (!centres.allFinite())
     fail("centres", "contains a non-finite value");
   m_centres = centres;
@@ -211,7 +205,7 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   if (m_constant < 0
       && std::abs(prestress)
           > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels) + 1))
-    fail("correction", "it is not stress-free at rest (N(1) = " + str(prestress) + " Pa)");
+    fail("correction", "it is not stress-free at rest (N(1) = " + to_text(prestress) + " Pa)");
   if (m_damping > 0) {
     if (p.damping_weights.size() == m)
       x.segment(m_elastic, m) = p.damping_weights;
@@ -257,7 +251,7 @@ VecX solve_regularised_normal_equations(
   const Eigen::LLT<MatX> llt(normal);
   if (llt.info() != Eigen::Success)
     fail("regularization",
-        "the normal equations are singular (" + str(samples) + " samples, " + str(u)
+        "the normal equations are singular (" + to_text(samples) + " samples, " + to_text(u)
             + " unknowns); increase the regularisation or give more varied samples");
   const VecX x = (llt.solve(rhs.cwiseQuotient(scale))).cwiseQuotient(scale);
   if (!x.allFinite())
@@ -271,8 +265,8 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
     fail("samples", "no samples to fit");
   if (samples.stretch_rates.rows() != n || samples.targets.rows() != n)
     fail("samples",
-        str(n) + " stretch samples but " + str(samples.stretch_rates.rows()) + " stretch rates and "
-            + str(samples.targets.rows()) + " targets");
+        to_text(n) + " stretch samples but " + to_text(samples.stretch_rates.rows())
+            + " stretch rates and " + to_text(samples.targets.rows()) + " targets");
   if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite()
       || !samples.targets.allFinite())
     fail("samples", "contain a non-finite value");

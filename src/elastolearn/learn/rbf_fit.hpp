@@ -17,17 +17,17 @@ struct RbfFitOptions {
   /// Keep the rest shape stress-free: N(1, 1, 1) = 0, as for every hyperelastic model. The
   /// kernels enter as φ_i(y) − φ_i(1) and the pressure c is not an unknown but follows from the
   /// weights (c = −Σ w_i φ_i(1)). Without it the fit may explain residual forces by a prestress
-  /// at rest (the full-size sphere's first correction had N(1) = +1.07 kPa), and an unloaded
-  /// object simulated with the learned material would not stay at rest.
+  /// at rest (the full-size sphere's first correction then has N(1) = +1.07 kPa), and an
+  /// unloaded object simulated with the learned material would not stay at rest.
   bool stress_free_rest = true;
   /// Also fit the quadratic tail q (material::quadratic_tail_basis; needs elastic_polynomial).
   bool quadratic_tail = true;
   /// Also fit the neo-Hookean tail r (material::neo_hookean_tail_basis; needs elastic_polynomial).
-  /// Off by default: on, the 240-tet regression case learned 0.0705 % instead of 0.0446 % and its
-  /// distilled network 0.349 % instead of 0.0462 %. The sphere cases turn it on, with a prior on
-  /// Δα₁ in the forward fit (ForwardFitOptions::damping_prior): alone it rescued the quick
-  /// sphere-compression's test simulation but tested above the nominal (2.398 % against 2.252 %);
-  /// together they bring the full-size case to 1.250 % (docs/benchmarks_learning.md, "Update 8").
+  /// Off by default: it makes the end-to-end regression case (tests/learn/test_learning_loop.cpp)
+  /// and its distilled network learn worse. The sphere cases turn it on, together with a prior
+  /// on Δα₁ in the forward fit (ForwardFitOptions::damping_prior): alone the tail keeps the
+  /// quick sphere-compression test simulation from diverging but tests above the nominal there
+  /// (docs/learning.md, "Neo-Hookean tail"; docs/benchmarks_learning.md).
   bool neo_hookean_tail = false;
   /// Fit the stiffness-damping RBF Δα₁(σ) (only the stress reconstruction can: it needs the
   /// elements' damping forces, which principal stress samples do not carry).

@@ -1,10 +1,10 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/space_time.hpp>
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -16,8 +16,8 @@ namespace {
 
 /// out = A B for sparse matrices A of one fixed pattern and a fixed dense B of a few columns
 /// (Φ on the free dofs), row by row: each row of A is read once for all columns of B, where
-/// Eigen's column-major sparse × dense product walks the whole of A once per column (it was 9 %
-/// of a learning run). Entry (i, j) is summed over A's columns in increasing order starting
+/// Eigen's column-major sparse × dense product walks the whole of A once per column (9 % of a
+/// learning run's time). Entry (i, j) is summed over A's columns in increasing order starting
 /// from zero, exactly as Eigen sums it, so the results are bitwise Eigen's; rows split over
 /// threads do not change any sum.
 class FixedPatternProduct {
@@ -150,8 +150,8 @@ SpaceTimeProblem::SpaceTimeProblem(TrajectoryPhysics& physics, ConstRef<MatX> ba
   const VecX free_masses = physics.dofs().restrict(physics.dof_masses());
   // Forces → the displacement they cause over 1 % of the trajectory's duration, so that the
   // balance with the position term does not depend on the time step (with h²/m̄ instead, a run
-  // at 1 ms steps weighted the physics 16× less than the same motion at 4 ms, and learning
-  // stalled: measured on a 1440-tet bar, 10.3 % → 3.7 % err_L against 10.3 % → 0.1 %).
+  // at 1 ms steps weighs the physics 16× less than the same motion at 4 ms, and learning stalls:
+  // docs/learning_loop.md).
   const double reference_time = 0.01 * steps * s.h;
   s.scale = reference_time * reference_time / free_masses.mean();
   s.inertia = s.free_basis.transpose() * free_masses.asDiagonal() * s.free_basis / (s.h * s.h);
@@ -249,7 +249,7 @@ SpaceTimeResult optimize_space_time(TrajectoryPhysics& physics, ConstRef<MatX> b
     const std::vector<VecX>& origin, const VecX& v0, const observe::Observation& observed,
     const SpaceTimeOptions& options, const ProgressCallback& progress) {
   options.validate();
-  const auto start_time = std::chrono::steady_clock::now();
+  const auto start_time = Clock::now();
   const int T = static_cast<int>(origin.size()) - 1;
   for (const auto& state : origin)
     if (state.size() != basis.rows())
@@ -312,8 +312,7 @@ SpaceTimeResult optimize_space_time(TrajectoryPhysics& physics, ConstRef<MatX> b
       ? static_cast<double>(observed.num_observed())
       : 1.0;
   result.position_rms = std::sqrt(current.position_squares / ((T + 1) * observed_points));
-  result.seconds
-      = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  result.seconds = seconds_since(start_time);
   return result;
 }
 

@@ -1,4 +1,6 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/stress_reconstruction.hpp>
 #include <elastolearn/learn/stress_reconstruction_lsqr.hpp>
 
@@ -8,27 +10,13 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::learn {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError("stress_reconstruction." + field, what);
-}
-
-template <typename T> std::string str(T v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+constexpr FieldErrors fail("stress_reconstruction");
 
 /// Element states of elements [begin, end) (serial; no allocation).
 void element_states_range(const ReconstructionMesh& mesh, const VecX& x, const VecX& v, int begin,
@@ -85,9 +73,9 @@ ReconstructionMesh::ReconstructionMesh(std::vector<fem::TetRestData> rest_data, 
     , num_vertices(n)
     , nominal(std::move(nominal_model)) {
   if (rest.size() != static_cast<size_t>(tets.rows()))
-    fail("mesh", str(rest.size()) + " rest data for " + str(tets.rows()) + " tets");
+    fail("mesh", to_text(rest.size()) + " rest data for " + to_text(tets.rows()) + " tets");
   if (tets.size() > 0 && (tets.minCoeff() < 0 || tets.maxCoeff() >= n))
-    fail("mesh", "a tet index is outside [0, " + str(n) + ")");
+    fail("mesh", "a tet index is outside [0, " + to_text(n) + ")");
 }
 
 void compute_element_states(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,
@@ -285,9 +273,9 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
 
 void StretchSampleOptions::validate() const {
   if (frame_stride < 1)
-    throw InputError("stretch_samples.frame_stride", "must be ≥ 1, got " + str(frame_stride));
+    throw InputError("stretch_samples.frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
   if (max_samples < 0)
-    throw InputError("stretch_samples.max_samples", "must be ≥ 0, got " + str(max_samples));
+    throw InputError("stretch_samples.max_samples", "must be ≥ 0, got " + to_text(max_samples));
 }
 
 MatX collect_stretches(const ReconstructionMesh& mesh, const std::vector<VecX>& positions,
@@ -332,13 +320,13 @@ ReconstructionMethod reconstruction_method_from_name(
 
 void StressReconstructionOptions::validate() const {
   if (frame_stride < 1)
-    fail("frame_stride", "must be ≥ 1, got " + str(frame_stride));
+    fail("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
   if (!std::isfinite(lsqr_tolerance) || lsqr_tolerance <= 0)
-    fail("lsqr_tolerance", "must be finite and > 0, got " + str(lsqr_tolerance));
+    fail("lsqr_tolerance", "must be finite and > 0, got " + to_text(lsqr_tolerance));
   if (lsqr_max_iterations < 0)
-    fail("lsqr_max_iterations", "must be ≥ 0, got " + str(lsqr_max_iterations));
+    fail("lsqr_max_iterations", "must be ≥ 0, got " + to_text(lsqr_max_iterations));
   if (!std::isfinite(full_space_weight) || full_space_weight < 0)
-    fail("full_space_weight", "must be finite and ≥ 0, got " + str(full_space_weight));
+    fail("full_space_weight", "must be finite and ≥ 0, got " + to_text(full_space_weight));
 }
 
 namespace detail {
@@ -350,7 +338,7 @@ void check_frames(const ReconstructionMesh& mesh, const fem::DofMap* dofs,
   if (positions.empty())
     fail("positions", "no frames");
   if (dofs != nullptr && dofs->num_dofs() != n3)
-    fail("dofs", "the DofMap has " + str(dofs->num_dofs()) + " dofs, the mesh " + str(n3));
+    fail("dofs", "the DofMap has " + to_text(dofs->num_dofs()) + " dofs, the mesh " + to_text(n3));
   const std::array<std::pair<const char*, const std::vector<VecX>*>, 3> lists {
     { { "positions", &positions }, { "velocities", velocities },
         { "target_forces", target_forces } }
@@ -359,14 +347,14 @@ void check_frames(const ReconstructionMesh& mesh, const fem::DofMap* dofs,
     if (list == nullptr)
       continue;
     if (list->size() != positions.size())
-      fail(name, str(list->size()) + " frames but " + str(positions.size()) + " positions");
+      fail(name, to_text(list->size()) + " frames but " + to_text(positions.size()) + " positions");
     for (size_t t = 0; t < list->size(); ++t) {
       const VecX& f = (*list)[t];
       if (f.size() != n3)
-        fail(std::string(name) + "[" + str(t) + "]",
-            "length " + str(f.size()) + ", expected 3n = " + str(n3));
+        fail(std::string(name) + "[" + to_text(t) + "]",
+            "length " + to_text(f.size()) + ", expected 3n = " + to_text(n3));
       if (!f.allFinite())
-        fail(std::string(name) + "[" + str(t) + "]", "contains a non-finite value");
+        fail(std::string(name) + "[" + to_text(t) + "]", "contains a non-finite value");
     }
   }
 }
@@ -384,7 +372,7 @@ ForceMisfit correction_force_misfit(const ReconstructionMesh& mesh, const fem::D
     const material::Correction& correction, const std::vector<VecX>& positions,
     const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces, int frame_stride) {
   if (frame_stride < 1)
-    fail("frame_stride", "must be ≥ 1, got " + str(frame_stride));
+    fail("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
   detail::check_frames(mesh, &dofs, positions, &velocities, &target_forces);
   if (dofs.num_free() == 0)
     fail("dofs", "no free degree of freedom");
@@ -420,10 +408,11 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
     fail("dofs", "no free degree of freedom");
   if (projected && (projection.rows() != rows || !projection.allFinite()))
     fail("projection",
-        "must have one finite row per free dof (" + str(rows) + "), got " + str(projection.rows()));
+        "must have one finite row per free dof (" + to_text(rows) + "), got "
+            + to_text(projection.rows()));
   if (design.damping_unknowns() > 0 && mesh.nominal.elastic == nullptr)
     fail("nominal", "fitting the damping correction needs the nominal elastic model");
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   const std::vector<int> frames
       = detail::selected_frames(int(positions.size()), options.frame_stride);
   const int u = design.num_unknowns();
@@ -470,13 +459,13 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
   normal.triangularView<Eigen::StrictlyUpper>() = normal.transpose();
   const double assembly_seconds = seconds_since(start);
 
-  const auto solve_start = std::chrono::steady_clock::now();
+  const auto solve_start = Clock::now();
   VecX x = solve_regularised_normal_equations(
       std::move(normal), rhs, design.regularization_weights(), long(frames.size()));
   material::RbfCorrection correction = design.correction(x);
   const double solve_seconds = seconds_since(solve_start);
 
-  const auto misfit_start = std::chrono::steady_clock::now();
+  const auto misfit_start = Clock::now();
   const ForceMisfit misfit = correction_force_misfit(
       mesh, dofs, correction, positions, velocities, target_forces, options.frame_stride);
   StressReconstructionResult result { std::move(correction), std::move(x), misfit, rows };

@@ -148,10 +148,10 @@ struct StressReconstructionOptions {
   int lsqr_max_iterations = 0;
   /// With a force projection P (reconstruct_rbf_correction's `projection`): the weight μ ≥ 0 of
   /// the unprojected misfit next to the projected one. μ = 0 leaves the correction's forces
-  /// outside span P unconstrained, and learned corrections then blew up on larger test motions
-  /// (quick sphere-tension: the test simulation diverged at μ = 0.01). Of μ = 0.03, 0.1, 0.3, 1
-  /// only 0.1 kept every benchmark target the unprojected fit met (at 0.3 the dragon tested at
-  /// 0.219 %, over its 0.2 %): docs/benchmarks_learning.md, "Update 5".
+  /// outside span P unconstrained, and a learned correction can then blow up on motions larger
+  /// than the training. 0.1 is the weight that keeps every learning-benchmark target the
+  /// unprojected fit meets (the comparison of weights: docs/learning.md, "Projected
+  /// reconstruction").
   double full_space_weight = 0.1;
   /// Throws InputError("stress_reconstruction.<field>", ...) for an out-of-range field.
   void validate() const;

@@ -1,22 +1,17 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/stress_reconstruction_lsqr.hpp>
 
 #include <Eigen/IterativeLinearSolvers>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
-#include <sstream>
 
 namespace elastolearn::learn {
 
 namespace {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 /// CGLS for one frame with B already assembled.
 ElementStressResult solve_min_norm(
@@ -81,7 +76,7 @@ StressReconstructionResult reconstruct_rbf_correction_via_lsqr(const Reconstruct
   detail::check_frames(mesh, &dofs, positions, &velocities, &target_forces);
   if (dofs.num_free() == 0)
     throw InputError("stress_reconstruction.dofs", "no free degree of freedom");
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   const std::vector<int> frames
       = detail::selected_frames(int(positions.size()), options.frame_stride);
   const Eigen::Index m = mesh.num_tets();
@@ -114,11 +109,11 @@ StressReconstructionResult reconstruct_rbf_correction_via_lsqr(const Reconstruct
       });
   const double assembly_seconds = seconds_since(start);
 
-  const auto solve_start = std::chrono::steady_clock::now();
+  const auto solve_start = Clock::now();
   RbfFitResult fit = fit_rbf_correction(design, samples);
   const double solve_seconds = seconds_since(solve_start);
 
-  const auto misfit_start = std::chrono::steady_clock::now();
+  const auto misfit_start = Clock::now();
   const ForceMisfit misfit = correction_force_misfit(
       mesh, dofs, fit.correction, positions, velocities, target_forces, options.frame_stride);
   StressReconstructionResult result { std::move(fit.correction), std::move(fit.unknowns), misfit,

@@ -1,21 +1,22 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/material/analytic_correction.hpp>
 
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::material {
+
+namespace {
+constexpr FieldErrors fail("analytic_correction");
+} // namespace
 
 AnalyticCorrection::AnalyticCorrection(const Parameters& p)
     : m_p(p) {
   const double values[3] = { p.a, p.b, p.c };
   const char* names[3] = { "a", "b", "c" };
   for (int k = 0; k < 3; ++k) {
-    if (!std::isfinite(values[k])) {
-      std::ostringstream os;
-      os << "must be finite, got " << values[k];
-      throw InputError(std::string("analytic_correction.") + names[k], os.str());
-    }
+    if (!std::isfinite(values[k]))
+      fail(names[k], "must be finite, got " + to_text(values[k]));
   }
 }
 

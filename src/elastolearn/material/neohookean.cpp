@@ -1,8 +1,8 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/material/neohookean.hpp>
 
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::material {
 
@@ -10,11 +10,9 @@ NeoHookeanModel::NeoHookeanModel(const Lame& lame, double inversion_threshold)
     : m_lame(lame)
     , m_eps(inversion_threshold)
     , m_log_eps(0) {
-  if (!std::isfinite(inversion_threshold) || inversion_threshold <= 0 || inversion_threshold >= 1) {
-    std::ostringstream os;
-    os << "must satisfy 0 < threshold < 1, got " << inversion_threshold;
-    throw InputError("neohookean.inversion_threshold", os.str());
-  }
+  if (!std::isfinite(inversion_threshold) || inversion_threshold <= 0 || inversion_threshold >= 1)
+    throw InputError("neohookean.inversion_threshold",
+        "must satisfy 0 < threshold < 1, got " + to_text(inversion_threshold));
   m_log_eps = std::log(m_eps);
 }
 

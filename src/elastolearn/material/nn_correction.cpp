@@ -1,18 +1,16 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/material/nn_correction.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::material {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError("nn_correction." + field, what);
-}
+constexpr FieldErrors fail("nn_correction");
 
 std::string layer_field(std::size_t k, const char* member) {
   return "layers[" + std::to_string(k) + "]." + member;
@@ -21,11 +19,9 @@ std::string layer_field(std::size_t k, const char* member) {
 template <typename Derived>
 void check_scale(const char* field, const Eigen::MatrixBase<Derived>& scale) {
   for (Eigen::Index i = 0; i < scale.size(); ++i) {
-    if (!std::isfinite(scale[i]) || scale[i] <= 0) {
-      std::ostringstream s;
-      s << "entry " << i << " must be finite and > 0, got " << scale[i];
-      fail(field, s.str());
-    }
+    if (!std::isfinite(scale[i]) || scale[i] <= 0)
+      fail(field,
+          "entry " + std::to_string(i) + " must be finite and > 0, got " + to_text(scale[i]));
   }
 }
 

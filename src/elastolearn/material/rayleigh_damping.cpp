@@ -1,18 +1,16 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
 
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::material {
 
 namespace {
 void check_coefficient(double value, const std::string& where) {
-  if (!std::isfinite(value) || value < 0) {
-    std::ostringstream os;
-    os << "Rayleigh coefficient must be finite and non-negative, got " << value;
-    throw InputError(where, os.str());
-  }
+  if (!std::isfinite(value) || value < 0)
+    throw InputError(
+        where, "Rayleigh coefficient must be finite and non-negative, got " + to_text(value));
 }
 } // namespace
 

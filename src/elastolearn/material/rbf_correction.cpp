@@ -1,17 +1,15 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/material/rbf_correction.hpp>
 
 #include <algorithm>
 #include <array>
-#include <sstream>
 
 namespace elastolearn::material {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& field, const std::string& what) {
-  throw InputError("rbf_correction." + field, what);
-}
+constexpr FieldErrors fail("rbf_correction");
 
 /// Stable descending order of three values: order[i] = index of the i-th largest.
 std::array<int, 3> descending_order(const Vec3& v) {
@@ -94,9 +92,7 @@ RbfCorrection::RbfCorrection(Parameters p)
   if (std::isnan(m_p.damping_floor) || m_p.damping_floor == std::numeric_limits<double>::infinity())
     fail("damping_floor", "must be a number or −infinity");
   if (!std::isfinite(m_p.epsilon) || m_p.epsilon < 0) {
-    std::ostringstream s;
-    s << "must be finite and ≥ 0, got " << m_p.epsilon;
-    fail("epsilon", s.str());
+    fail("epsilon", "must be finite and ≥ 0, got " + to_text(m_p.epsilon));
   }
 }
 

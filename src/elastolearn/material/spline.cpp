@@ -1,9 +1,9 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/material/spline.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::material {
 
@@ -19,17 +19,14 @@ CubicSpline::CubicSpline(std::vector<double> x, std::vector<double> y, std::stri
   }
   const std::size_t n = m_x.size();
   for (std::size_t k = 0; k < n; ++k) {
-    if (!std::isfinite(m_x[k]) || !std::isfinite(m_y[k])) {
-      std::ostringstream os;
-      os << "knot " << k << " is not finite (x = " << m_x[k] << ", y = " << m_y[k] << ")";
-      throw InputError(where, os.str());
-    }
-    if (k > 0 && !(m_x[k] > m_x[k - 1])) {
-      std::ostringstream os;
-      os << "knot x must be strictly increasing, but x[" << k << "] = " << m_x[k] << " <= x["
-         << k - 1 << "] = " << m_x[k - 1];
-      throw InputError(where, os.str());
-    }
+    if (!std::isfinite(m_x[k]) || !std::isfinite(m_y[k]))
+      throw InputError(where,
+          "knot " + std::to_string(k) + " is not finite (x = " + to_text(m_x[k])
+              + ", y = " + to_text(m_y[k]) + ")");
+    if (k > 0 && !(m_x[k] > m_x[k - 1]))
+      throw InputError(where,
+          "knot x must be strictly increasing, but x[" + std::to_string(k) + "] = "
+              + to_text(m_x[k]) + " <= x[" + std::to_string(k - 1) + "] = " + to_text(m_x[k - 1]));
   }
   // Fritsch–Carlson tangents.
   m_m.assign(n, 0.0);

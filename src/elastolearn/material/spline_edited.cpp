@@ -1,10 +1,10 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/material/spline_edited.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 namespace elastolearn::material {
 
@@ -34,24 +34,19 @@ SplineEditedModel::SplineEditedModel(ElasticModelType base, const Lame& lame,
   m_base = make_elastic_model(base, lame);
   const auto& x = m_spline.knots_x();
   const auto& y = m_spline.knots_y();
-  std::ostringstream os;
-  os.precision(17);
   const bool tension = region == SplineEditRegion::Tension;
   const std::size_t near = tension ? 0 : x.size() - 1; // knot nearest the rest stretch
-  if (tension ? !(x.front() >= 1) : !(x.back() <= 1)) {
-    os << "knots of a " << to_string(region) << " edit must satisfy x " << (tension ? ">=" : "<=")
-       << " 1, got x = " << x[near];
-    throw InputError(where + ".spline", os.str());
-  }
-  if (std::abs(y[near] - 1) > 1e-12) {
-    os << "the knot nearest the rest stretch (x = " << x[near] << ") must have value 1, got "
-       << y[near];
-    throw InputError(where + ".spline", os.str());
-  }
-  if (!(m_spline.min_value() > 0)) {
-    os << "spline values must be positive, got " << m_spline.min_value();
-    throw InputError(where + ".spline", os.str());
-  }
+  if (tension ? !(x.front() >= 1) : !(x.back() <= 1))
+    throw InputError(where + ".spline",
+        "knots of a " + to_string(region) + " edit must satisfy x " + (tension ? ">=" : "<=")
+            + " 1, got x = " + to_text_exact(x[near]));
+  if (std::abs(y[near] - 1) > 1e-12)
+    throw InputError(where + ".spline",
+        "the knot nearest the rest stretch (x = " + to_text_exact(x[near])
+            + ") must have value 1, got " + to_text_exact(y[near]));
+  if (!(m_spline.min_value() > 0))
+    throw InputError(where + ".spline",
+        "spline values must be positive, got " + to_text_exact(m_spline.min_value()));
 }
 
 double SplineEditedModel::f_prime(double x) const {

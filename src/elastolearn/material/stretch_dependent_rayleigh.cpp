@@ -1,17 +1,15 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/material/stretch_dependent_rayleigh.hpp>
-
-#include <sstream>
 
 namespace elastolearn::material {
 
 namespace {
 void check_non_negative(const StretchCurve& s, const std::string& where) {
-  if (s.lower_bound() < 0) {
-    std::ostringstream os;
-    os << "Rayleigh coefficient spline must be non-negative, got a knot value " << s.lower_bound();
-    throw InputError(where, os.str());
-  }
+  if (s.lower_bound() < 0)
+    throw InputError(where,
+        "Rayleigh coefficient spline must be non-negative, got a knot value "
+            + to_text(s.lower_bound()));
 }
 } // namespace
 

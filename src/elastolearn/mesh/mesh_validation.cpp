@@ -1,9 +1,9 @@
 #include <elastolearn/mesh/mesh_validation.hpp>
 
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::mesh {
 
@@ -13,13 +13,6 @@ std::string locate(const std::string& source, const std::vector<int>* lines, int
   if (lines && index < static_cast<int>(lines->size()) && (*lines)[index] > 0)
     return source + ":" + std::to_string((*lines)[index]);
   return source;
-}
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
 }
 
 } // namespace
@@ -45,7 +38,7 @@ void validate_tet_mesh(
     for (int k = 0; k < 3; ++k) {
       if (!std::isfinite(rest(i, k)))
         throw InputError(locate(source, vlines, static_cast<int>(i)),
-            "vertex " + std::to_string(i) + " has a non-finite coordinate " + fmt(rest(i, k)));
+            "vertex " + std::to_string(i) + " has a non-finite coordinate " + to_text(rest(i, k)));
     }
   }
   const int n = static_cast<int>(rest.rows());
@@ -63,11 +56,11 @@ void validate_tet_mesh(
         rest.row(tets(t, 3)), degenerate);
     if (degenerate)
       throw InputError(where(),
-          "tet " + std::to_string(t) + " is degenerate (rest volume " + fmt(det / 6.0) + ")");
+          "tet " + std::to_string(t) + " is degenerate (rest volume " + to_text(det / 6.0) + ")");
     if (det < 0)
       throw InputError(where(),
           "tet " + std::to_string(t) + " is inverted (negative orientation, rest volume "
-              + fmt(det / 6.0) + "); tets must satisfy det[x1-x0, x2-x0, x3-x0] > 0");
+              + to_text(det / 6.0) + "); tets must satisfy det[x1-x0, x2-x0, x3-x0] > 0");
   }
 }
 

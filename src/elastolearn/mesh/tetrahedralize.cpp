@@ -2,12 +2,12 @@
 
 #include <elastolearn/config.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/mesh/external_program.hpp>
 #include <elastolearn/mesh/surface_repair.hpp>
 #include <elastolearn/mesh/surface_simplification.hpp>
 #include <elastolearn/mesh/tetgen_io.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,8 +19,6 @@
 namespace elastolearn::mesh {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 /// TetGen at quality bound ~1.5 makes roughly this many tets per surface triangle when the
 /// surface, not the volume bound, limits the size (measured: elephant 7.8, bear 6.8).
@@ -59,7 +57,7 @@ class TetgenRunner {
     const ProgramResult result
         = run_program(m_report.tetgen, { switches, off.string() }, m_dir.path() / (stem + ".log"));
     TetgenRun record { switches, max_volume, static_cast<int>(surface.faces.rows()), 0,
-      std::chrono::duration<double>(Clock::now() - start).count() };
+      seconds_since(start) };
     if (m_options.verbose)
       std::fprintf(stderr, "%s", result.output.c_str());
     std::optional<TetMesh> mesh;
@@ -266,7 +264,7 @@ TetMesh tetrahedralize(const SurfaceMesh& surface_in, const TetrahedralizeOption
   report.surface_faces = static_cast<int>(meshed.faces.rows());
   report.num_tets = mesh->num_tets();
   report.num_vertices = mesh->num_vertices();
-  report.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  report.seconds = seconds_since(start);
   if (report_out)
     *report_out = std::move(report);
   return std::move(*mesh);

@@ -1,9 +1,9 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/observe/observation.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace elastolearn::observe {
 
@@ -11,13 +11,6 @@ namespace {
 
 const std::string k_ids = "/observed/vertex_ids";
 const std::string k_positions = "/observed/positions";
-
-std::string number(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
 
 } // namespace
 
@@ -57,16 +50,17 @@ void Observation::validate(const std::string& source) const {
     for (Eigen::Index i = 0; i < x.size(); ++i) {
       if (!std::isfinite(x.data()[i])) {
         throw InputError(where(k_positions),
-            "frame " + std::to_string(t) + ": non-finite value " + number(x.data()[i])
+            "frame " + std::to_string(t) + ": non-finite value " + to_text_exact(x.data()[i])
                 + " for vertex " + std::to_string(vertex_ids[i / 3]) + " (component "
                 + std::to_string(i % 3) + ")");
       }
     }
   }
   if (!std::isfinite(dt) || dt <= 0)
-    throw InputError(where("dt"), "time step must be positive and finite, got " + number(dt));
+    throw InputError(
+        where("dt"), "time step must be positive and finite, got " + to_text_exact(dt));
   if (!std::isfinite(start_time))
-    throw InputError(where("/time"), "non-finite start time " + number(start_time));
+    throw InputError(where("/time"), "non-finite start time " + to_text_exact(start_time));
 }
 
 void Observation::validate(
@@ -86,8 +80,8 @@ void Observation::validate(
   }
   if (expected_dt > 0 && std::abs(dt - expected_dt) > 1e-9 * expected_dt) {
     throw InputError(source + ": dt",
-        "observation time step " + number(dt) + " s does not match the scene's "
-            + number(expected_dt) + " s");
+        "observation time step " + to_text_exact(dt) + " s does not match the scene's "
+            + to_text_exact(expected_dt) + " s");
   }
 }
 
@@ -98,13 +92,14 @@ double uniform_time_step(const std::vector<double>& time, const std::string& sou
   }
   const double dt = time[1] - time[0];
   if (!std::isfinite(dt) || dt <= 0)
-    throw InputError(source, "times do not increase: " + number(time[0]) + ", " + number(time[1]));
+    throw InputError(
+        source, "times do not increase: " + to_text_exact(time[0]) + ", " + to_text_exact(time[1]));
   for (std::size_t t = 2; t < time.size(); ++t) {
     const double step = time[t] - time[t - 1];
     if (!(std::abs(step - dt) <= 1e-6 * dt)) {
       throw InputError(source,
-          "frames are not evenly spaced: interval " + std::to_string(t - 1) + " is " + number(step)
-              + " s, the first is " + number(dt) + " s");
+          "frames are not evenly spaced: interval " + std::to_string(t - 1) + " is "
+              + to_text_exact(step) + " s, the first is " + to_text_exact(dt) + " s");
     }
   }
   return dt;

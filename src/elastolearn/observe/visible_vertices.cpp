@@ -1,11 +1,11 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
-#include <sstream>
 
 namespace elastolearn::observe {
 
@@ -53,11 +53,8 @@ std::vector<int> farthest_point_sample(
 }
 
 int visible_vertex_count(double fraction, int num_surface_vertices) {
-  if (!(fraction > 0 && fraction <= 1)) {
-    std::ostringstream s;
-    s << "must be in (0, 1], got " << fraction;
-    throw InputError("visible fraction", s.str());
-  }
+  if (!(fraction > 0 && fraction <= 1))
+    throw InputError("visible fraction", "must be in (0, 1], got " + to_text(fraction));
   const int count = static_cast<int>(std::lround(fraction * num_surface_vertices));
   return std::clamp(count, 1, std::max(1, num_surface_vertices));
 }
@@ -73,11 +70,9 @@ std::vector<int> select_visible_vertices(
 
 Observation observe_vertices(const std::vector<Positions>& frames, double dt,
     const std::vector<int>& ids, double noise_sigma, std::uint64_t seed, double start_time) {
-  if (!std::isfinite(noise_sigma) || noise_sigma < 0) {
-    std::ostringstream s;
-    s << "noise standard deviation must be finite and non-negative, got " << noise_sigma;
-    throw InputError("noise", s.str());
-  }
+  if (!std::isfinite(noise_sigma) || noise_sigma < 0)
+    throw InputError("noise",
+        "noise standard deviation must be finite and non-negative, got " + to_text(noise_sigma));
   if (frames.empty())
     throw InputError("trajectory", "no frames to observe");
   const Eigen::Index n = frames.front().rows();

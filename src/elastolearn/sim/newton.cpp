@@ -1,7 +1,7 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/sim/newton.hpp>
 
-#include <chrono>
 #include <cmath>
 
 namespace elastolearn::sim {
@@ -26,13 +26,6 @@ SolverTimings& SolverTimings::operator+=(const SolverTimings& o) {
   solve += o.solve;
   return *this;
 }
-
-namespace {
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-} // namespace
 
 NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatrix& A,
     LinearSolver& solver, const NewtonOptions& options) {

@@ -1,7 +1,7 @@
 #include <elastolearn/core/interrupt.hpp>
+#include <elastolearn/core/timing.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 
-#include <chrono>
 #include <cstdio>
 
 namespace elastolearn::sim {
@@ -24,7 +24,7 @@ SimulationReport run_simulation(
 SimulationReport run_simulation(
     Simulator& simulator, int frames, const FrameSink& sink, const ProgressCallback& progress) {
   SimulationReport report;
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   if (sink)
     sink(0, simulator.time(), simulator.positions(), simulator.velocities());
   report.frames_written = 1;
@@ -54,7 +54,7 @@ SimulationReport run_simulation(
     }
   }
   report.completed = report.frames_written == frames + 1;
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = seconds_since(start);
   return report;
 }
 

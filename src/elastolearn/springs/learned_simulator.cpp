@@ -62,45 +62,30 @@ void LearnedSimulatorOptions::validate() const {
     throw InputError("simulation.direct_max_dofs", "must be >= 0");
 }
 
-namespace {
-void check_dt(double dt) {
-  if (!(dt > 0.0) || !std::isfinite(dt))
-    throw InputError("simulation.dt", "must be > 0, got " + std::to_string(dt));
-}
-} // namespace
-
 // --- paper mode --------------------------------------------------------------------------
 
 PaperSimulator::PaperSimulator(
     SpringSystem system, LearnedSpring spring, double dt, const Loads& loads)
-    : m_system(std::move(system))
-    , m_spring(std::move(spring))
-    , m_dt(dt) {
-  check_dt(dt);
+    : ExplicitStepper(std::move(system), dt, loads)
+    , m_spring(std::move(spring)) {
   if (std::abs(dt - m_spring.dt()) > 1e-12 * m_spring.dt())
     throw InputError("simulation.dt",
         "paper mode predicts exactly one training step: dt must equal "
         "the spring's training dt "
             + std::to_string(m_spring.dt()) + ", got " + std::to_string(dt));
-  const int n = m_system.node_count(), s = m_system.spring_count();
+  // this->system(): the parameter `system` (moved into the base) hides the accessor.
+  const int n = this->system().node_count(), s = this->system().spring_count();
   m_spring_dx.resize(s, 3);
   m_spring_dv.resize(s, 3);
   m_node_dx.resize(n, 3);
   m_node_dv.resize(n, 3);
-  m_no_spring_forces = Positions::Zero(n, 3);
-  set_loads(loads);
-}
-
-void PaperSimulator::set_loads(const Loads& loads) {
-  m_external = detail::checked_forces(m_system, loads);
-  m_gravity = loads.gravity;
 }
 
 void PaperSimulator::step(SpringState& state) {
-  const SpringSystem& sys = m_system;
+  const SpringSystem& sys = system();
   // 1. External forces only: one semi-implicit Euler step (paper §2, "First, we apply external
   //    (gravity) forces").
-  detail::semi_implicit_update(sys, m_no_spring_forces, m_external, m_gravity, m_dt, state);
+  loads_only_step(state);
   // 2. Each spring predicts (Δe, Δv) in its 1-D frame from the updated state; the prediction is
   //    oriented along the spring, with opposite signs at its two nodes (paper Fig. 1).
   detail::parallel_blocks(sys.spring_count(), [&](int begin, int end) {
@@ -128,29 +113,14 @@ void PaperSimulator::step(SpringState& state) {
 
 ExplicitLearnedSimulator::ExplicitLearnedSimulator(
     SpringSystem system, LearnedSpring spring, double dt, const Loads& loads)
-    : m_system(std::move(system))
-    , m_spring(std::move(spring))
-    , m_dt(dt) {
-  check_dt(dt);
-  m_spring_forces.resize(m_system.spring_count(), 3);
-  m_node_forces.resize(m_system.node_count(), 3);
-  set_loads(loads);
-}
-
-void ExplicitLearnedSimulator::set_loads(const Loads& loads) {
-  m_external = detail::checked_forces(m_system, loads);
-  m_gravity = loads.gravity;
-}
+    : ExplicitStepper(std::move(system), dt, loads)
+    , m_spring(std::move(spring)) { }
 
 void ExplicitLearnedSimulator::step(SpringState& state) {
-  const LearnedSpring& spring = m_spring;
   // The learned impulse m·Δv̂ of each spring, evaluated at the start of the step, summed at the
   // nodes; position is integrated once, by the semi-implicit update.
-  detail::spring_forces(
-      m_system, state.x, state.v,
-      [&spring](double e, double rate) { return spring.force(e, rate); }, m_spring_forces);
-  detail::gather(m_system, m_spring_forces, m_node_forces);
-  detail::semi_implicit_update(m_system, m_node_forces, m_external, m_gravity, m_dt, state);
+  const LearnedSpring& spring = m_spring;
+  semi_implicit_step(state, [&spring](double e, double rate) { return spring.force(e, rate); });
 }
 
 // --- factory ---------------------------------------------------------------------------------

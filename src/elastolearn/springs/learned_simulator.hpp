@@ -9,8 +9,8 @@
 ///   reference semi-implicit Euler system up to the regression's round-off.
 /// - implicit: corrected, stiff. Backward Euler linearised once per step with the learned
 ///   spring's slopes (see implicit_simulator.hpp).
+#include <elastolearn/springs/explicit_stepper.hpp>
 #include <elastolearn/springs/learned_spring.hpp>
-#include <elastolearn/springs/spring_system.hpp>
 
 #include <memory>
 #include <string>
@@ -43,48 +43,30 @@ struct LearnedSimulatorOptions {
 };
 
 /// The paper's learned simulator (§2, §6): see the file comment.
-class PaperSimulator final : public SpringStepper {
+class PaperSimulator final : public ExplicitStepper {
   public:
   /// Throws InputError if dt differs from the spring's training dt (the learned map is a map
   /// over exactly one training step) or loads are malformed.
   PaperSimulator(SpringSystem system, LearnedSpring spring, double dt, const Loads& loads = {});
   void step(SpringState& state) override;
-  void set_loads(const Loads& loads) override;
-  const SpringSystem& system() const override { return m_system; }
-  double dt() const override { return m_dt; }
-  bool is_local() const override { return true; }
   std::string_view name() const override { return "paper"; }
 
   private:
-  SpringSystem m_system;
   LearnedSpring m_spring;
-  double m_dt;
-  Positions m_external;
-  Vec3 m_gravity = Vec3::Zero();
   Positions m_spring_dx, m_spring_dv, m_node_dx, m_node_dv; // scratch
-  Positions m_no_spring_forces; // n×3 zeros: the external-only first step
 };
 
 /// Corrected explicit learned simulator: see the file comment.
-class ExplicitLearnedSimulator final : public SpringStepper {
+class ExplicitLearnedSimulator final : public ExplicitStepper {
   public:
   /// Throws InputError for dt ≤ 0 or malformed loads.
   ExplicitLearnedSimulator(
       SpringSystem system, LearnedSpring spring, double dt, const Loads& loads = {});
   void step(SpringState& state) override;
-  void set_loads(const Loads& loads) override;
-  const SpringSystem& system() const override { return m_system; }
-  double dt() const override { return m_dt; }
-  bool is_local() const override { return true; }
   std::string_view name() const override { return "explicit"; }
 
   private:
-  SpringSystem m_system;
   LearnedSpring m_spring;
-  double m_dt;
-  Positions m_external;
-  Vec3 m_gravity = Vec3::Zero();
-  Positions m_spring_forces, m_node_forces; // scratch
 };
 
 /// Build the simulator of `options.mode`. Throws InputError for invalid options.

@@ -1,0 +1,50 @@
+#pragma once
+/// \file The clamped bar that tests and benchmarks simulate: a box of 6-tet cubes
+/// (mesh::make_box_bar) held fixed at x = 0, with lumped mass. Header-only, so that each test
+/// executable links only the layers it tests; bench/ includes it too (bench/CMakeLists.txt).
+#include <elastolearn/material/elastic_model_type.hpp>
+#include <elastolearn/material/rayleigh_damping.hpp>
+#include <elastolearn/mesh/primitives.hpp>
+#include <elastolearn/mesh/vertex_selection.hpp>
+#include <elastolearn/sim/scene.hpp>
+
+#include <array>
+#include <memory>
+
+namespace elastolearn::test {
+
+/// What differs between the bars. Everything else is sim::Scene's default (lumped mass, CHOLMOD,
+/// default Newton options, at rest); callers set initial conditions, solver options and names on
+/// the returned scene.
+struct BarOptions {
+  Vec3 size = Vec3(0.4, 0.1, 0.1); ///< [m], the box [0, size.x] × [0, size.y] × [0, size.z]
+  std::array<int, 3> cells { 8, 2, 2 }; ///< cubes along x, y, z (6 tets each)
+  material::ElasticModelType model = material::ElasticModelType::Corotated;
+  double young = 1e5; ///< E [Pa]
+  double poisson = 0.4; ///< ν
+  double density = 1000; ///< ρ [kg/m³]
+  /// Rayleigh damping α₀ [1/s], α₁ [s]. When both are 0 the material has no damping model at all
+  /// (not a zero one).
+  double alpha0 = 0, alpha1 = 0;
+  Vec3 gravity = Vec3(0, -9.81, 0); ///< [m/s²]
+  double dt = 1e-3; ///< [s]
+  int frames = 100;
+};
+
+/// The scene of a bar clamped at x = 0 (every vertex of that face is fixed).
+inline sim::Scene bar_scene(const BarOptions& o = {}) {
+  sim::Scene s;
+  s.mesh = mesh::make_box_bar(o.size, o.cells);
+  s.material.elastic = material::make_elastic_model(
+      o.model, material::Lame::from_young_poisson(o.young, o.poisson));
+  if (o.alpha0 != 0 || o.alpha1 != 0)
+    s.material.damping = std::make_shared<material::RayleighDamping>(o.alpha0, o.alpha1);
+  s.material.density = o.density;
+  s.fixed_vertices = mesh::vertices_with_min_coordinate(s.mesh, 0, 1e-9);
+  s.gravity = o.gravity;
+  s.dt = o.dt;
+  s.frames = o.frames;
+  return s;
+}
+
+} // namespace elastolearn::test
