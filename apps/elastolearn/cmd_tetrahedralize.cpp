@@ -2,6 +2,7 @@
 // (TetGen run as an external program), printing counts, quality and output paths.
 #include "command.hpp"
 
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/mesh/surface_mesh.hpp>
 #include <elastolearn/mesh/tetgen_io.hpp>
@@ -24,6 +25,9 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
   const std::filesystem::path out(args.output);
   if (out.has_extension() && out.extension() != ".node" && out.extension() != ".ele")
     throw InputError(args.output, "output must be a TetGen .node/.ele path (or their common stem)");
+  const auto [node, ele] = mesh::tetgen_files(out);
+  check_command_paths({ { args.input, "surface" } },
+      { { node, "tet mesh output (.node)" }, { ele, "tet mesh output (.ele, beside the .node)" } });
   const mesh::SurfaceMesh surface = mesh::read_surface_mesh(args.input);
   std::printf("surface   %s: %d vertices, %d faces, enclosed volume %.6g\n", args.input.c_str(),
       static_cast<int>(surface.vertices.rows()), static_cast<int>(surface.faces.rows()),
@@ -45,7 +49,7 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
       "quality   dihedral [%.2f, %.2f] deg, max radius ratio %.3g, tet volume [%.3g, %.3g]\n",
       q.min_dihedral_deg, q.max_dihedral_deg, q.max_radius_ratio, q.min_volume, q.max_volume);
   const auto stem = mesh::tetgen_stem(out);
-  mesh::write_tetgen(stem, tets);
+  mesh::write_tetgen(out, tets);
   std::printf("wrote     %s.node, %s.ele (%.2f s)\n", stem.string().c_str(), stem.string().c_str(),
       report.seconds);
 }

@@ -16,12 +16,15 @@ int parse_axis(const JsonObject& o, const std::string& key) {
   return a[0] - 'x';
 }
 
-mesh::TetMesh parse_mesh(const JsonObject& o, const std::filesystem::path& base_dir) {
+mesh::TetMesh parse_mesh(
+    const JsonObject& o, const std::filesystem::path& base_dir, std::vector<CommandInput>& inputs) {
   if (o.has("file")) {
     o.reject_unknown_keys({ "file" });
     std::filesystem::path p = o.string("file");
     if (p.is_relative())
       p = base_dir / p;
+    for (const auto& file : mesh::tet_mesh_files(p))
+      inputs.push_back({ file, "mesh of the scene " + o.file() });
     return mesh::read_tet_mesh(p);
   }
   const std::string type = o.choice("type", { "box", "sphere" });
@@ -33,12 +36,20 @@ mesh::TetMesh parse_mesh(const JsonObject& o, const std::filesystem::path& base_
     const auto cells = o.integers("cells");
     if (cells.size() != 3 || *std::min_element(cells.begin(), cells.end()) < 1)
       o.fail("cells", "expected three positive integers");
+    if (6.0 * cells[0] * double(cells[1]) * double(cells[2]) > double(mesh::kMaxGeneratedTets))
+      o.fail("cells",
+          "6 x " + std::to_string(cells[0]) + " x " + std::to_string(cells[1]) + " x "
+              + std::to_string(cells[2]) + " tets is more than a generated mesh may have ("
+              + std::to_string(mesh::kMaxGeneratedTets) + ")");
     return mesh::make_box_bar(size, { cells[0], cells[1], cells[2] });
   }
   o.reject_unknown_keys({ "type", "radius", "tets" });
   const int tets = o.integer("tets");
   if (tets < 8)
     o.fail("tets", "must be at least 8");
+  if (tets > mesh::kMaxGeneratedTets)
+    o.fail("tets",
+        "must be at most " + std::to_string(mesh::kMaxGeneratedTets) + " (a generated mesh)");
   return mesh::make_sphere(o.positive("radius"), tets);
 }
 
@@ -167,7 +178,9 @@ SceneFile parse_scene(
   SceneFile out;
   sim::Scene& s = out.scene;
   s.name = root.string("name", std::filesystem::path(file).stem().string());
-  s.mesh = parse_mesh(root.object("mesh"), base_dir);
+  s.mesh = parse_mesh(root.object("mesh"), base_dir, out.inputs);
+  if (const auto material = referenced_material(root, base_dir))
+    out.inputs.push_back({ *material, "material of the scene " + file });
   s.material = scene_material_model(
       root, base_dir, &out.material_training_stretches); // inline object or path of a material file
   s.mass = root.choice("mass", { "lumped", "consistent" }, "lumped") == "lumped"
@@ -223,6 +236,7 @@ SceneFile parse_scene(
 SceneFile read_scene_file(const std::filesystem::path& path) {
   SceneFile out = parse_scene(read_json_file(path), path.string(), path.parent_path());
   out.path = path;
+  out.inputs.insert(out.inputs.begin(), CommandInput { path, "scene" });
   return out;
 }
 
