@@ -5,6 +5,7 @@
 #include "command.hpp"
 #include "demo_scenes.hpp"
 
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/io/material_file.hpp>
@@ -41,6 +42,8 @@ std::vector<VecX> simulate_and_save(
 
 void run_demo(const fs::path& out, double fraction) {
   const auto start = Clock::now();
+  // The demo reads no file (its scenes are built in): only its folder is checked.
+  check_command_paths({}, { { out, "demo output folder (-o)", OutputKind::folder } });
   fs::create_directories(out);
   const auto train
       = io::parse_scene(nlohmann::json::parse(app::kDemoTrainScene), "built-in bar_train.json", out)

@@ -4,6 +4,7 @@
 // learned material, and compare both with the true trajectory over all vertices.
 #include "command.hpp"
 
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
@@ -120,6 +121,17 @@ std::optional<double> ratio(double nominal, double learned) {
 
 void run_evaluate(const EvaluateOptions& opts) {
   io::SceneFile file = io::read_scene_file(opts.scene);
+  {
+    std::vector<CommandInput> inputs = file.inputs;
+    inputs.push_back({ opts.material, "material (--material)" });
+    inputs.push_back({ opts.truth, "true trajectory (--truth)" });
+    std::vector<CommandOutput> outputs;
+    if (!opts.output.empty())
+      outputs.push_back({ opts.output, "learned trajectory output (-o)" });
+    if (!opts.json.empty())
+      outputs.push_back({ opts.json, "JSON report (--json)" });
+    check_command_paths(inputs, outputs);
+  }
   if (!opts.solver.empty())
     file.scene.linear_solver = sim::linear_solver_type_from_string(opts.solver);
   const sim::Scene& nominal_scene = file.scene;

@@ -6,6 +6,7 @@
 // "Parameter-fitting baseline".
 #include "command.hpp"
 
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
@@ -55,6 +56,9 @@ learn::NominalParameters start_parameters(
 void run_fit(const FitOptions& o) {
   const io::SceneFile scene_file = io::read_scene_file(o.scene);
   const sim::Scene& scene = scene_file.scene;
+  std::vector<CommandInput> inputs = scene_file.inputs;
+  inputs.push_back({ o.observations, "observations (--observations)" });
+  check_command_paths(inputs, { { o.output, "fitted material output (-o)" } });
   if (scene.material.correction)
     throw InputError(o.scene,
         "material: the scene's material carries a correction; fit-parameters fits a nominal one");

@@ -1,10 +1,11 @@
-// elastolearn info FILE: a summary of a tet mesh, surface mesh, trajectory, scene or learned
-// material.
+// elastolearn info FILE: a summary of a tet mesh, surface mesh, trajectory, observation, scene or
+// learned material.
 #include "command.hpp"
 
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
@@ -34,10 +35,41 @@ void print_tet_mesh(const mesh::TetMesh& m) {
       q.max_radius_ratio);
 }
 
+void print_observation(const std::filesystem::path& path) {
+  const observe::Observation o = io::read_observation_h5(path);
+  const auto [lowest, highest] = std::minmax_element(o.vertex_ids.begin(), o.vertex_ids.end());
+  std::printf("  observation: %d frames, t = %g .. %g s (dt = %g s), %d observed vertices\n",
+      o.num_frames(), o.start_time, o.start_time + (o.num_frames() - 1) * o.dt, o.dt,
+      o.num_observed());
+  std::printf("  vertex ids %d .. %d: the rest mesh has at least %d vertices (the file holds no "
+              "mesh)\n",
+      *lowest, *highest, *highest + 1);
+  Box3 box(o.positions.front().colwise().minCoeff().transpose(),
+      o.positions.front().colwise().maxCoeff().transpose());
+  double max_motion = 0;
+  for (const auto& p : o.positions) {
+    box.extend(Box3(p.colwise().minCoeff().transpose(), p.colwise().maxCoeff().transpose()));
+    max_motion = std::max(max_motion, (p - o.positions.front()).rowwise().norm().maxCoeff());
+  }
+  std::printf("  observed points over all frames:\n");
+  print_box(box);
+  std::printf("  largest motion of an observed point from frame 0: %g m\n", max_motion);
+  const auto metadata = io::read_observation_metadata(path);
+  if (!metadata.contains("noise_sigma"))
+    std::printf("  noise: not recorded\n");
+  for (const auto& [k, v] : metadata)
+    std::printf("  %s: %s\n", k.c_str(), v.c_str());
+}
+
 void info(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path.string(), "is a folder, not a file");
   std::printf("%s\n", path.c_str());
-  if (ext == ".h5" || ext == ".hdf5") {
+  if ((ext == ".h5" || ext == ".hdf5") && io::is_observation_h5(path)) {
+    print_observation(path);
+  } else if (ext == ".h5" || ext == ".hdf5") {
     const auto t = io::read_trajectory_h5(path);
     std::printf("  trajectory: %zu frames, t = %g .. %g s, %ld vertices, %ld tets, %ld edges, %ld "
                 "faces%s\n",
@@ -90,8 +122,8 @@ void info(const std::filesystem::path& path) {
 void add_info_command(CLI::App& root) {
   auto files = std::make_shared<std::vector<std::string>>();
   auto* cmd = root.add_subcommand("info",
-      "Summarise a mesh (.node/.ele/.msh/.veg/.obj/.off/.ply/.stl), trajectory (.h5), scene or "
-      "learned material (.json)");
+      "Summarise a mesh (.node/.ele/.msh/.veg/.obj/.off/.ply/.stl), trajectory or observation "
+      "(.h5), scene or learned material (.json)");
   cmd->add_option("files", *files, "files to describe")->required();
   cmd->callback([files] {
     for (const auto& f : *files)

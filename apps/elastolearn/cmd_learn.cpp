@@ -4,6 +4,7 @@
 #include "command.hpp"
 
 #include <elastolearn/core/atomic_file.hpp>
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/interrupt.hpp>
 #include <elastolearn/core/timing.hpp>
@@ -76,7 +77,6 @@ std::shared_ptr<const elastolearn::material::Correction> distil_network(const Le
 void write_report(const std::filesystem::path& dir, const elastolearn::learn::LearningState& state,
     const nlohmann::json& summary) {
   using namespace elastolearn;
-  std::filesystem::create_directories(dir);
   std::ostringstream csv;
   csv << "iteration,forward_rms_m,forward_max_m,forward_mean_m,control_force_rms_N,space_time_"
          "initial,"
@@ -99,6 +99,22 @@ void run_learn(const LearnOptions& o) {
   using namespace elastolearn;
   const auto scene_file = io::read_scene_file(o.scene);
   const sim::Scene& scene = scene_file.scene;
+  const std::filesystem::path checkpoint
+      = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
+  {
+    std::vector<CommandInput> inputs = scene_file.inputs;
+    inputs.push_back({ o.observations, "observations (--observations)" });
+    // With --resume the checkpoint is read and then rewritten on purpose: it is an output only.
+    std::vector<CommandOutput> outputs
+        = { { o.output, "learned material output (-o)" }, { checkpoint, "checkpoint" } };
+    if (!o.report.empty()) {
+      const std::filesystem::path report = o.report;
+      outputs.push_back({ report, "--report folder", OutputKind::folder });
+      outputs.push_back({ report / "convergence.csv", "report's convergence.csv" });
+      outputs.push_back({ report / "report.json", "report's report.json" });
+    }
+    check_command_paths(inputs, outputs);
+  }
   if (scene.material.correction)
     throw InputError(o.scene,
         "material: the scene's material already carries a correction; learn from a nominal one");
@@ -112,8 +128,6 @@ void run_learn(const LearnOptions& o) {
   options.rbf.quadratic_tail = !o.linear_tail;
   options.validate();
 
-  const std::filesystem::path checkpoint
-      = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
   const io::LearningInputs inputs { o.scene, o.observations,
     io::learning_options_to_json(options) };
   learn::LearningState state;

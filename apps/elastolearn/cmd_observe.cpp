@@ -4,12 +4,14 @@
 // the surface, with optional Gaussian noise. Format: docs/observations.md.
 #include "command.hpp"
 
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/mesh/tet_mesh.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 
+#include <charconv>
 #include <cstdint>
 #include <cstdio>
 
@@ -24,8 +26,19 @@ struct ObserveOptions {
   std::uint64_t seed = 1;
 };
 
+/// Shortest text that reads back as `v` (the file's metadata are strings).
+std::string exact(double v) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
+  return std::string(buffer, result.ptr);
+}
+
 void run_observe(const ObserveOptions& opts) {
   using namespace elastolearn;
+  std::vector<CommandInput> inputs = { { opts.trajectory, "trajectory" } };
+  if (!opts.vertices.empty())
+    inputs.push_back({ opts.vertices, "vertex list (--vertices)" });
+  check_command_paths(inputs, { { opts.output, "observation output (-o)" } });
   const io::TrajectoryData traj = io::read_trajectory_h5(opts.trajectory);
   if (traj.tets.rows() == 0) {
     throw InputError(opts.trajectory + ": /tets",
@@ -49,7 +62,12 @@ void run_observe(const ObserveOptions& opts) {
   }
   const observe::Observation obs = observe::observe_vertices(
       traj.positions, dt, ids, opts.noise, opts.seed, traj.time.front());
-  io::write_observation_h5(opts.output, obs);
+  const std::string selection = opts.vertices.empty()
+      ? "visible fraction " + exact(opts.fraction) + " (farthest-point sampling)"
+      : "vertex list " + opts.vertices;
+  io::write_observation_h5(opts.output, obs,
+      { { "source", opts.trajectory }, { "selection", selection },
+          { "noise_sigma", exact(opts.noise) }, { "seed", std::to_string(opts.seed) } });
 
   const int surface = static_cast<int>(mesh.surface_vertices().size());
   std::printf("observed %d vertices (%d surface vertices, %.1f %%) over %d frames, dt = %g s",

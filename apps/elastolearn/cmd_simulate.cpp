@@ -1,6 +1,7 @@
 // elastolearn simulate scene.json -o traj.h5 [--vtu DIR] [--material learned.json]
 #include "command.hpp"
 
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
@@ -44,14 +45,6 @@ void add_simulate_command(CLI::App& root) {
       file.scene.linear_solver = sim::linear_solver_type_from_string(opts->solver);
     if (opts->frames > 0)
       file.scene.frames = opts->frames;
-    std::string material_source = "the scene";
-    std::optional<material::StretchRange> trained = file.material_training_stretches;
-    if (!opts->material.empty()) {
-      const io::MaterialFile material = io::read_material_file(opts->material);
-      file.scene.material = io::material_model(material, opts->material);
-      trained = material.training_stretches;
-      material_source = opts->material;
-    }
     io::SceneOutputOptions out;
     if (!opts->output.empty())
       out.trajectory = opts->output;
@@ -64,6 +57,23 @@ void add_simulate_command(CLI::App& root) {
     else
       out.vtu_directory = file.outputs.vtu_directory;
     out.every = opts->every > 0 ? opts->every : file.outputs.every;
+    std::vector<CommandInput> inputs = file.inputs;
+    if (!opts->material.empty())
+      inputs.push_back({ opts->material, "material (--material)" });
+    std::vector<CommandOutput> outputs = { { out.trajectory, "trajectory output" } };
+    if (out.vtu_directory) {
+      outputs.push_back({ *out.vtu_directory, "ParaView folder", OutputKind::folder });
+      outputs.push_back({ *out.vtu_directory / (file.scene.name + ".pvd"), "ParaView series" });
+    }
+    check_command_paths(inputs, outputs);
+    std::string material_source = "the scene";
+    std::optional<material::StretchRange> trained = file.material_training_stretches;
+    if (!opts->material.empty()) {
+      const io::MaterialFile material = io::read_material_file(opts->material);
+      file.scene.material = io::material_model(material, opts->material);
+      trained = material.training_stretches;
+      material_source = opts->material;
+    }
     const auto& s = file.scene;
     std::printf("scene %s: %d vertices, %d tets, %s, %d frames of dt = %g s, solver %s\n",
         s.name.c_str(), s.mesh.num_vertices(), s.mesh.num_tets(),

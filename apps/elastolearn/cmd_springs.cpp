@@ -2,6 +2,7 @@
 // (paper 004), reproduced and corrected. Parses, calls the springs layer, prints.
 #include "command.hpp"
 
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/io/springs_scene.hpp>
@@ -67,6 +68,7 @@ void add_learn(CLI::App& parent) {
       ->capture_default_str();
   cmd->add_option("-o,--output", a->output, "learned spring JSON")->required();
   cmd->callback([a] {
+    check_command_paths({}, { { a->output, "learned spring output (-o)" } });
     TrainingOptions t;
     t.law.kind = spring_law_kind_from_string(a->law, "--law");
     t.law.k = a->k;
@@ -180,6 +182,12 @@ void add_simulate(CLI::App& parent) {
     std::optional<std::filesystem::path> vtu = scene.vtu_directory;
     if (!a->vtu.empty())
       vtu = a->vtu;
+    std::vector<CommandOutput> outputs = { { output, "trajectory output" } };
+    if (vtu) {
+      outputs.push_back({ *vtu, "ParaView folder", OutputKind::folder });
+      outputs.push_back({ *vtu / (output.stem().string() + ".pvd"), "ParaView series" });
+    }
+    check_command_paths(scene.inputs, outputs);
     auto stepper = io::make_scene_stepper(scene);
     std::printf("%s: %d nodes, %d springs, mode %s, dt %g s, %d steps\n", scene.name.c_str(),
         scene.system.node_count(), scene.system.spring_count(),

@@ -3,6 +3,7 @@
 // paths.
 #include "command.hpp"
 
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/mesh/surface_mesh.hpp>
 #include <elastolearn/mesh/tetgen_io.hpp>
@@ -30,6 +31,9 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
   if (!(args.scale > 0 && std::isfinite(args.scale)))
     throw InputError(
         "--scale", "must be a positive number (a negative scale would mirror the mesh)");
+  const auto [node, ele] = mesh::tetgen_files(out);
+  check_command_paths({ { args.input, "surface" } },
+      { { node, "tet mesh output (.node)" }, { ele, "tet mesh output (.ele, beside the .node)" } });
   mesh::SurfaceMesh surface = mesh::read_surface_mesh(args.input);
   surface.vertices *= args.scale;
   char scaled[48] = "";
@@ -55,7 +59,7 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
       "quality   dihedral [%.2f, %.2f] deg, max radius ratio %.3g, tet volume [%.3g, %.3g]\n",
       q.min_dihedral_deg, q.max_dihedral_deg, q.max_radius_ratio, q.min_volume, q.max_volume);
   const auto stem = mesh::tetgen_stem(out);
-  mesh::write_tetgen(stem, tets);
+  mesh::write_tetgen(out, tets);
   std::printf("wrote     %s.node, %s.ele (%.2f s)\n", stem.string().c_str(), stem.string().c_str(),
       report.seconds);
 }

@@ -153,3 +153,29 @@ TEST_F(CliTest, ObserveSamplesSurfaceVerticesReproducibly) {
   EXPECT_NE(r.output.find("ids.txt"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(m_dir / "c.h5"));
 }
+
+TEST_F(CliTest, InfoDescribesObservationFiles) {
+  const auto traj = m_dir / "bar.h5", obs = m_dir / "obs.h5";
+  ASSERT_EQ(
+      run("simulate " + write("bar.json", kSmallScene).string() + " -o " + traj.string() + " -q")
+          .exit_code,
+      0);
+  ASSERT_EQ(run("observe " + traj.string() + " --visible-fraction 0.5 --noise 1e-4 --seed 7 -o "
+                + obs.string())
+                .exit_code,
+      0);
+  const auto r = run("info " + obs.string() + " " + traj.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // What the file holds: frames and their times, the observed vertices, the noise it recorded.
+  EXPECT_NE(
+      r.output.find("observation: 21 frames, t = 0 .. 0.04 s (dt = 0.002 s)"), std::string::npos)
+      << r.output;
+  const auto observed = elastolearn::io::read_observation_h5(obs);
+  EXPECT_NE(r.output.find(std::to_string(observed.num_observed()) + " observed vertices"),
+      std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("noise_sigma: 1e-04"), std::string::npos)
+      << r.output; // shortest exact text
+  EXPECT_NE(r.output.find("source: " + traj.string()), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("trajectory: 21 frames"), std::string::npos) << r.output; // still
+}

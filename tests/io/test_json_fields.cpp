@@ -169,3 +169,20 @@ TEST(JsonFile, WriteIsAtomicPrettyAndRoundTrips) {
   EXPECT_NE(text.find("\n  \"format\""), std::string::npos); // 2-space indent
   EXPECT_EQ(text.back(), '\n');
 }
+
+TEST(ReadJsonFile, HostileTextIsOneInputErrorWithItsPlace) {
+  ScratchDir dir;
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return dir / name;
+  };
+  // A number beyond double's range: nlohmann throws out_of_range, not parse_error.
+  expect_input_error([&] { read_json_file(write("big.json", "{\n  \"young\": 1e999\n}")); },
+      { "big.json:2:12", "number overflow parsing '1e999'" });
+  // Deep nesting is refused before parsing (recursive code would exhaust the stack).
+  expect_input_error([&] { read_json_file(write("deep.json", std::string(100000, '[') + "1")); },
+      { "deep.json:1:257", "nested deeper than 256 levels" });
+  // Brackets inside strings do not count.
+  EXPECT_NO_THROW(read_json_file(write("str.json", "{\"a\": \"" + std::string(1000, '[') + "\"}")));
+  expect_input_error([&] { read_json_file(dir.path()); }, { "is a folder, not a file" });
+}

@@ -95,6 +95,26 @@ TEST(ObservationFile, RoundTripIsExact) {
   EXPECT_NEAR(time[3], 0.1 + 3.0 / 30.0, 1e-15);
 }
 
+TEST(ObservationFile, MetadataRoundTripAndRecognition) {
+  ScratchDir dir;
+  write_observation_h5(
+      dir / "obs.h5", make_observation(), { { "noise_sigma", "0.0001" }, { "source", "traj.h5" } });
+  EXPECT_EQ(read_observation_metadata(dir / "obs.h5"),
+      (std::map<std::string, std::string> {
+          { "noise_sigma", "0.0001" }, { "source", "traj.h5" } }));
+  EXPECT_TRUE(is_observation_h5(dir / "obs.h5"));
+  EXPECT_FALSE(is_observation_h5(dir / "missing.h5"));
+  std::ofstream(dir / "text.h5") << "not hdf5";
+  EXPECT_FALSE(is_observation_h5(dir / "text.h5"));
+  // "format" and "dt" belong to the layout; nothing is written when they are misused.
+  expect_input_error(
+      [&] {
+        write_observation_h5(dir / "bad.h5", make_observation(), { { "dt", "1" } });
+      },
+      { "bad.h5", "reserved" });
+  EXPECT_FALSE(fs::exists(dir / "bad.h5"));
+}
+
 TEST(ObservationFile, ReadsAUserWrittenFile) {
   // dt as a numeric string, ids in any order: accepted, then checked against a scene.
   ScratchDir dir;

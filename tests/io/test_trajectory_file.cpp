@@ -452,3 +452,38 @@ with h5py.File(sys.argv[2], "w") as g:
   expected.metadata["written_by"] = "h5py";
   expect_same(expected, read_trajectory_h5(dir / "theirs.h5"));
 }
+
+TEST(TrajectoryFileRejects, DatasetsThatDeclareMoreThanTheyStore) {
+  // A few hundred bytes can declare 10⁹ frames: chunked /positions with no chunk written. The
+  // reader must refuse it before allocating memory for the declared shape.
+  ScratchDir dir;
+  RawFile raw;
+  raw.f64.erase("/positions");
+  raw.write(dir / "huge.h5");
+  {
+    const hid_t file = H5Fopen((dir / "huge.h5").c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const h5::Shape shape { 1000000000, 5, 3 }, chunk { 1, 5, 3 };
+    const hid_t space = H5Screate_simple(3, shape.data(), nullptr);
+    const hid_t plist = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(plist, 3, chunk.data());
+    H5Dclose(
+        H5Dcreate2(file, "/positions", H5T_IEEE_F64LE, space, H5P_DEFAULT, plist, H5P_DEFAULT));
+    H5Pclose(plist);
+    H5Sclose(space);
+    H5Fclose(file);
+  }
+  EXPECT_LT(fs::file_size(dir / "huge.h5"), 100000u);
+  // /time has 3 entries, so the frame count mismatch would be found too; the storage check
+  // comes first because it runs when the dataset is opened.
+  expect_input_error([&] { read_trajectory_h5(dir / "huge.h5"); },
+      { "huge.h5: /positions", "declares shape (1000000000, 5, 3) but does not store all" });
+}
+
+TEST(TrajectoryFile, WrittenFilesCountAsFullyStored) {
+  // Compressed chunks are smaller than the data they hold: the storage check counts chunks,
+  // so every file the writer makes (many frames, several chunks, a partial last chunk) reads.
+  ScratchDir dir;
+  const TrajectoryData data = make_trajectory(300, 40, true);
+  write_trajectory_h5(dir / "t.h5", data);
+  expect_same(read_trajectory_h5(dir / "t.h5"), data);
+}

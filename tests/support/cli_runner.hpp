@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,6 +18,35 @@ struct Run {
   int exit_code;
   std::string output; ///< stdout + stderr
 };
+
+/// What one run printed on each stream, and how it ended.
+struct SplitRun {
+  int exit_code; ///< the exit status, or 128 + signal if a signal ended it (as a shell reports)
+  std::string out; ///< stdout
+  std::string err; ///< stderr
+};
+
+/// Run `elastolearn arguments` through the shell with stdout and stderr captured apart. `prefix`
+/// is shell text run first in the same shell (e.g. "cd DIR && ulimit -v N &&").
+inline SplitRun run_split(const std::string& arguments, const std::string& prefix = "") {
+  static int counter = 0;
+  const std::filesystem::path err_file = std::filesystem::temp_directory_path()
+      / ("elastolearn_stderr_" + std::to_string(::getpid()) + "_" + std::to_string(++counter));
+  const std::string command = prefix + " " + std::string(ELASTOLEARN_EXECUTABLE) + " " + arguments
+      + " 2>'" + err_file.string() + "'";
+  FILE* pipe = popen(command.c_str(), "r");
+  SplitRun r { -1, "", "" };
+  std::array<char, 4096> buffer {};
+  while (size_t n = fread(buffer.data(), 1, buffer.size(), pipe))
+    r.out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  std::ifstream in(err_file, std::ios::binary);
+  r.err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  in.close();
+  std::filesystem::remove(err_file);
+  return r;
+}
 
 inline Run run(const std::string& arguments) {
   const std::string command = std::string(ELASTOLEARN_EXECUTABLE) + " " + arguments + " 2>&1";

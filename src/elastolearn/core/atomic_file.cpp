@@ -48,11 +48,16 @@ void write_text_file_atomic(const std::filesystem::path& path, const std::string
 }
 
 std::string read_text_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path.string(), "is a folder, not a file");
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw InputError(path.string(), "cannot open file for reading");
   std::ostringstream ss;
   ss << in.rdbuf();
+  if (in.bad())
+    throw InputError(path.string(), "cannot read file");
   return ss.str();
 }
 

@@ -2,8 +2,10 @@
 /// \file Error tiers (as in Drake): `assert` for hot-path invariants, `ELASTOLEARN_CHECK` for
 /// impossible states (always on), and `InputError` for bad user input — it names the file, field
 /// or line and the offending value. The app catches InputError, prints one line, exits non-zero.
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace elastolearn {
 
@@ -42,6 +44,12 @@ class InternalError : public std::logic_error {
 
 [[noreturn]] void throw_internal_error(
     const char* condition, const char* file, int line, const std::string& message);
+
+/// `text` made safe to print as one terminal line: control characters (newlines, escape
+/// sequences) and bytes that are not UTF-8 become `\xNN`, and it is cut after about `max_bytes`
+/// bytes with "...". Messages quote input files, and a hostile file's bytes must neither break
+/// the one-line error nor reach the terminal raw.
+std::string printable_line(std::string_view text, std::size_t max_bytes = 400);
 
 } // namespace elastolearn
 

@@ -56,6 +56,40 @@ hsize_t product(const Shape& shape, std::size_t from = 0) {
   return p;
 }
 
+/// True if the dataset stores every value its shape `dims` declares: a chunked dataset has all
+/// its chunks written (counted, since compressed chunks make the byte count meaningless), a
+/// contiguous one its whole extent. Virtual datasets (data in other files) never count as stored.
+bool fully_stored(hid_t dataset, const Shape& dims) {
+  if (product(dims) == 0)
+    return true;
+  Handle plist(H5Dget_create_plist(dataset), H5Pclose);
+  switch (H5Pget_layout(plist.id())) {
+  case H5D_COMPACT:
+    return true;
+  case H5D_CONTIGUOUS: {
+    H5D_space_status_t status = H5D_SPACE_STATUS_ERROR;
+    return H5Dget_space_status(dataset, &status) >= 0 && status == H5D_SPACE_STATUS_ALLOCATED;
+  }
+  case H5D_CHUNKED: {
+    Shape chunk(dims.size(), 0);
+    if (H5Pget_chunk(plist.id(), int(chunk.size()), chunk.data()) != int(dims.size()))
+      return false;
+    hsize_t expected = 1;
+    for (std::size_t i = 0; i < dims.size(); ++i) {
+      if (chunk[i] == 0)
+        return false;
+      expected *= (dims[i] + chunk[i] - 1) / chunk[i];
+    }
+    // HDF5 1.10 wants the dataset's own space here, not H5S_ALL.
+    Handle space(H5Dget_space(dataset), H5Sclose);
+    hsize_t written = 0;
+    return H5Dget_num_chunks(dataset, space.id(), &written) >= 0 && written >= expected;
+  }
+  default:
+    return false;
+  }
+}
+
 const char* class_name(H5T_class_t c) {
   switch (c) {
   case H5T_INTEGER:
@@ -220,7 +254,21 @@ Dataset File::dataset(const std::string& name) const {
   Handle ds(H5Dopen2(m_file.id(), name.c_str(), H5P_DEFAULT), H5Dclose);
   if (!ds.valid())
     fail(name, with_reason("is not a readable dataset"));
-  return Dataset(*this, std::move(ds), name);
+  Dataset dataset(*this, std::move(ds), name);
+  // A shape is only a claim: a few hundred bytes can declare a dataset of 10¹² values whose
+  // chunks were never written. Refuse it before anyone allocates memory for it.
+  const Shape dims = dataset.shape();
+  double values = 1; // in double: the product of a hostile shape may not fit 64 bits
+  for (hsize_t d : dims)
+    values *= double(d);
+  if (values > 0x1p50)
+    fail(name, "declares shape " + shape_string(dims) + ", too many values to read");
+  if (!fully_stored(dataset.m_handle.id(), dims)) {
+    fail(name,
+        "declares shape " + shape_string(dims)
+            + " but does not store all of its data (an unfinished or damaged file)");
+  }
+  return dataset;
 }
 
 Shape Dataset::shape() const {

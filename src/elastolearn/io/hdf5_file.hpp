@@ -117,7 +117,8 @@ class File {
 
   /// True if a link (dataset or group) exists at `object`, checking every group on the way.
   bool exists(const std::string& object) const;
-  /// Open a dataset. Throws InputError if it is missing or not a dataset.
+  /// Open a dataset. Throws InputError if it is missing, not a dataset, or does not store all the
+  /// values its shape declares (unwritten chunks: a tiny file can claim 10¹² values).
   Dataset dataset(const std::string& dataset) const;
   /// Shape of a dataset. Throws InputError if it is missing or not a dataset.
   Shape shape(const std::string& name) const { return dataset(name).shape(); }

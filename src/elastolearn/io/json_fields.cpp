@@ -251,27 +251,79 @@ void JsonObject::reject_unknown_keys(const std::vector<std::string>& known) cons
   }
 }
 
+namespace {
+
+/// "file:line:column" of byte `offset` (0-based) of `text`.
+std::string text_position(
+    const std::filesystem::path& path, const std::string& text, std::size_t offset) {
+  const std::size_t end = std::min(offset, text.size());
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < end; ++i) {
+    if (text[i] == '\n')
+      ++line, column = 1;
+    else
+      ++column;
+  }
+  return path.string() + ":" + std::to_string(line) + ":" + std::to_string(column);
+}
+
+/// The deepest nesting of arrays and objects we parse. nlohmann's parser keeps its own stack, but
+/// other code walks values recursively: 10⁵ '[' would overflow the call stack. Files of this
+/// library nest a few levels.
+constexpr int k_max_json_depth = 256;
+
+/// Throws InputError at the first '[' or '{' (outside strings) nested deeper than the limit.
+void check_json_depth(const std::filesystem::path& path, const std::string& text) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > k_max_json_depth)
+        throw InputError(text_position(path, text, i),
+            "invalid JSON: nested deeper than " + std::to_string(k_max_json_depth) + " levels");
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+}
+
+} // namespace
+
 Json read_json_file(const std::filesystem::path& path) {
   const std::string text = read_text_file(path);
+  check_json_depth(path, text);
   try {
     return Json::parse(text);
+  } catch (const Json::out_of_range& e) {
+    // A number beyond double's range ("1e999"): the message quotes it; point at it if found.
+    std::string message = e.what();
+    const std::size_t colon = message.find("] ");
+    if (colon != std::string::npos)
+      message = message.substr(colon + 2);
+    const std::size_t quote = message.find('\'');
+    const std::size_t end = quote == std::string::npos ? quote : message.find('\'', quote + 1);
+    const std::size_t at = end == std::string::npos
+        ? std::string::npos
+        : text.find(message.substr(quote + 1, end - quote - 1));
+    throw InputError(at == std::string::npos ? path.string() : text_position(path, text, at),
+        "invalid JSON: " + message);
   } catch (const Json::parse_error& e) {
-    // Line and column of the byte where parsing stopped (e.byte is 1-based).
-    const std::size_t end = std::min<std::size_t>(e.byte ? e.byte - 1 : 0, text.size());
-    std::size_t line = 1, column = 1;
-    for (std::size_t i = 0; i < end; ++i) {
-      if (text[i] == '\n')
-        ++line, column = 1;
-      else
-        ++column;
-    }
+    // Where parsing stopped (e.byte is 1-based).
+    const std::string where = text_position(path, text, e.byte ? e.byte - 1 : 0);
     std::string message = e.what();
     const std::size_t at = message.find("column ");
     const std::size_t colon = at == std::string::npos ? std::string::npos : message.find(": ", at);
     if (colon != std::string::npos)
       message = message.substr(colon + 2);
-    throw InputError(path.string() + ":" + std::to_string(line) + ":" + std::to_string(column),
-        "invalid JSON: " + message);
+    throw InputError(where, "invalid JSON: " + message);
   }
 }
 

@@ -80,7 +80,9 @@ class JsonObject {
 /// A JSON value for messages: compact, cut to ~60 characters ("-3", "\"abc\"", "[1,2]", "null").
 std::string describe_json(const nlohmann::json& value);
 
-/// Parse a JSON file; syntax errors name the file, line and column ("scene.json:3:14").
+/// Parse a JSON file; syntax errors name the file, line and column ("scene.json:3:14"), and so
+/// do numbers beyond double's range ("1e999") and nesting deeper than 256 arrays/objects (which
+/// no elastolearn file needs, and which would exhaust the stack of recursive code).
 /// Throws InputError.
 nlohmann::json read_json_file(const std::filesystem::path& path);
 

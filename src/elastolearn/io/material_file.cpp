@@ -306,10 +306,6 @@ fem::MaterialModel material_model(const MaterialFile& file, const std::string& s
   return model;
 }
 
-namespace {
-
-/// The material file a scene's "material" string refers to (resolved against base_dir), or
-/// nothing for an inline material object.
 std::optional<std::filesystem::path> referenced_material(
     const JsonObject& scene, const std::filesystem::path& base_dir) {
   if (!scene.has("material") || !scene.json().at("material").is_string())
@@ -317,12 +313,13 @@ std::optional<std::filesystem::path> referenced_material(
   std::filesystem::path p = scene.string("material");
   if (p.is_relative())
     p = base_dir / p;
-  if (!std::filesystem::is_regular_file(p))
+  std::error_code ec;
+  if (!std::filesystem::exists(p, ec))
     scene.fail("material", "material file " + p.string() + " does not exist");
+  if (!std::filesystem::is_regular_file(p, ec))
+    scene.fail("material", p.string() + " is not a material file (a folder?)");
   return p;
 }
-
-} // namespace
 
 MaterialFile scene_material(const JsonObject& scene, const std::filesystem::path& base_dir) {
   if (const auto path = referenced_material(scene, base_dir))

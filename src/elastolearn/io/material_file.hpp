@@ -74,6 +74,12 @@ std::string describe_material_model(const fem::MaterialModel& model);
 /// or the material file.
 MaterialFile scene_material(const JsonObject& scene, const std::filesystem::path& base_dir);
 
+/// The material file a scene's "material" field names (resolved against `base_dir`), or nothing
+/// for an inline material object. Throws InputError naming the scene's field if the file does
+/// not exist.
+std::optional<std::filesystem::path> referenced_material(
+    const JsonObject& scene, const std::filesystem::path& base_dir);
+
 /// material_model(scene_material(scene, base_dir)), with errors of an inline material naming
 /// the scene's field ("scene.json: material.young") and of a referenced one its file.
 /// If `training_stretches` is not null it receives the referenced file's training range (none

@@ -89,9 +89,13 @@ double read_dt(const h5::File& file) {
 
 } // namespace
 
-void write_observation_h5(const std::filesystem::path& path, const observe::Observation& obs) {
+void write_observation_h5(const std::filesystem::path& path, const observe::Observation& obs,
+    const std::map<std::string, std::string>& metadata) {
   const std::string name = path.string();
   obs.validate(name);
+  for (const auto& [key, value] : metadata)
+    if (key.empty() || key == "format" || key == "dt")
+      throw InputError(name, "invalid metadata key '" + key + "' (empty or reserved)");
   const hsize_t T = static_cast<hsize_t>(obs.num_frames());
   const hsize_t k = static_cast<hsize_t>(obs.num_observed());
   std::vector<double> positions(T * k * 3);
@@ -107,6 +111,8 @@ void write_observation_h5(const std::filesystem::path& path, const observe::Obse
   file.write(k_time, time.data(), { T });
   file.set_attribute("format", std::string(k_kind) + "/" + std::to_string(k_version));
   set_number_attribute(file, "dt", obs.dt);
+  for (const auto& [key, value] : metadata)
+    file.set_attribute(key, value);
   file.close();
   atomic.commit();
 }
@@ -154,6 +160,24 @@ observe::Observation read_observation_h5(const std::filesystem::path& path) {
   }
   obs.validate(file.name());
   return obs;
+}
+
+std::map<std::string, std::string> read_observation_metadata(const std::filesystem::path& path) {
+  const h5::File file = h5::File::open(path);
+  check_format(file);
+  std::map<std::string, std::string> metadata = file.attributes("/");
+  metadata.erase("format");
+  metadata.erase("dt");
+  return metadata;
+}
+
+bool is_observation_h5(const std::filesystem::path& path) {
+  try {
+    const std::optional<std::string> format = h5::File::open(path).attribute("format");
+    return format && format->rfind(std::string(k_kind) + "/", 0) == 0;
+  } catch (const InputError&) {
+    return false;
+  }
 }
 
 std::vector<int> read_vertex_id_list(const std::filesystem::path& path) {

@@ -4,10 +4,13 @@
 ///   /observed/vertex_ids (k) i32      mesh vertex index of each observed point
 ///   /observed/positions (T, k, 3) f64 observed positions [m], frame by frame
 ///   /time (T) f64                     frame times [s], evenly spaced by dt
-///   root attributes: format = "elastolearn-observation/1", dt (float64 [s])
+///   root attributes: format = "elastolearn-observation/1", dt (float64 [s]), plus optional
+///   free-form string metadata (observe writes source, selection, noise_sigma, seed)
 #include <elastolearn/observe/observation.hpp>
 
 #include <filesystem>
+#include <map>
+#include <string>
 #include <vector>
 
 namespace elastolearn::io {
@@ -15,7 +18,9 @@ namespace elastolearn::io {
 /// Write atomically (temporary file + rename): /time is start_time + t·dt. The observation is
 /// validated first (Observation::validate), so a written file always reads back.
 /// Throws InputError naming the path (and field) on invalid data or when the file cannot be made.
-void write_observation_h5(const std::filesystem::path& path, const observe::Observation& obs);
+/// `metadata` become string attributes on the root group ("format" and "dt" are reserved).
+void write_observation_h5(const std::filesystem::path& path, const observe::Observation& obs,
+    const std::map<std::string, std::string>& metadata = {});
 
 /// Read and validate an observation file: format attribute, shapes ((k,), (T, k, 3), (T,)),
 /// integer ids ≥ 0 and distinct, finite positions, dt (a number, or a string holding one)
@@ -23,6 +28,15 @@ void write_observation_h5(const std::filesystem::path& path, const observe::Obse
 /// It does not know the mesh: call `obs.validate(num_vertices, frames, dt, path)` against the
 /// scene next. Throws InputError("<file>: <dataset>", ...) on any problem.
 observe::Observation read_observation_h5(const std::filesystem::path& path);
+
+/// The root attributes of an observation file other than "format" and "dt" (e.g. "noise_sigma"),
+/// as text (numbers in shortest round-trip form). Throws InputError like read_observation_h5.
+std::map<std::string, std::string> read_observation_metadata(const std::filesystem::path& path);
+
+/// True if `path` is an HDF5 file whose root "format" attribute names an elastolearn observation
+/// (any version); false for anything else, including files that cannot be opened, so that a
+/// caller can choose the reader whose errors it then reports.
+bool is_observation_h5(const std::filesystem::path& path);
 
 /// Read a text list of vertex ids: integers separated by white space or commas, '#' starts a
 /// comment to the end of the line. Throws InputError("<file>:<line>", ...) for a token that is

@@ -33,7 +33,9 @@ mesh::Placement parse_placement(const JsonObject& o) {
   return p;
 }
 
-mesh::TetMesh unplaced_mesh(const JsonObject& o, const std::filesystem::path& base_dir) {
+/// The mesh before placement; a mesh file's paths join `inputs`.
+mesh::TetMesh unplaced_mesh(
+    const JsonObject& o, const std::filesystem::path& base_dir, std::vector<CommandInput>& inputs) {
   const std::vector<std::string> placement = { "scale", "rotate_deg", "translate" };
   auto known = [&](std::vector<std::string> keys) {
     keys.insert(keys.end(), placement.begin(), placement.end());
@@ -44,6 +46,8 @@ mesh::TetMesh unplaced_mesh(const JsonObject& o, const std::filesystem::path& ba
     std::filesystem::path p = o.string("file");
     if (p.is_relative())
       p = base_dir / p;
+    for (const auto& file : mesh::tet_mesh_files(p))
+      inputs.push_back({ file, "mesh of the scene " + o.file() });
     return mesh::read_tet_mesh(p);
   }
   const std::string type = o.choice("type", { "box", "sphere" });
@@ -55,19 +59,28 @@ mesh::TetMesh unplaced_mesh(const JsonObject& o, const std::filesystem::path& ba
     const auto cells = o.integers("cells");
     if (cells.size() != 3 || *std::min_element(cells.begin(), cells.end()) < 1)
       o.fail("cells", "expected three positive integers");
+    if (6.0 * cells[0] * double(cells[1]) * double(cells[2]) > double(mesh::kMaxGeneratedTets))
+      o.fail("cells",
+          "6 x " + std::to_string(cells[0]) + " x " + std::to_string(cells[1]) + " x "
+              + std::to_string(cells[2]) + " tets is more than a generated mesh may have ("
+              + std::to_string(mesh::kMaxGeneratedTets) + ")");
     return mesh::make_box_bar(size, { cells[0], cells[1], cells[2] });
   }
   o.reject_unknown_keys(known({ "type", "radius", "tets" }));
   const int tets = o.integer("tets");
   if (tets < 8)
     o.fail("tets", "must be at least 8");
+  if (tets > mesh::kMaxGeneratedTets)
+    o.fail("tets",
+        "must be at most " + std::to_string(mesh::kMaxGeneratedTets) + " (a generated mesh)");
   return mesh::make_sphere(o.positive("radius"), tets);
 }
 
 /// The mesh (file or procedural), scaled, rotated and translated as the scene asks.
-mesh::TetMesh parse_mesh(const JsonObject& o, const std::filesystem::path& base_dir) {
+mesh::TetMesh parse_mesh(
+    const JsonObject& o, const std::filesystem::path& base_dir, std::vector<CommandInput>& inputs) {
   const mesh::Placement placement = parse_placement(o);
-  return mesh::place(unplaced_mesh(o, base_dir), placement, o.file() + ": " + o.path());
+  return mesh::place(unplaced_mesh(o, base_dir, inputs), placement, o.file() + ": " + o.path());
 }
 
 /// The vertices a selection object names (possibly none).
@@ -161,11 +174,13 @@ sim::PointLoad parse_load(const JsonObject& o, const mesh::TetMesh& mesh) {
 /// `{"type": "trajectory", "file": F, "frame": k}`: frame k of trajectory file F (k < 0 counts
 /// from the end), which must have been recorded on the scene's mesh.
 void parse_recorded_state(const JsonObject& o, const mesh::TetMesh& mesh,
-    const std::filesystem::path& base_dir, sim::InitialCondition& ic) {
+    const std::filesystem::path& base_dir, sim::InitialCondition& ic,
+    std::vector<CommandInput>& inputs) {
   o.reject_unknown_keys({ "type", "file", "frame" });
   std::filesystem::path path = o.string("file");
   if (path.is_relative())
     path = base_dir / path;
+  inputs.push_back({ path, "initial state of the scene " + o.file() });
   const std::string name = o.string("file");
   const int requested = o.integer("frame");
   // Errors inside the trajectory file name both the scene field and the file's dataset.
@@ -215,12 +230,12 @@ void parse_recorded_state(const JsonObject& o, const mesh::TetMesh& mesh,
   ic.time = frame.time;
 }
 
-sim::InitialCondition parse_initial(
-    const JsonObject& o, const mesh::TetMesh& mesh, const std::filesystem::path& base_dir) {
+sim::InitialCondition parse_initial(const JsonObject& o, const mesh::TetMesh& mesh,
+    const std::filesystem::path& base_dir, std::vector<CommandInput>& inputs) {
   sim::InitialCondition ic;
   const std::string type = o.choice("type", { "rest", "velocity", "static", "trajectory" }, "rest");
   if (type == "trajectory") {
-    parse_recorded_state(o, mesh, base_dir, ic);
+    parse_recorded_state(o, mesh, base_dir, ic, inputs);
   } else if (type == "rest") {
     o.reject_unknown_keys({ "type" });
   } else if (type == "velocity") {
@@ -259,7 +274,9 @@ SceneFile parse_scene(
   SceneFile out;
   sim::Scene& s = out.scene;
   s.name = root.string("name", std::filesystem::path(file).stem().string());
-  s.mesh = parse_mesh(root.object("mesh"), base_dir);
+  s.mesh = parse_mesh(root.object("mesh"), base_dir, out.inputs);
+  if (const auto material = referenced_material(root, base_dir))
+    out.inputs.push_back({ *material, "material of the scene " + file });
   s.material = scene_material_model(
       root, base_dir, &out.material_training_stretches); // inline object or path of a material file
   s.mass = root.choice("mass", { "lumped", "consistent" }, "lumped") == "lumped"
@@ -275,7 +292,7 @@ SceneFile parse_scene(
     for (const auto& l : root.objects("loads"))
       s.loads.push_back(parse_load(l, s.mesh));
   if (root.has("initial"))
-    s.initial = parse_initial(root.object("initial"), s.mesh, base_dir);
+    s.initial = parse_initial(root.object("initial"), s.mesh, base_dir, out.inputs);
   const JsonObject time = root.object("time");
   time.reject_unknown_keys({ "dt", "frames" });
   s.dt = time.positive("dt");
@@ -315,6 +332,7 @@ SceneFile parse_scene(
 SceneFile read_scene_file(const std::filesystem::path& path) {
   SceneFile out = parse_scene(read_json_file(path), path.string(), path.parent_path());
   out.path = path;
+  out.inputs.insert(out.inputs.begin(), CommandInput { path, "scene" });
   return out;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 /// \file Scene JSON files ("format": "elastolearn-scene/1"); the format is documented in
 /// docs/scene_format.md. Every error names the file and the field.
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/material/stretch_range.hpp>
 #include <elastolearn/sim/scene.hpp>
@@ -24,6 +25,10 @@ struct SceneFile {
   /// The training range of a learned material the scene references (io::MaterialFile).
   std::optional<material::StretchRange> material_training_stretches;
   std::filesystem::path path;
+  /// Every file the scene was read from: the scene file itself (when read from a file), its
+  /// mesh file(s) (both .node and .ele of a TetGen mesh) and its material file, so that a command
+  /// can refuse to overwrite any of them (check_command_paths).
+  std::vector<CommandInput> inputs;
 };
 
 /// Read and validate a scene file. Throws InputError naming the file and field.

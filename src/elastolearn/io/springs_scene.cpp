@@ -16,6 +16,9 @@ SpringSystem parse_system(const JsonObject& o, std::string& type) {
     const int nodes = o.integer("nodes");
     if (nodes < 2)
       o.fail("nodes", "a rope needs at least 2 nodes, got " + std::to_string(nodes));
+    if (nodes > kMaxSpringNodes)
+      o.fail("nodes",
+          "must be at most " + std::to_string(kMaxSpringNodes) + ", got " + std::to_string(nodes));
     return make_rope(nodes, o.positive("rest_length", 1.0), o.positive("mass", 1.0));
   }
   o.reject_unknown_keys({ "type", "columns", "rows", "spacing", "shear", "plane", "pins", "mass" });
@@ -26,6 +29,10 @@ SpringSystem parse_system(const JsonObject& o, std::string& type) {
     o.fail("columns", "must be >= 2, got " + std::to_string(c.columns));
   if (c.rows < 2)
     o.fail("rows", "must be >= 2, got " + std::to_string(c.rows));
+  if (double(c.columns) * double(c.rows) > double(kMaxSpringNodes))
+    o.fail("",
+        std::to_string(c.columns) + " x " + std::to_string(c.rows) + " nodes is more than "
+            + std::to_string(kMaxSpringNodes));
   c.spacing = o.positive("spacing", 1.0);
   c.shear = o.boolean("shear", true);
   c.plane = cloth_plane_from_string(
@@ -99,6 +106,7 @@ SpringsScene parse_springs_scene(
   if (spring.has("model")) {
     spring.reject_unknown_keys({ "model" });
     scene.learned_spring = base_dir / spring.string("model");
+    scene.inputs.push_back({ *scene.learned_spring, "learned spring of the scene " + file });
   } else {
     scene.training.law = parse_law(spring);
   }
@@ -182,7 +190,9 @@ SpringsScene parse_springs_scene(
 
 SpringsScene read_springs_scene(const std::filesystem::path& path) {
   const nlohmann::json json = read_json_file(path);
-  return parse_springs_scene(json, path.string(), path.parent_path());
+  SpringsScene scene = parse_springs_scene(json, path.string(), path.parent_path());
+  scene.inputs.insert(scene.inputs.begin(), CommandInput { path, "scene" });
+  return scene;
 }
 
 springs::LearnedSpring scene_learned_spring(const SpringsScene& scene) {

@@ -2,6 +2,7 @@
 /// \file Springs scene JSON ("format": "elastolearn-springs-scene/1") and learned-spring JSON
 /// ("format": "elastolearn-learned-spring/1"); formats documented in docs/springs.md. Every error
 /// names the file and the field.
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/springs/learned_simulator.hpp>
@@ -29,6 +30,9 @@ struct SpringsScene {
   std::optional<std::filesystem::path> trajectory; ///< output HDF5 (relative to the scene)
   std::optional<std::filesystem::path> vtu_directory; ///< output VTU/PVD folder
   int every = 1; ///< record every k-th step
+  /// The files the scene was read from: the scene file (when read from a file) and its learned
+  /// spring file, so that a command can refuse to overwrite them (check_command_paths).
+  std::vector<CommandInput> inputs;
 };
 
 /// Read and validate a springs scene. Throws InputError naming the file and field.

@@ -58,8 +58,8 @@ bool LineReader::next() {
 
 void LineReader::require(std::string_view what) {
   if (!next())
-    throw InputError(m_name + ":" + std::to_string(m_line_number),
-        "unexpected end of file (truncated?) while reading " + std::string(what));
+    throw InputError(
+        where(), "unexpected end of file (truncated?) while reading " + std::string(what));
 }
 
 void LineReader::require_tokens(std::size_t n, std::string_view what) const {
@@ -69,7 +69,8 @@ void LineReader::require_tokens(std::size_t n, std::string_view what) const {
 }
 
 std::string LineReader::where() const {
-  return m_name + ":" + std::to_string(m_line_number);
+  // Before the first line (an empty file) there is no line to name.
+  return m_line_number > 0 ? m_name + ":" + std::to_string(m_line_number) : m_name;
 }
 
 void LineReader::fail(const std::string& message) const {

@@ -37,7 +37,7 @@ class LineReader {
   std::string_view line() const { return m_line; }
   /// 1-based line number of the current line.
   int line_number() const { return m_line_number; }
-  /// "file:line" of the current line.
+  /// "file:line" of the current line ("file" before the first line).
   std::string where() const;
   /// The file name used in errors.
   const std::string& name() const { return m_name; }

@@ -70,6 +70,15 @@ TetMesh make_box_bar(const Vec3& size, const std::array<int, 3>& cells) {
     if (cells[a] < 1)
       throw InputError("make_box_bar",
           "cells[" + std::to_string(a) + "] must be >= 1, got " + std::to_string(cells[a]));
+  }
+  // In double: the product of three ints can overflow 64 bits' worth of care, not a double's.
+  const double tets = 6.0 * cells[0] * double(cells[1]) * double(cells[2]);
+  if (tets > double(kMaxGeneratedTets))
+    throw InputError("make_box_bar",
+        "6 x " + std::to_string(cells[0]) + " x " + std::to_string(cells[1]) + " x "
+            + std::to_string(cells[2]) + " tets is more than a generated mesh may have ("
+            + std::to_string(kMaxGeneratedTets) + ")");
+  for (int a = 0; a < 3; ++a) {
     for (int i = 0; i <= cells[a]; ++i)
       coords[a].push_back(size[a] * i / cells[a]);
     dir[a].assign(static_cast<std::size_t>(cells[a]), 1);
@@ -82,6 +91,10 @@ TetMesh make_sphere(double radius, int target_tets) {
     throw InputError("make_sphere", "radius must be positive, got " + std::to_string(radius));
   if (target_tets < 1)
     throw InputError("make_sphere", "target_tets must be >= 1, got " + std::to_string(target_tets));
+  if (target_tets > kMaxGeneratedTets)
+    throw InputError("make_sphere",
+        "target_tets " + std::to_string(target_tets) + " is more than a generated mesh may have ("
+            + std::to_string(kMaxGeneratedTets) + ")");
   // Cells per axis a ≤ b ≤ c ≤ a+1 with 6abc closest to the target (relative error); consecutive
   // candidates differ by a factor ≤ 1.5 for a ≥ 2, so the best one is within ±30 %.
   std::array<int, 3> n { 2, 2, 2 };

@@ -6,11 +6,17 @@
 
 namespace elastolearn::mesh {
 
+/// The most tets a generated mesh may have. Far beyond what the solvers handle in reasonable
+/// time (~10⁶ tets), it keeps every index in `int` and the memory a mistyped count asks for
+/// bounded (≈ 1 GB), so that a count of 10¹⁵ is a clear error instead of an allocation failure.
+constexpr long long kMaxGeneratedTets = 10'000'000;
+
 /// The box [0, size.x]×[0, size.y]×[0, size.z] [m] split into cells[0]×cells[1]×cells[2] equal
 /// cuboids, each cut into 6 tets around its main diagonal (the Kuhn/Freudenthal pattern, the same
 /// in every cell, so neighbouring cells share their face diagonals: conforming).
 /// Vertex (i, j, k) of the lattice has index i + (cells[0]+1)·(j + (cells[1]+1)·k).
-/// Throws InputError if a size is not positive/finite or a cell count is < 1.
+/// Throws InputError if a size is not positive/finite, a cell count is < 1 or the mesh would have
+/// more than kMaxGeneratedTets tets (6·cells[0]·cells[1]·cells[2]).
 TetMesh make_box_bar(const Vec3& size, const std::array<int, 3>& cells);
 
 /// A ball of radius `radius` [m] centred at the origin, with about `target_tets` tets (within ±30 %
@@ -22,7 +28,8 @@ TetMesh make_box_bar(const Vec3& size, const std::array<int, 3>& cells);
 /// conforming); the cube is then mapped onto the ball by the radial map
 /// p ↦ radius · p · ‖p‖∞ / ‖p‖₂, which sends the cube surface onto the sphere. Surface vertices lie
 /// exactly on the sphere, so the mesh volume approaches 4/3·π·r³ from below as O(h²).
-/// Throws InputError if radius is not positive/finite or target_tets < 1.
+/// Throws InputError if radius is not positive/finite, target_tets < 1 or target_tets >
+/// kMaxGeneratedTets.
 TetMesh make_sphere(double radius, int target_tets);
 
 } // namespace elastolearn::mesh

@@ -43,11 +43,16 @@ std::filesystem::path tetgen_stem(const std::filesystem::path& path) {
   return path;
 }
 
-TetMesh read_tetgen(const std::filesystem::path& path) {
+std::array<std::filesystem::path, 2> tetgen_files(const std::filesystem::path& path) {
   const auto stem = tetgen_stem(path);
   auto node_path = stem, ele_path = stem;
   node_path += ".node";
   ele_path += ".ele";
+  return { node_path, ele_path };
+}
+
+TetMesh read_tetgen(const std::filesystem::path& path) {
+  const auto [node_path, ele_path] = tetgen_files(path);
 
   SourceLines lines;
   LineReader nodes(node_path);
@@ -106,11 +111,8 @@ TetMesh read_tetgen(const std::filesystem::path& path) {
   return TetMesh(std::move(rest), std::move(tets), ele_path.string());
 }
 
-void write_tetgen(const std::filesystem::path& stem_in, const TetMesh& mesh) {
-  const auto stem = tetgen_stem(stem_in);
-  auto node_path = stem, ele_path = stem;
-  node_path += ".node";
-  ele_path += ".ele";
+void write_tetgen(const std::filesystem::path& stem, const TetMesh& mesh) {
+  const auto [node_path, ele_path] = tetgen_files(stem);
 
   std::string node = "# elastolearn rest mesh: <id> x y z (0-based)\n";
   node += std::to_string(mesh.num_vertices()) + " 3 0 0\n";

@@ -7,6 +7,7 @@
 /// 0- or 1-based, decided by the first point's id; ids must be consecutive.
 #include <elastolearn/mesh/tet_mesh.hpp>
 
+#include <array>
 #include <filesystem>
 
 namespace elastolearn::mesh {
@@ -24,5 +25,9 @@ void write_tetgen(const std::filesystem::path& stem, const TetMesh& mesh);
 
 /// `path` without a `.node` / `.ele` extension (other extensions are kept).
 std::filesystem::path tetgen_stem(const std::filesystem::path& path);
+
+/// `<stem>.node` and `<stem>.ele` for `path` (either file or their stem): the files read_tetgen
+/// reads and write_tetgen writes.
+std::array<std::filesystem::path, 2> tetgen_files(const std::filesystem::path& path);
 
 } // namespace elastolearn::mesh

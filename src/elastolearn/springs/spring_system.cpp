@@ -114,6 +114,9 @@ ClothPins cloth_pins_from_string(const std::string& name, const std::string& whe
 SpringSystem make_rope(int nodes, double rest_length, double node_mass) {
   if (nodes < 2)
     throw InputError("rope.nodes", "must be >= 2, got " + std::to_string(nodes));
+  if (nodes > kMaxSpringNodes)
+    throw InputError("rope.nodes",
+        "must be at most " + std::to_string(kMaxSpringNodes) + ", got " + std::to_string(nodes));
   if (!(rest_length > 0.0))
     throw InputError("rope.rest_length", "must be > 0");
   if (!(node_mass > 0.0))
@@ -137,6 +140,10 @@ SpringSystem make_cloth(const ClothOptions& o) {
     throw InputError("cloth.columns", "must be >= 2, got " + std::to_string(o.columns));
   if (o.rows < 2)
     throw InputError("cloth.rows", "must be >= 2, got " + std::to_string(o.rows));
+  if (double(o.columns) * double(o.rows) > double(kMaxSpringNodes))
+    throw InputError("cloth",
+        std::to_string(o.columns) + " x " + std::to_string(o.rows) + " nodes is more than "
+            + std::to_string(kMaxSpringNodes));
   if (!(o.spacing > 0.0))
     throw InputError("cloth.spacing", "must be > 0");
   if (!(o.node_mass > 0.0))

@@ -57,10 +57,15 @@ struct ClothOptions {
   double node_mass = 1.0; ///< [kg] (paper: unit mass)
 };
 
+/// The most nodes a generated rope or cloth may have: far beyond what the experiments use, it
+/// keeps a mistyped count (10⁹) a clear error instead of an allocation failure.
+constexpr long long kMaxSpringNodes = 10'000'000;
+
 /// Rope of `nodes` nodes along +x with spacing `rest_length`, node 0 pinned (paper §4).
-/// Throws InputError for nodes < 2 or non-positive length/mass.
+/// Throws InputError for nodes < 2 or > kMaxSpringNodes, or non-positive length/mass.
 SpringSystem make_rope(int nodes, double rest_length = 1.0, double node_mass = 1.0);
-/// Rectangular cloth; node (column i, row r) has index r·columns + i. Throws InputError.
+/// Rectangular cloth; node (column i, row r) has index r·columns + i. Throws InputError, also
+/// for more than kMaxSpringNodes nodes.
 SpringSystem make_cloth(const ClothOptions& options);
 /// Nodes of the bottom row of a cloth made by make_cloth (row rows−1).
 std::vector<int> cloth_bottom_row(const ClothOptions& options);
