@@ -26,8 +26,9 @@ struct SceneFile {
   std::optional<material::StretchRange> material_training_stretches;
   std::filesystem::path path;
   /// Every file the scene was read from: the scene file itself (when read from a file), its
-  /// mesh file(s) (both .node and .ele of a TetGen mesh) and its material file, so that a command
-  /// can refuse to overwrite any of them (check_command_paths).
+  /// mesh file(s) (both .node and .ele of a TetGen mesh), its material file and the trajectory
+  /// of a recorded initial state, so that a command can refuse to overwrite any of them
+  /// (check_command_paths).
   std::vector<CommandInput> inputs;
 };
 
