@@ -118,6 +118,10 @@ void run_learn(const LearnOptions& o) {
   if (scene.material.correction)
     throw InputError(o.scene,
         "material: the scene's material already carries a correction; learn from a nominal one");
+  if (scene.mass != fem::MassType::Lumped)
+    throw InputError(o.scene,
+        "mass: learning needs \"lumped\" mass (the paper's); learn with lumped mass and simulate "
+        "the learned material with either (docs/learning_loop.md, \"Lumped mass only\")");
   observe::Observation observed = io::read_observation_h5(o.observations);
   observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, o.observations);
 

@@ -135,4 +135,20 @@ TEST_F(CliLearnTest, RefusesObservationsOfAnotherLength) {
   EXPECT_FALSE(fs::exists(path("l.json")));
 }
 
+TEST_F(CliLearnTest, RefusesAConsistentMassSceneNamingTheField) {
+  ASSERT_EQ(run("simulate " + path("scene.json") + " -o " + path("truth.h5") + " -q").exit_code, 0);
+  ASSERT_EQ(
+      run("observe " + path("truth.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code,
+      0);
+  std::ofstream(m_dir / "consistent.json") << std::regex_replace(
+      k_scene, std::regex("\"gravity\""), "\"mass\": \"consistent\", \"gravity\"");
+  const auto r = run("learn " + path("consistent.json") + " --observations " + path("obs.h5")
+      + " -o " + path("l.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(
+      r.output.find("consistent.json: mass: learning needs \"lumped\" mass"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(path("l.json")));
+}
+
 } // namespace
