@@ -1,8 +1,8 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
-#include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/levenberg_marquardt.hpp>
 #include <elastolearn/learn/trajectory_physics.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 #include <elastolearn/sim/simulator.hpp>
 
 #include <elastolearn/core/timing.hpp>
@@ -59,7 +59,7 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
   const auto start = Clock::now();
   const bool sensitivities = mode != Sensitivities::none;
   ForwardSensitivityPass pass;
-  const sim::Scene corrected = with_correction(
+  const sim::Scene corrected = sim::with_correction(
       scene, std::make_shared<material::RbfCorrection>(design.correction(unknowns)));
   sim::Simulator simulator(corrected);
   const auto initial = simulator.apply_initial_condition();
