@@ -15,6 +15,7 @@
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 
 #include <cstdio>
 #include <thread>
@@ -55,7 +56,7 @@ double deformation(const std::vector<VecX>& frames, const mesh::TetMesh& mesh) {
 
 /// Forward simulation of a scene; throws if it does not complete (the truth must).
 std::vector<VecX> simulate_or_throw(const sim::Scene& scene, const std::string& what) {
-  auto run = learn::simulate_positions(scene);
+  auto run = sim::simulate_positions(scene);
   if (!run.completed)
     throw InputError(what, "simulation failed: " + run.message);
   return std::move(run.positions);
@@ -63,7 +64,7 @@ std::vector<VecX> simulate_or_throw(const sim::Scene& scene, const std::string& 
 
 /// err_L of `scene`'s simulation against the truth frames; −1 if it diverged.
 double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
-  const auto run = learn::simulate_positions(scene);
+  const auto run = sim::simulate_positions(scene);
   if (!run.completed) {
     std::fprintf(stderr, "   (diverged: %s)\n", run.message.c_str());
     return -1;
@@ -252,7 +253,7 @@ Row run_case(const LearningCase& c) {
   t0 = Clock::now();
   row.err_nominal = err_l(c.test, truth_test);
   row.err_fit = err_l(learn::scene_with_parameters(c.test, c.nominal_type, fit.fitted), truth_test);
-  row.err_learned = err_l(learn::with_correction(c.test, state.best), truth_test);
+  row.err_learned = err_l(sim::with_correction(c.test, state.best), truth_test);
   std::printf("   test err_L: nominal %.3f %%, parameter fit %.3f %%, learned %.3f %% (target ≤ "
               "%.1f %%; %.1f s)\n",
       row.err_nominal, row.err_fit, row.err_learned, row.target, seconds_since(t0));

@@ -16,6 +16,7 @@
 #include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -107,7 +108,7 @@ void run_demo(const fs::path& out, double fraction) {
   const auto test_truth = simulate_and_save(with_material(test, truth), out, "test_truth");
   const auto test_nominal = simulate_and_save(test, out, "test_nominal");
   const auto test_learned
-      = simulate_and_save(learn::with_correction(test, state.best), out, "test_learned");
+      = simulate_and_save(sim::with_correction(test, state.best), out, "test_learned");
   const auto e_nominal
       = learn::as_percent_of(learn::position_error(test_nominal, test_truth), size);
   const auto e_learned

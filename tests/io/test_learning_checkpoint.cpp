@@ -5,6 +5,7 @@
 #include <elastolearn/io/learning_checkpoint.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 
 #include <support/bar_scene.hpp>
 
@@ -28,7 +29,7 @@ struct Fixture {
   std::filesystem::path file
       = std::filesystem::temp_directory_path() / "elastolearn_test_checkpoint.json";
   Fixture() {
-    const auto run = learn::simulate_positions(bar(material::ElasticModelType::NeoHookean, 1e6));
+    const auto run = sim::simulate_positions(bar(material::ElasticModelType::NeoHookean, 1e6));
     std::vector<Positions> frames;
     for (const auto& x : run.positions)
       frames.emplace_back(unflatten(x));

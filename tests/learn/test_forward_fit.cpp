@@ -3,10 +3,10 @@
 // recovers a correction the design can express from the observed motion alone.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
-#include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 
 #include <support/bar_scene.hpp>
 
@@ -32,7 +32,7 @@ sim::Scene small_bar() {
 }
 
 observe::Observation observe_run(const sim::Scene& scene) {
-  const ForwardRun run = simulate_positions(scene);
+  const sim::ForwardRun run = sim::simulate_positions(scene);
   EXPECT_TRUE(run.completed) << run.message;
   std::vector<Positions> frames;
   for (const auto& x : run.positions)
@@ -107,7 +107,7 @@ TEST(ForwardFit, RecoversACorrectionTheDesignCanExpressFromHalfTheVertices) {
   truth_unknowns[0] = -2e3; // a kernel weight [Pa]
   truth_unknowns[4] = 8e3; // own slope a = 2Δμ + Δλ [Pa]
   truth_unknowns[5] = 2e3; // other slope b = Δλ [Pa]
-  const observe::Observation observed = observe_run(with_correction(
+  const observe::Observation observed = observe_run(sim::with_correction(
       nominal, std::make_shared<material::RbfCorrection>(design.correction(truth_unknowns))));
   ForwardFitOptions options;
   options.max_iterations = 4;

@@ -1,8 +1,8 @@
 // The sparse reduced space-time optimisation (paper 000 §5.1, Eqs. 2–5): derivatives of its
 // objective against finite differences, and what it must recover.
-#include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/space_time.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 
 #include <support/bar_scene.hpp>
 #include <support/finite_difference.hpp>
@@ -60,7 +60,7 @@ std::vector<VecX> displaced(const std::vector<VecX>& x, const MatX& basis, const
 
 TEST(SpaceTime, GradientMatchesFiniteDifferences) {
   const sim::Scene scene = small_bar(6);
-  const auto run = simulate_positions(scene);
+  const auto run = sim::simulate_positions(scene);
   ASSERT_TRUE(run.completed);
   const MatX basis = random_basis(scene, 4, 3);
   // Data a little off the simulation, and a trajectory off both: all residuals non-zero.
@@ -93,7 +93,7 @@ TEST(SpaceTime, NormalMatrixIsGaussNewtonHessianAtASolution) {
   // At a simulated trajectory observed exactly, every residual vanishes, so the Hessian of E
   // equals JᵀJ: the block-banded normal matrix must match finite differences of the gradient.
   const sim::Scene scene = small_bar(5);
-  const auto run = simulate_positions(scene);
+  const auto run = sim::simulate_positions(scene);
   ASSERT_TRUE(run.completed);
   const MatX basis = random_basis(scene, 3, 7);
   const auto observed = observe_all_surface(scene, run.positions);
@@ -115,7 +115,7 @@ TEST(SpaceTime, NormalMatrixIsGaussNewtonHessianAtASolution) {
 
 TEST(SpaceTime, RecoversAnObservedSimulationFromAPerturbedStart) {
   const sim::Scene scene = small_bar(20);
-  const auto run = simulate_positions(scene);
+  const auto run = sim::simulate_positions(scene);
   ASSERT_TRUE(run.completed);
   const MatX basis = random_basis(scene, 6, 11);
   const auto observed = observe_all_surface(scene, run.positions);

@@ -1,14 +1,17 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
-#include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/levenberg_marquardt.hpp>
 #include <elastolearn/learn/trajectory_physics.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 #include <elastolearn/sim/simulator.hpp>
 
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/sim/linear_solver.hpp>
 
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <optional>
 
 namespace elastolearn::learn {
 
@@ -56,7 +59,7 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
   const auto start = Clock::now();
   const bool sensitivities = mode != Sensitivities::none;
   ForwardSensitivityPass pass;
-  const sim::Scene corrected = with_correction(
+  const sim::Scene corrected = sim::with_correction(
       scene, std::make_shared<material::RbfCorrection>(design.correction(unknowns)));
   sim::Simulator simulator(corrected);
   const auto initial = simulator.apply_initial_condition();
@@ -179,46 +182,64 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
     throw InputError(
         "forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
   result.rms_history.push_back(current.error.rms);
-  double mu = options.damping;
   const int first_damping = design.elastic_unknowns(), n_damping = design.damping_unknowns();
-  for (int it = 0; it < options.max_iterations; ++it) {
-    // The priors ρ Σ (s_i w_i)² on the damping (ρ_d) and the elastic (ρ_e) unknowns, with s
-    // fixed by the current pass so that the trial and the current objective are measured alike
-    // (and a resumed fit, which recomputes the current pass, takes the same steps).
-    VecX prior_weights = VecX::Zero(start.size());
+  // The priors ρ Σ (s_i w_i)² on the damping (ρ_d) and the elastic (ρ_e) unknowns, with s
+  // fixed by the current pass so that the trial and the current objective are measured alike
+  // (and a resumed fit, which recomputes the current pass, takes the same steps).
+  VecX prior_weights;
+  const auto objective = [&](const ForwardSensitivityPass& pass, const VecX& w) {
+    return pass.squared_error + w.dot(prior_weights.cwiseProduct(w));
+  };
+  // The current point is result.unknowns with its pass `current`; a trial waits in trial_unknowns
+  // and `trial`.
+  VecX trial_unknowns;
+  ForwardSensitivityPass trial;
+  LevenbergMarquardtProblem problem;
+  problem.linearize = [&]() -> std::optional<NormalEquations> {
+    prior_weights = VecX::Zero(start.size());
     prior_weights.head(first_damping)
         = options.elastic_prior * current.normal.diagonal().head(first_damping);
     prior_weights.segment(first_damping, n_damping)
         = options.damping_prior * current.normal.diagonal().segment(first_damping, n_damping);
-    const auto objective = [&](const ForwardSensitivityPass& pass, const VecX& w) {
-      return pass.squared_error + w.dot(prior_weights.cwiseProduct(w));
+    NormalEquations equations { current.normal,
+      current.gradient + prior_weights.cwiseProduct(result.unknowns),
+      objective(current, result.unknowns), current.error.samples };
+    equations.hessian.diagonal() += prior_weights;
+    return equations;
+  };
+  problem.evaluate = [&](const VecX& step) {
+    trial_unknowns = result.unknowns + step;
+    trial = simulate_with_sensitivities(
+        scene, observed, mesh, design, trial_unknowns, options.sensitivities, progress);
+    result.rms_history.push_back(trial.completed ? trial.error.rms : -1.0);
+    TrialEvaluation evaluation { .completed = trial.completed };
+    if (trial.completed)
+      evaluation.cost = objective(trial, trial_unknowns);
+    return evaluation;
+  };
+  problem.accept = [&] {
+    result.unknowns = trial_unknowns;
+    current = std::move(trial);
+  };
+  if (on_step)
+    problem.on_step = [&](const LevenbergMarquardtStep& step) {
+      return on_step(step.accepted ? current : trial, step.accepted, result.unknowns, step.damping);
     };
-    MatX normal = current.normal;
-    normal.diagonal() += prior_weights;
-    const VecX gradient = current.gradient + prior_weights.cwiseProduct(result.unknowns);
-    // Levenberg–Marquardt step on the Jacobi-scaled normal equations, (Ĥ + μ I) Δ̂ = −ĝ: the RBF
-    // fit's regularised solve with μ as its (dimensionless) Tikhonov weight.
-    const VecX step = solve_regularised_normal_equations(
-        std::move(normal), -gradient, VecX::Constant(start.size(), mu), current.error.samples);
-    const VecX trial = result.unknowns + step;
-    ForwardSensitivityPass next = simulate_with_sensitivities(
-        scene, observed, mesh, design, trial, options.sensitivities, progress);
-    result.rms_history.push_back(next.completed ? next.error.rms : -1.0);
-    const bool accepted
-        = next.completed && objective(next, trial) < objective(current, result.unknowns);
-    if (accepted) {
-      result.unknowns = trial;
-      ++result.accepted;
-      mu /= 3;
-    } else {
-      mu *= 10;
-    }
-    const bool go_on = !on_step || on_step(next, accepted, result.unknowns, mu);
-    if (accepted)
-      current = std::move(next);
-    if (!go_on)
-      break;
-  }
+  // Levenberg–Marquardt on the Jacobi-scaled normal equations, (Ĥ + μ I) Δ̂ = −ĝ: the RBF fit's
+  // regularised solve with μ as its (dimensionless) Tikhonov weight. Every trial counts against
+  // max_iterations; the equations change only with an accepted step's pass.
+  const int unlimited = std::numeric_limits<int>::max();
+  result.accepted = levenberg_marquardt(problem,
+      { .max_iterations = unlimited,
+          .max_steps = options.max_iterations,
+          .max_rejections = unlimited,
+          .initial_damping = options.damping,
+          .scaling = DampingScaling::jacobi,
+          .damping_decrease = 3,
+          .min_damping = 0,
+          .damping_increase = 10,
+          .failed_damping_increase = 10 })
+                        .accepted;
   result.seconds = seconds_since(started);
   return result;
 }

@@ -1,7 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
-#include <elastolearn/sim/run_simulation.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -55,7 +55,7 @@ std::vector<Positions> as_positions(const std::vector<VecX>& frames) {
 }
 
 /// `run` with the tracked vertices moved to their data at every frame.
-ForwardRun with_tracked_data(ForwardRun run, const sim::Scene& tracked_scene) {
+sim::ForwardRun with_tracked_data(sim::ForwardRun run, const sim::Scene& tracked_scene) {
   if (!run.completed || !tracked_scene.tracked)
     return run;
   const auto& tracked = *tracked_scene.tracked;
@@ -116,31 +116,6 @@ void LearningOptions::validate() const {
     throw InputError("learn.max_full_space_dofs", "must be ≥ 1");
 }
 
-sim::Scene with_correction(
-    const sim::Scene& scene, std::shared_ptr<const material::Correction> correction) {
-  sim::Scene out = scene;
-  out.material.correction = std::move(correction);
-  return out;
-}
-
-ForwardRun simulate_positions(const sim::Scene& scene, const ProgressCallback& progress) {
-  ForwardRun run;
-  run.positions.reserve(static_cast<size_t>(scene.frames) + 1);
-  const auto report = sim::run_simulation(
-      scene,
-      [&](int frame, double, const VecX& x, const VecX& v) {
-        if (frame == 0)
-          run.initial_velocity = v;
-        run.positions.push_back(x);
-      },
-      progress);
-  run.completed = report.completed;
-  run.message = report.message;
-  if (!run.completed)
-    run.positions.clear();
-  return run;
-}
-
 namespace {
 
 /// RBF centres: k-means over the stretch views of `positions` (at most options.centres).
@@ -171,7 +146,7 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
     centres = state.best->parameters().centres;
   } else {
     centres = rbf_centres(
-        mesh, simulate_positions(scene, callbacks.progress).positions, options, options.seed);
+        mesh, sim::simulate_positions(scene, callbacks.progress).positions, options, options.seed);
   }
   const RbfDesign design(centres, options.rbf);
   const VecX start
@@ -247,11 +222,11 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
     IterationRecord record;
     record.iteration = state.next_iteration;
     LearningState next = state; // committed only once the iteration is complete
-    const sim::Scene current = with_correction(scene, state.correction);
+    const sim::Scene current = sim::with_correction(scene, state.correction);
 
     // 1. Forward simulation with C_k: the convergence signal.
     auto t0 = Clock::now();
-    const ForwardRun forward = simulate_positions(current, callbacks.progress);
+    const sim::ForwardRun forward = sim::simulate_positions(current, callbacks.progress);
     record.seconds_forward = seconds_since(t0);
     record.forward_completed = forward.completed;
     if (!forward.completed && record.iteration == 0)
@@ -289,10 +264,10 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
         return false;
       // 2. Constrained forward simulation: the starting trajectory (falls back to the forward one).
       t0 = Clock::now();
-      const ForwardRun constrained = all_free_tracked
+      const sim::ForwardRun constrained = all_free_tracked
           ? with_tracked_data(forward, tracked_scene)
-          : simulate_positions(
-              with_correction(tracked_scene, state.correction), callbacks.progress);
+          : sim::simulate_positions(
+              sim::with_correction(tracked_scene, state.correction), callbacks.progress);
       record.seconds_constrained = seconds_since(t0);
 
       // 3. POD basis of the forward simulation (and of the constrained one).

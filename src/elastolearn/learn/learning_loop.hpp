@@ -140,18 +140,4 @@ struct LearningCallbacks {
 bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
     const LearningOptions& options, LearningState& state, const LearningCallbacks& callbacks = {});
 
-/// The scene with `correction` attached to its material.
-sim::Scene with_correction(
-    const sim::Scene& scene, std::shared_ptr<const material::Correction> correction);
-
-/// All states of a forward simulation (flat 3n), and its initial velocity. Empty positions if it
-/// diverged before the end (message then says where).
-struct ForwardRun {
-  std::vector<VecX> positions;
-  VecX initial_velocity;
-  bool completed = false;
-  std::string message;
-};
-ForwardRun simulate_positions(const sim::Scene& scene, const ProgressCallback& progress = {});
-
 } // namespace elastolearn::learn

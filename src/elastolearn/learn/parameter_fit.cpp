@@ -1,6 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/interrupt.hpp>
 #include <elastolearn/core/timing.hpp>
+#include <elastolearn/learn/levenberg_marquardt.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
 #include <elastolearn/material/spline_edited.hpp>
@@ -8,13 +9,12 @@
 
 #include <oneapi/tbb/parallel_for.h>
 
-#include <Eigen/Cholesky>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 namespace elastolearn::learn {
 
@@ -309,17 +309,34 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
   }
   report.initial_rms = current.rms(samples);
   report.initial_max = current.max_error;
-  double lambda = options.initial_lambda;
-  record(0, current, lambda, 0);
+  record(0, current, options.initial_lambda, 0);
 
+  // Levenberg–Marquardt in the transformed coordinates u. The current point is report.fitted,
+  // `current` its evaluation; a trial waits in trial_parameters and `trial` until the driver
+  // accepts or rejects it.
+  FitStop stopped_by = FitStop::Interrupted; // why the problem ended the solve, when it did
+  std::string stopped_because;
+  const auto stop = [&](FitStop why, std::string message) {
+    stopped_by = why;
+    stopped_because = std::move(message);
+  };
+  const auto interrupted
+      = [&] { stop(FitStop::Interrupted, "interrupted; the best parameters so far are kept"); };
+  VecX u(p);
+  NominalParameters trial_parameters;
+  Evaluation trial;
+  std::string last_failure; // the last trial's divergence ("" if it completed)
   const double h = options.finite_difference_step;
-  for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
-    if (current.rms(samples) <= error_floor)
-      return finish(current, FitStop::Converged, "the observation is matched to round-off");
-    report.iterations = iteration;
+
+  LevenbergMarquardtProblem problem;
+  problem.linearize = [&]() -> std::optional<NormalEquations> {
+    if (current.rms(samples) <= error_floor) {
+      stop(FitStop::Converged, "the observation is matched to round-off");
+      return std::nullopt;
+    }
+    ++report.iterations;
     // Transformed coordinates of the current parameters (re-derived each time, so a damping
     // clamped at 0 sits at log(floor) where its forward difference is informative).
-    VecX u(p);
     for (int i = 0; i < p; ++i)
       u[i] = transform.to_u(fitted[i], report.fitted);
 
@@ -328,9 +345,9 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
     std::vector<int> runs(static_cast<size_t>(p), 0), failures(static_cast<size_t>(p), 0);
     const auto column = [&](int i) {
       for (const double step : { h, -h }) {
-        NominalParameters trial = report.fitted;
-        transform.set(fitted[i], u[i] + step, trial);
-        const Evaluation e = evaluate(scene, type, trial, obs, frames);
+        NominalParameters perturbed = report.fitted;
+        transform.set(fitted[i], u[i] + step, perturbed);
+        const Evaluation e = evaluate(scene, type, perturbed, obs, frames);
         ++runs[static_cast<size_t>(i)];
         if (e.completed) {
           J.col(i) = (e.residual - current.residual) / step;
@@ -351,80 +368,71 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
       report.simulations += runs[static_cast<size_t>(i)];
       report.diverged += failures[static_cast<size_t>(i)];
     }
-    if (interrupt_requested())
-      return finish(
-          current, FitStop::Interrupted, "interrupted; the best parameters so far are kept");
-
-    const MatX JtJ = J.transpose() * J;
-    const VecX gradient = J.transpose() * current.residual;
-    // Columns whose simulations all diverged (or that do not influence the motion) stay fixed.
-    const double diag_max = JtJ.diagonal().maxCoeff();
-    if (!(diag_max > 0))
-      return finish(current, FitStop::NoImprovingStep,
-          "no fitted parameter changes the observed motion (or every perturbed simulation "
-          "diverged)");
-    std::vector<bool> active(static_cast<size_t>(p));
+    if (interrupt_requested()) {
+      interrupted();
+      return std::nullopt;
+    }
+    // A column whose simulations all diverged (or that does not influence the motion) has a zero
+    // diagonal in JᵀJ: the Marquardt scaling holds that parameter fixed.
+    return NormalEquations { J.transpose() * J, J.transpose() * current.residual, current.cost,
+      samples };
+  };
+  problem.evaluate = [&](const VecX& delta) {
+    trial_parameters = report.fitted;
     for (int i = 0; i < p; ++i)
-      active[static_cast<size_t>(i)] = JtJ(i, i) > 1e-14 * diag_max;
-
-    int rejected = 0;
-    std::string last_failure;
-    bool accepted = false;
-    double improvement = 0;
-    while (!accepted) {
-      MatX A = JtJ;
-      for (int i = 0; i < p; ++i) {
-        if (active[static_cast<size_t>(i)]) {
-          A(i, i) *= 1 + lambda;
-        } else {
-          A.row(i).setZero();
-          A.col(i).setZero();
-          A(i, i) = 1;
-        }
-      }
-      VecX rhs = -gradient;
-      for (int i = 0; i < p; ++i)
-        if (!active[static_cast<size_t>(i)])
-          rhs[i] = 0;
-      VecX delta = A.ldlt().solve(rhs);
-      const double largest = delta.cwiseAbs().maxCoeff();
-      if (largest > options.max_step)
-        delta *= options.max_step / largest;
-
-      NominalParameters trial = report.fitted;
-      for (int i = 0; i < p; ++i)
-        transform.set(fitted[i], u[i] + delta[i], trial);
-      Evaluation e = evaluate(scene, type, trial, obs, frames);
-      ++report.simulations;
-      if (interrupt_requested())
-        return finish(
-            current, FitStop::Interrupted, "interrupted; the best parameters so far are kept");
-      if (e.completed && e.cost < current.cost) {
-        improvement = (current.cost - e.cost) / current.cost;
-        current = std::move(e);
-        report.fitted = trial;
-        lambda = std::max(lambda / 3, 1e-12);
-        accepted = true;
-      } else {
-        if (!e.completed)
-          ++report.diverged;
-        last_failure = e.completed ? "" : e.message;
-        lambda *= e.completed ? 4 : 10; // a diverged trial was a long step: shrink harder
-        if (++rejected >= options.max_rejections) {
-          record(iteration, current, lambda, rejected);
-          return finish(current, FitStop::NoImprovingStep,
-              std::to_string(rejected) + " trial steps in a row did not lower the error"
-                  + (last_failure.empty() ? std::string() : " (last: " + last_failure + ")"));
-        }
-      }
+      transform.set(fitted[i], u[i] + delta[i], trial_parameters);
+    trial = evaluate(scene, type, trial_parameters, obs, frames);
+    ++report.simulations;
+    if (interrupt_requested()) {
+      interrupted();
+      return TrialEvaluation { .stop = true };
     }
-    record(iteration, current, lambda, rejected);
-    if (improvement < options.tolerance) {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "relative improvement %.2g below the tolerance %.2g",
-          improvement, options.tolerance);
-      return finish(current, FitStop::Converged, buf);
-    }
+    if (!trial.completed)
+      ++report.diverged;
+    last_failure = trial.completed ? "" : trial.message;
+    return TrialEvaluation { .completed = trial.completed, .cost = trial.cost };
+  };
+  problem.accept = [&] {
+    current = std::move(trial);
+    report.fitted = trial_parameters;
+  };
+  problem.on_step = [&](const LevenbergMarquardtStep& step) {
+    if (step.accepted || step.gives_up)
+      record(step.iteration, current, step.damping, step.rejections);
+    return true;
+  };
+
+  const LevenbergMarquardtSummary summary = levenberg_marquardt(problem,
+      { .max_iterations = options.max_iterations,
+          .max_rejections = options.max_rejections,
+          .initial_damping = options.initial_lambda,
+          .scaling = DampingScaling::marquardt,
+          .damping_decrease = 3,
+          .min_damping = 1e-12,
+          .damping_increase = 4,
+          .failed_damping_increase = 10, // a diverged trial was a long step: shrink harder
+          .max_step = options.max_step,
+          .function_tolerance = options.tolerance });
+  switch (summary.stop) {
+  case LevenbergMarquardtStop::stopped:
+    return finish(current, stopped_by, stopped_because);
+  case LevenbergMarquardtStop::converged: {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "relative improvement %.2g below the tolerance %.2g",
+        summary.relative_decrease, options.tolerance);
+    return finish(current, FitStop::Converged, buf);
+  }
+  case LevenbergMarquardtStop::no_improving_step:
+    return finish(current, FitStop::NoImprovingStep,
+        std::to_string(summary.rejections) + " trial steps in a row did not lower the error"
+            + (last_failure.empty() ? std::string() : " (last: " + last_failure + ")"));
+  case LevenbergMarquardtStop::degenerate:
+    return finish(current, FitStop::NoImprovingStep,
+        "no fitted parameter changes the observed motion (or every perturbed simulation "
+        "diverged)");
+  case LevenbergMarquardtStop::max_iterations:
+  case LevenbergMarquardtStop::max_steps:
+    break;
   }
   return finish(current, FitStop::MaxIterations,
       "reached " + std::to_string(options.max_iterations) + " iterations");

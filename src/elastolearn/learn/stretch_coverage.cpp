@@ -1,7 +1,7 @@
 #include <elastolearn/core/error.hpp>
-#include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/material/principal_stress.hpp>
+#include <elastolearn/sim/forward_run.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
@@ -66,7 +66,8 @@ std::optional<material::StretchRange> training_stretch_range(
     const sim::Scene& training, std::shared_ptr<const material::Correction> correction) {
   if (!correction)
     return std::nullopt;
-  const ForwardRun run = simulate_positions(with_correction(training, std::move(correction)));
+  const sim::ForwardRun run
+      = sim::simulate_positions(sim::with_correction(training, std::move(correction)));
   if (!run.completed)
     return std::nullopt;
   return trajectory_stretch_range(training.mesh, run.positions);

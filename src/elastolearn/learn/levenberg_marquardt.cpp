@@ -1,0 +1,173 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
+#include <elastolearn/learn/levenberg_marquardt.hpp>
+#include <elastolearn/learn/rbf_fit.hpp>
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace elastolearn::learn {
+
+namespace {
+
+constexpr FieldErrors fail("levenberg_marquardt");
+
+/// Below this fraction of the largest diagonal entry an unknown counts as not moving the
+/// residuals (marquardt scaling holds it fixed).
+constexpr double kInactiveDiagonal = 1e-14;
+
+/// The normal equations of one iteration and the damped steps from them.
+class DampedSystem {
+  public:
+  DampedSystem(NormalEquations equations, DampingScaling scaling)
+      : m_equations(std::move(equations))
+      , m_scaling(scaling) {
+    const MatX& h = m_equations.hessian;
+    ELASTOLEARN_CHECK(
+        h.rows() > 0 && h.rows() == h.cols() && m_equations.gradient.size() == h.rows(),
+        "the normal equations must be n × n and n with n ≥ 1");
+    if (m_scaling == DampingScaling::marquardt) {
+      const double diag_max = h.diagonal().maxCoeff();
+      m_degenerate = !(diag_max > 0);
+      m_active.resize(static_cast<size_t>(h.rows()));
+      for (Eigen::Index i = 0; i < h.rows(); ++i)
+        m_active[static_cast<size_t>(i)] = h(i, i) > kInactiveDiagonal * diag_max;
+    }
+  }
+
+  /// No step can be formed (marquardt: no unknown moves the residuals).
+  bool degenerate() const { return m_degenerate; }
+  double cost() const { return m_equations.cost; }
+
+  /// The step for damping `mu`, scaled down to `max_step` in its largest entry.
+  VecX step(double mu, double max_step) const {
+    VecX delta = m_scaling == DampingScaling::marquardt ? marquardt_step(mu) : jacobi_step(mu);
+    const double largest = delta.cwiseAbs().maxCoeff();
+    if (largest > max_step)
+      delta *= max_step / largest;
+    return delta;
+  }
+
+  private:
+  VecX marquardt_step(double mu) const {
+    const Eigen::Index n = m_equations.hessian.rows();
+    MatX a = m_equations.hessian;
+    VecX rhs = -m_equations.gradient;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      if (m_active[static_cast<size_t>(i)]) {
+        a(i, i) *= 1 + mu;
+      } else {
+        a.row(i).setZero();
+        a.col(i).setZero();
+        a(i, i) = 1;
+        rhs[i] = 0;
+      }
+    }
+    return a.ldlt().solve(rhs);
+  }
+
+  VecX jacobi_step(double mu) const {
+    const Eigen::Index n = m_equations.hessian.rows();
+    return solve_regularised_normal_equations(
+        m_equations.hessian, -m_equations.gradient, VecX::Constant(n, mu), m_equations.samples);
+  }
+
+  NormalEquations m_equations;
+  DampingScaling m_scaling;
+  std::vector<bool> m_active; ///< marquardt: unknowns that move the residuals
+  bool m_degenerate = false;
+};
+
+} // namespace
+
+void LevenbergMarquardtOptions::validate() const {
+  if (max_iterations < 1)
+    fail("max_iterations", "must be ≥ 1, got " + to_text(max_iterations));
+  if (max_steps < 0)
+    fail("max_steps", "must be ≥ 0, got " + to_text(max_steps));
+  if (max_rejections < 1)
+    fail("max_rejections", "must be ≥ 1, got " + to_text(max_rejections));
+  if (!(initial_damping > 0 && std::isfinite(initial_damping)))
+    fail("initial_damping", "must be finite and > 0, got " + to_text(initial_damping));
+  if (!(damping_decrease >= 1 && std::isfinite(damping_decrease)))
+    fail("damping_decrease", "must be finite and ≥ 1, got " + to_text(damping_decrease));
+  if (!(min_damping >= 0 && std::isfinite(min_damping)))
+    fail("min_damping", "must be finite and ≥ 0, got " + to_text(min_damping));
+  if (!(damping_increase > 1 && std::isfinite(damping_increase)))
+    fail("damping_increase", "must be finite and > 1, got " + to_text(damping_increase));
+  if (!(failed_damping_increase > 1 && std::isfinite(failed_damping_increase)))
+    fail("failed_damping_increase",
+        "must be finite and > 1, got " + to_text(failed_damping_increase));
+  if (!(max_step > 0))
+    fail("max_step", "must be > 0, got " + to_text(max_step));
+  if (!(function_tolerance >= 0 && std::isfinite(function_tolerance)))
+    fail("function_tolerance", "must be finite and ≥ 0, got " + to_text(function_tolerance));
+}
+
+LevenbergMarquardtSummary levenberg_marquardt(
+    const LevenbergMarquardtProblem& problem, const LevenbergMarquardtOptions& options) {
+  options.validate();
+  ELASTOLEARN_CHECK(problem.linearize && problem.evaluate && problem.accept,
+      "a Levenberg–Marquardt problem needs linearize, evaluate and accept");
+  LevenbergMarquardtSummary summary;
+  summary.damping = options.initial_damping;
+  const auto end = [&](LevenbergMarquardtStop stop) {
+    summary.stop = stop;
+    return summary;
+  };
+  double& mu = summary.damping;
+  while (true) {
+    if (summary.iterations >= options.max_iterations)
+      return end(LevenbergMarquardtStop::max_iterations);
+    if (summary.steps >= options.max_steps)
+      return end(LevenbergMarquardtStop::max_steps);
+    std::optional<NormalEquations> equations = problem.linearize();
+    if (!equations)
+      return end(LevenbergMarquardtStop::stopped);
+    ++summary.iterations;
+    const DampedSystem system(std::move(*equations), options.scaling);
+    if (system.degenerate())
+      return end(LevenbergMarquardtStop::degenerate);
+    summary.rejections = 0;
+    while (true) {
+      if (summary.steps >= options.max_steps)
+        return end(LevenbergMarquardtStop::max_steps);
+      const TrialEvaluation trial = problem.evaluate(system.step(mu, options.max_step));
+      ++summary.steps;
+      if (trial.stop)
+        return end(LevenbergMarquardtStop::stopped);
+      LevenbergMarquardtStep step;
+      step.iteration = summary.iterations;
+      step.completed = trial.completed;
+      step.accepted = trial.completed && trial.cost < system.cost();
+      step.cost = trial.completed ? trial.cost : std::numeric_limits<double>::infinity();
+      if (step.accepted) {
+        step.relative_decrease = (system.cost() - trial.cost) / system.cost();
+        summary.relative_decrease = step.relative_decrease;
+        ++summary.accepted;
+        mu = std::max(mu / options.damping_decrease, options.min_damping);
+        problem.accept();
+      } else {
+        mu *= trial.completed ? options.damping_increase : options.failed_damping_increase;
+        ++summary.rejections;
+        step.gives_up = summary.rejections >= options.max_rejections;
+      }
+      step.rejections = summary.rejections;
+      step.damping = mu;
+      if (problem.on_step && !problem.on_step(step))
+        return end(LevenbergMarquardtStop::stopped);
+      if (step.gives_up)
+        return end(LevenbergMarquardtStop::no_improving_step);
+      if (step.accepted) {
+        if (step.relative_decrease < options.function_tolerance)
+          return end(LevenbergMarquardtStop::converged);
+        break;
+      }
+    }
+  }
+}
+
+} // namespace elastolearn::learn
