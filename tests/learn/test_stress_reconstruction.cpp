@@ -5,6 +5,8 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/fem/elastic_force.hpp>
+#include <elastolearn/learn/correction_force.hpp>
+#include <elastolearn/learn/element_state.hpp>
 #include <elastolearn/learn/kmeans.hpp>
 #include <elastolearn/learn/stress_reconstruction.hpp>
 #include <elastolearn/learn/stress_reconstruction_lsqr.hpp>

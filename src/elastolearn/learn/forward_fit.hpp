@@ -11,8 +11,8 @@
 /// "Forward fit"). Each iteration costs one forward simulation plus, per frame, one extra
 /// factorisation and a solve with one right-hand side per unknown.
 #include <elastolearn/core/progress.hpp>
+#include <elastolearn/learn/correction_force.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
-#include <elastolearn/learn/stress_reconstruction.hpp>
 #include <elastolearn/learn/trajectory_error.hpp>
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>

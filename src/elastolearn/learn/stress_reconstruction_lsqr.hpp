@@ -4,6 +4,7 @@
 /// fit to those (stretch, stretch rate, p̂) samples. The paper prefers the direct RBF
 /// reconstruction (stress_reconstruction.hpp) because these min-norm stresses need not match the
 /// true ones; this path is kept for comparison.
+#include <elastolearn/learn/element_force_operator.hpp>
 #include <elastolearn/learn/stress_reconstruction.hpp>
 
 #include <Eigen/SparseCore>

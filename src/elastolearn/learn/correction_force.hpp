@@ -1,0 +1,67 @@
+#pragma once
+/// \file The nodal forces of a material correction (paper 000 §4.1, Eqs. 1 and 13): the force of
+/// a given correction (correction_force), its misfit against target forces, and the linear map
+/// from an RBF design's unknowns to that force (CorrectionForceJacobian).
+#include <elastolearn/fem/dof_map.hpp>
+#include <elastolearn/learn/element_state.hpp>
+#include <elastolearn/learn/rbf_fit.hpp>
+
+#include <array>
+#include <vector>
+
+namespace elastolearn::learn {
+
+/// Nodal forces [N] (flat 3n) of a correction: what fem::ElasticForce gives with it minus without
+/// it, f = Σ_e B_e N(σ_e, ḟ_e) + α₁ (−(K_e − K_e^d) v_e) + [(α₁ + Δα₁)⁺ − α₁] (−K_e^d v_e)
+/// with K_e, K_e^d the damping stiffness (material::damping_tangent) of the corrected and the
+/// nominal model (Eq. 1's N term, the nominal
+/// Rayleigh term on the corrected stiffness, and Eq. 13's damping term; α₁ from
+/// mesh.nominal.damping). Without mesh.nominal.elastic only the N term. Parallel over elements.
+VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
+    const VecX& x, const VecX& v);
+
+/// J of one frame: column i is the nodal force (free dofs) of RBF unknown i alone at a state
+/// (x, v), so that the correction's force there (correction_force, restricted) is J x: element e
+/// adds [B_e A_e + α₁ D_e [A_e; ∂A_e/∂σ], (−K_e^nom v_e) d_e] (RbfDesign's A, d; Eq. 13) to its
+/// free dofs' rows (exact up to Δα₁'s clamps). The element blocks are computed in parallel in
+/// batches and added in element order, so J does not depend on the thread count. Owns its work
+/// space (allocated once); one instance per concurrent caller. `mesh`, `dofs` and `design` must
+/// outlive it.
+class CorrectionForceJacobian {
+  public:
+  /// Throws InputError if the design fits damping but mesh.nominal has no elastic model.
+  CorrectionForceJacobian(
+      const ReconstructionMesh& mesh, const fem::DofMap& dofs, const RbfDesign& design);
+  /// Jᵀ (unknowns × free dofs) at flat 3n positions x [m] and velocities v [m/s].
+  const MatX& transposed(const VecX& x, const VecX& v);
+
+  private:
+  /// Element e's 12 × u block into `rows`.
+  void element_rows(int e, Eigen::Ref<MatX> rows, RbfDesign::OutputMatrix& outputs,
+      RbfDesign::OutputGradient& gradients, Eigen::RowVectorXd& damping_row) const;
+
+  const ReconstructionMesh& m_mesh;
+  const RbfDesign& m_design;
+  std::vector<std::array<int, 12>>
+      m_free_rows; ///< free index of each element's local dofs (−1: prescribed)
+  std::vector<ElementState> m_states;
+  MatX m_jt;
+  MatX m_batch; ///< 12 rows per element of one batch
+};
+
+/// RMS force misfit of a correction against targets over the free dofs.
+struct ForceMisfit {
+  /// √(Σ_t ‖r_t‖² / (T · n_free)), r_t = restrict_free(f_t − g_t), n_free = free vertices [N]
+  double rms_residual = 0;
+  double rms_target = 0; ///< the same for g_t alone [N]
+  int frames = 0; ///< T, frames used
+};
+
+/// Misfit of `correction`'s nodal forces (correction_force) against the targets at frames
+/// 0, stride, 2·stride, … Same inputs and checks as reconstruct_rbf_correction.
+ForceMisfit correction_force_misfit(const ReconstructionMesh& mesh, const fem::DofMap& dofs,
+    const material::Correction& correction, const std::vector<VecX>& positions,
+    const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
+    int frame_stride = 1);
+
+} // namespace elastolearn::learn
