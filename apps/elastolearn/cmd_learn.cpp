@@ -3,13 +3,12 @@
 // (paper 000 §3–§6; docs/learning.md). Checkpoints after every iteration; --resume continues.
 #include "command.hpp"
 
-#include <elastolearn/core/atomic_file.hpp>
 #include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/interrupt.hpp>
 #include <elastolearn/core/timing.hpp>
-#include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/learning_checkpoint.hpp>
+#include <elastolearn/io/learning_report.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
@@ -20,7 +19,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <sstream>
 
 namespace {
 
@@ -72,27 +70,6 @@ std::shared_ptr<const elastolearn::material::Correction> distil_network(const Le
             { "seconds_training", r.training.seconds } } } };
   return std::make_shared<const material::NnCorrection>(
       learn::with_teacher_damping(r.correction, teacher));
-}
-
-void write_report(const std::filesystem::path& dir, const elastolearn::learn::LearningState& state,
-    const nlohmann::json& summary) {
-  using namespace elastolearn;
-  std::ostringstream csv;
-  csv << "iteration,forward_rms_m,forward_max_m,forward_mean_m,control_force_rms_N,space_time_"
-         "initial,"
-         "space_time_objective,space_time_iterations,modes,centres,correction_misfit_N,correction_"
-         "target_N,"
-         "seconds_forward,seconds_pod,seconds_constrained,seconds_space_time,seconds_"
-         "reconstruction\n";
-  for (const auto& r : state.history)
-    csv << r.iteration << ',' << r.forward_error.rms << ',' << r.forward_error.max << ','
-        << r.forward_error.mean << ',' << r.control_force_rms << ',' << r.space_time_initial << ','
-        << r.space_time_objective << ',' << r.space_time_iterations << ',' << r.modes << ','
-        << r.centres << ',' << r.correction_misfit << ',' << r.correction_target << ','
-        << r.seconds_forward << ',' << r.seconds_pod << ',' << r.seconds_constrained << ','
-        << r.seconds_space_time << ',' << r.seconds_reconstruction << '\n';
-  write_text_file_atomic(dir / "convergence.csv", csv.str());
-  io::write_json_file(dir / "report.json", summary);
 }
 
 void run_learn(const LearnOptions& o) {
@@ -202,9 +179,8 @@ void run_learn(const LearnOptions& o) {
     total_seconds += r.seconds_total();
     history.push_back(io::iteration_record_to_json(r));
   }
-  const nlohmann::json root = io::read_json_file(o.scene);
-  io::MaterialFile learned
-      = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
+  io::MaterialFile learned;
+  learned.material = scene_file.nominal_material;
   learned.correction = state.best;
   learned.training_stretches = learn::training_stretch_range(scene, state.best);
   learned.training = { { "scene", o.scene }, { "observations", o.observations },
@@ -219,7 +195,7 @@ void run_learn(const LearnOptions& o) {
   }
   io::write_material_file(o.output, learned);
   if (!o.report.empty())
-    write_report(o.report, state, learned.training);
+    io::write_learning_report(o.report, state.history, learned.training);
 
   const auto& first = state.history.front().forward_error;
   std::printf("best: iteration %d, observation error rms %.4f %% (nominal %.4f %%), max %.4f %% "

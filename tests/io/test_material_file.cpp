@@ -391,7 +391,9 @@ TEST(MaterialFile, SceneMayReferenceAMaterialFile) {
   ASSERT_TRUE(s.material_training_stretches.has_value()) << "simulate compares with it";
   EXPECT_EQ(s.material_training_stretches->max, Vec3(1.03, 1.0, 0.97));
 
-  // scene_material gives the nominal JSON too (what `learn` needs to save a result).
+  // The scene file and scene_material give the nominal JSON too (what `learn` saves a result
+  // with).
+  EXPECT_EQ(s.nominal_material, k_nominal);
   const Json scene_json = Json::parse(scene);
   EXPECT_EQ(scene_material(JsonObject(scene_json, "scene.json"), dir.path()).material, k_nominal);
 

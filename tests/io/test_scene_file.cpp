@@ -57,6 +57,13 @@ double max_distance(const Positions& a, const Positions& b) {
 
 // --- mesh placement ---------------------------------------------------------------------------
 
+TEST(SceneFile, KeepsAnInlineMaterialAsTheNominalMaterial) {
+  const Json json = bar_scene();
+  const SceneFile s = parse(json, std::filesystem::current_path());
+  EXPECT_EQ(s.nominal_material, json.at("material"));
+  EXPECT_FALSE(s.material_training_stretches.has_value());
+}
+
 TEST(SceneFile, PlacesTheMeshScaledThenRotatedThenTranslated) {
   ScratchDir dir;
   Json j = bar_scene();

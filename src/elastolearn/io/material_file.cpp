@@ -329,18 +329,22 @@ MaterialFile scene_material(const JsonObject& scene, const std::filesystem::path
   return out;
 }
 
-fem::MaterialModel scene_material_model(const JsonObject& scene,
-    const std::filesystem::path& base_dir,
-    std::optional<material::StretchRange>* training_stretches) {
-  if (training_stretches)
-    training_stretches->reset();
+fem::MaterialModel scene_material_model(
+    const JsonObject& scene, const std::filesystem::path& base_dir, MaterialFile* file) {
   if (const auto path = referenced_material(scene, base_dir)) {
-    MaterialFile file = read_material_file(*path);
-    if (training_stretches)
-      *training_stretches = file.training_stretches;
-    return material_model(file, path->string());
+    MaterialFile read = read_material_file(*path);
+    fem::MaterialModel model = material_model(read, path->string());
+    if (file)
+      *file = std::move(read);
+    return model;
   }
-  return parse_material(scene.object("material"));
+  const JsonObject object = scene.object("material");
+  fem::MaterialModel model = parse_material(object);
+  if (file) {
+    *file = MaterialFile();
+    file->material = object.json();
+  }
+  return model;
 }
 
 } // namespace elastolearn::io

@@ -82,10 +82,9 @@ std::optional<std::filesystem::path> referenced_material(
 
 /// material_model(scene_material(scene, base_dir)), with errors of an inline material naming
 /// the scene's field ("scene.json: material.young") and of a referenced one its file.
-/// If `training_stretches` is not null it receives the referenced file's training range (none
-/// for an inline material or a file without one).
-fem::MaterialModel scene_material_model(const JsonObject& scene,
-    const std::filesystem::path& base_dir,
-    std::optional<material::StretchRange>* training_stretches = nullptr);
+/// If `file` is not null it receives scene_material(scene, base_dir) (the material file is read
+/// once).
+fem::MaterialModel scene_material_model(
+    const JsonObject& scene, const std::filesystem::path& base_dir, MaterialFile* file = nullptr);
 
 } // namespace elastolearn::io

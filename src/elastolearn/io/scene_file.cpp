@@ -277,8 +277,10 @@ SceneFile parse_scene(
   s.mesh = parse_mesh(root.object("mesh"), base_dir, out.inputs);
   if (const auto material = referenced_material(root, base_dir))
     out.inputs.push_back({ *material, "material of the scene " + file });
-  s.material = scene_material_model(
-      root, base_dir, &out.material_training_stretches); // inline object or path of a material file
+  MaterialFile material_file; // inline object or path of a material file
+  s.material = scene_material_model(root, base_dir, &material_file);
+  out.material_training_stretches = material_file.training_stretches;
+  out.nominal_material = std::move(material_file.material);
   s.mass = root.choice("mass", { "lumped", "consistent" }, "lumped") == "lumped"
       ? fem::MassType::Lumped
       : fem::MassType::Consistent;

@@ -6,6 +6,8 @@
 #include <elastolearn/material/stretch_range.hpp>
 #include <elastolearn/sim/scene.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -24,6 +26,9 @@ struct SceneFile {
   SceneOutputs outputs;
   /// The training range of a learned material the scene references (io::MaterialFile).
   std::optional<material::StretchRange> material_training_stretches;
+  /// The scene's nominal material as a scene-format "material" object: the inline object or the
+  /// "material" of the material file the scene references (what a learned material starts from).
+  nlohmann::json nominal_material;
   std::filesystem::path path;
   /// Every file the scene was read from: the scene file itself (when read from a file), its
   /// mesh file(s) (both .node and .ele of a TetGen mesh), its material file and the trajectory
