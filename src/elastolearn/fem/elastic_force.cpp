@@ -23,8 +23,7 @@ ElasticForce::ElasticForce(const mesh::TetMesh& mesh, MaterialModel material, Ma
     , m_rest(precompute_rest_data(mesh))
     , m_material(std::move(material))
     , m_mass(mass)
-    , m_damping_tangent(
-          m_material.damping ? m_material.damping->tangent() : material::DampingTangent::FlipFree) {
+    , m_damping_tangent(material::damping_tangent_of(m_material.damping.get())) {
   ELASTOLEARN_CHECK(m_material.elastic != nullptr, "ElasticForce needs an elastic model");
   const int m = mesh.num_tets();
   const int n = mesh.num_vertices();
@@ -101,9 +100,8 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
         if (m_mass == MassType::Lumped) {
           force -= c.alpha.alpha0 * (density * rest.volume / 4.0) * ve;
         } else {
-          // Consistent M_e = ρ vol/20 (1 + δ_ab) I₃: (M_e v)_a = ρ vol/20 (v_a + Σ_b v_b).
-          const Vec3 sum = ve.rowwise().sum();
-          force -= c.alpha.alpha0 * (density * rest.volume / 20.0) * (ve.colwise() + sum);
+          Eigen::Map<Vec12>(force.data()) -= c.alpha.alpha0
+              * (consistent_mass_block(rest.volume, density) * Eigen::Map<const Vec12>(ve.data()));
         }
       }
     }
@@ -149,10 +147,7 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
       if (m_mass == MassType::Lumped) {
         J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
       } else {
-        const double m = c_v * c.alpha.alpha0 * density * rest.volume / 20.0;
-        for (int a = 0; a < 4; ++a)
-          for (int b = 0; b < 4; ++b)
-            J.block<3, 3>(3 * a, 3 * b).diagonal().array() += (a == b ? 2 : 1) * m;
+        J += c_v * c.alpha.alpha0 * consistent_mass_block(rest.volume, density);
       }
     }
     if (correction && c_v != 0 && !c.stress.d_stretch_rates.isZero(0)) {

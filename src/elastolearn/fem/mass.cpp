@@ -31,15 +31,19 @@ VecX lumped_dof_masses(const VecX& vertex_masses) {
   return out;
 }
 
+Mat12 consistent_mass_block(double volume, double density) {
+  Mat12 block;
+  const double base = density * volume / 20.0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      block.block<3, 3>(3 * a, 3 * b) = (a == b ? 2.0 : 1.0) * base * Mat3::Identity();
+  return block;
+}
+
 std::vector<double> consistent_mass_blocks(const std::vector<TetRestData>& rest, double density) {
   std::vector<double> blocks(rest.size() * 144, 0.0);
-  for (size_t e = 0; e < rest.size(); ++e) {
-    Eigen::Map<Mat12> block(blocks.data() + 144 * e);
-    const double base = density * rest[e].volume / 20.0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        block.block<3, 3>(3 * a, 3 * b) = (a == b ? 2.0 : 1.0) * base * Mat3::Identity();
-  }
+  for (size_t e = 0; e < rest.size(); ++e)
+    Eigen::Map<Mat12>(blocks.data() + 144 * e) = consistent_mass_block(rest[e].volume, density);
   return blocks;
 }
 

@@ -21,7 +21,11 @@ VecX lumped_vertex_masses(
 /// Per-dof lumped masses (each vertex mass repeated 3×). Length 3n.
 VecX lumped_dof_masses(const VecX& vertex_masses);
 
-/// Element buffer (m·144) of consistent mass blocks ρ·vol/20·(1 + δ_ab)·I₃, for SystemMatrix.
+/// One element's consistent mass matrix ρ·vol/20·(1 + δ_ab)·I₃ (12×12, local dofs x0, y0, z0, x1,
+/// …).
+Mat12 consistent_mass_block(double volume, double density);
+
+/// Element buffer (m·144) of consistent mass blocks (consistent_mass_block), for SystemMatrix.
 std::vector<double> consistent_mass_blocks(const std::vector<TetRestData>& rest, double density);
 
 } // namespace elastolearn::fem

@@ -31,10 +31,9 @@ double nominal_alpha1(const ReconstructionMesh& mesh, const Vec3& stretches) {
   return mesh.nominal.damping ? mesh.nominal.damping->coefficients(stretches[0]).alpha1 : 0.0;
 }
 
-/// The stiffness the nominal's damping scales (fem::ElasticForce's choice without a model).
+/// The stiffness the nominal's damping scales (as fem::ElasticForce chooses it).
 material::DampingTangent nominal_damping_tangent(const ReconstructionMesh& mesh) {
-  return mesh.nominal.damping ? mesh.nominal.damping->tangent()
-                              : material::DampingTangent::FlipFree;
+  return material::damping_tangent_of(mesh.nominal.damping.get());
 }
 
 constexpr int k_jacobian_batch = 512; ///< elements per batch of CorrectionForceJacobian

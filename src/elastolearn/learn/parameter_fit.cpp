@@ -208,8 +208,7 @@ sim::Scene scene_with_parameters(
     result.material.elastic = material::make_elastic_model(type, lame);
   }
   auto damping = std::make_shared<material::RayleighDamping>(parameters.alpha0, parameters.alpha1);
-  if (scene.material.damping)
-    damping->set_tangent(scene.material.damping->tangent());
+  damping->set_tangent(material::damping_tangent_of(scene.material.damping.get()));
   result.material.damping = std::move(damping);
   return result;
 }

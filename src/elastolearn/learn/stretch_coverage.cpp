@@ -88,25 +88,18 @@ std::string extrapolation_note(const StretchCoverage& coverage) {
     return "";
   const material::StretchRange& trained = *coverage.trained();
   const material::StretchRange& visited = coverage.visited();
+  static constexpr const char* subscripts[] = { "₁", "₂", "₃" };
   std::string beyond;
   char text[200];
   for (int k = 0; k < 3; ++k) {
     if (visited.max[k] > trained.max[k] + coverage.tolerance()) {
       std::snprintf(text, sizeof text, "%ss%s up to %.3f (trained ≤ %.3f)",
-          beyond.empty() ? "" : ", ",
-          k == 0       ? "₁"
-              : k == 1 ? "₂"
-                       : "₃",
-          visited.max[k], trained.max[k]);
+          beyond.empty() ? "" : ", ", subscripts[k], visited.max[k], trained.max[k]);
       beyond += text;
     }
     if (visited.min[k] < trained.min[k] - coverage.tolerance()) {
       std::snprintf(text, sizeof text, "%ss%s down to %.3f (trained ≥ %.3f)",
-          beyond.empty() ? "" : ", ",
-          k == 0       ? "₁"
-              : k == 1 ? "₂"
-                       : "₃",
-          visited.min[k], trained.min[k]);
+          beyond.empty() ? "" : ", ", subscripts[k], visited.min[k], trained.min[k]);
       beyond += text;
     }
   }

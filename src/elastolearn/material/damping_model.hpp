@@ -52,4 +52,10 @@ class DampingModel {
   DampingTangent m_tangent = DampingTangent::FlipFree;
 };
 
+/// The stiffness a damping model's α₁ scales; FlipFree without a model (a correction's Δα₁ then
+/// acts alone, on the default tangent).
+inline DampingTangent damping_tangent_of(const DampingModel* damping) {
+  return damping ? damping->tangent() : DampingTangent::FlipFree;
+}
+
 } // namespace elastolearn::material
