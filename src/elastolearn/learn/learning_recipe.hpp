@@ -1,0 +1,100 @@
+#pragma once
+/// \file The one way to learn (docs/learning_recipe.md): from one or more recorded motions of an
+/// object, each a scene with the nominal material and its observations, produce the material that
+/// predicts held-out data best. The stages, each a function below:
+///   0. noise: σ of the observations, given or estimated (observe/noise_estimate.hpp); the
+///      positions the loop follows are smoothed in time to that level, never differentiated raw;
+///   1. split: with two or more motions the last is held out for validation; with one, its last
+///      `validation_fraction` of the frames are;
+///   2. parameter fit: E, ν, α₀, α₁ of the nominal model fitted to the training data;
+///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit;
+///   4. validation: every candidate (the given nominal, the fitted nominal, each completed
+///      correction of the loop and of the forward fit) simulates the held-out data; the one with
+///      the smallest RMS error there is the result.
+/// The validation choice is what makes the result never worse than fitting parameters on data
+/// nobody tuned the recipe for: the fitted nominal is always a candidate.
+#include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/motion.hpp>
+#include <elastolearn/learn/parameter_fit.hpp>
+#include <elastolearn/material/elastic_model_type.hpp>
+#include <elastolearn/observe/observation.hpp>
+#include <elastolearn/sim/scene.hpp>
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace elastolearn::learn {
+
+struct RecipeOptions {
+  /// Observation noise σ [m] (standard deviation per coordinate); < 0: estimated from the data.
+  double noise = -1;
+  /// With one motion: the fraction of its frames, at the end, held out for validation.
+  double validation_fraction = 0.2;
+  /// Stage 2; its `parameters` say which of E, ν, α₀, α₁ move.
+  bool fit_parameters = true;
+  ParameterFitOptions parameter_fit;
+  /// Stage 3 (the loop's forward_fit.max_iterations steps follow it).
+  LearningOptions loop;
+  /// Throws InputError("learn.<field>", ...) for an out-of-range field.
+  void validate() const;
+};
+
+/// How σ was obtained.
+struct NoiseLevel {
+  double sigma = 0; ///< [m]
+  bool estimated = true; ///< false: given by the user
+  double smoothing_residual = 0; ///< RMS change of the positions by the temporal smoothing [m]
+};
+
+/// What the validation compares.
+enum class CandidateKind { Nominal, FittedNominal, Loop, ForwardFit };
+std::string to_string(CandidateKind kind);
+
+struct Candidate {
+  CandidateKind kind = CandidateKind::Nominal;
+  int iteration = -1; ///< the loop's (or forward fit's) iteration; −1 for the nominals
+  /// The material's correction (null for the nominals); its elastic model is the fitted nominal's
+  /// except for CandidateKind::Nominal.
+  std::shared_ptr<const material::RbfCorrection> correction;
+  bool completed = false; ///< the validation simulation completed
+  ErrorSummary validation; ///< at the held-out observations [m]
+  ErrorSummary training; ///< at the training observations [m] (the loop's own signal)
+};
+
+/// Everything the recipe decided and measured.
+struct RecipeResult {
+  NoiseLevel noise;
+  int training_frames = 0; ///< frames per training motion used (single motion: the split)
+  int validation_frames = 0; ///< frames compared in validation
+  std::string validation_data; ///< "last 20 % of frames of <name>" or "motion <name>"
+  ParameterFitReport parameter_fit; ///< stage 2 (its `fitted` = the given nominal if skipped)
+  material::ElasticModelType nominal_type {};
+  fem::MaterialModel fitted_nominal; ///< the nominal material with the fitted parameters
+  LearningState loop; ///< stage 3's final state (history, best)
+  std::vector<Candidate> candidates;
+  int chosen = -1; ///< index into candidates
+  double seconds = 0;
+  const Candidate& choice() const { return candidates.at(static_cast<size_t>(chosen)); }
+  /// The chosen material: the fitted nominal (or the given one) with the chosen correction.
+  fem::MaterialModel material(const fem::MaterialModel& given_nominal) const;
+};
+
+struct RecipeCallbacks {
+  std::function<void(const std::string&)> message; ///< one line per stage event
+  LearningCallbacks loop; ///< the loop's (its checkpoint is the caller's business)
+};
+
+/// The nominal parameters (E, ν, α₀, α₁) and model type of a scene's material; throws
+/// InputError("material", ...) if the elastic model has no single (E, ν) or the damping is not
+/// constant Rayleigh damping (fit-parameters needs both).
+NominalParameters nominal_parameters_of(
+    const fem::MaterialModel& material, material::ElasticModelType& type);
+
+/// Run all stages. Throws InputError for invalid inputs (no motion, motions of different
+/// materials, an observation that does not fit its scene).
+RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions& options = {},
+    const RecipeCallbacks& callbacks = {});
+
+} // namespace elastolearn::learn
