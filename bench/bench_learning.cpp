@@ -7,17 +7,24 @@
 //
 //   bench_learning [--quick] [--data DIR] [--modes R --kernels M ...] [CASE ...]   (no case = all;
 //   --help)
+//   bench_learning --random N --seed S [--random-case I] [--draw-only]   (random cases, each
+//   learned by the one recipe, learn::learn_material, with its default options: issue 19)
 //
 // A plain program with a table printout (not Google Benchmark): each case runs once and takes
 // seconds to minutes. Set-up and measured numbers: docs/benchmarks_learning.md.
 #include "learning_cases.hpp"
+#include "random_cases.hpp"
 
 #include <elastolearn/core/timing.hpp>
+#include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
+#include <algorithm>
 #include <cstdio>
+#include <limits>
+#include <span>
 #include <thread>
 
 namespace {
@@ -309,12 +316,241 @@ void print_table(const std::vector<Row>& rows) {
         err(r.err_fit).c_str(), err(r.err_learned).c_str(), r.target);
 }
 
+// --- Random cases (bench_learning --random N --seed S; random_cases.hpp) ---------------------
+
+struct RandomRow {
+  int index = 0;
+  std::string shape, truth;
+  int tets = 0, observed = 0, attempts = 0;
+  bool in_family = false;
+  double visible = 1, noise = 0;
+  double train_deformation = 0, test_deformation = 0; ///< % of the diagonal
+  double err_nominal = -1, err_fit = -1, err_learned = -1; ///< test err_L [%] (−1: diverged)
+  double learn_seconds = 0, fit_seconds = 0;
+  int fit_diverged = 0, loop_diverged = 0, validation_diverged = 0; ///< in learning
+  int test_diverged = 0; ///< of the fitted and learned test simulations
+  std::string chosen;
+  int learning_divergences() const { return fit_diverged + loop_diverged + validation_diverged; }
+};
+
+/// The truth's motions must complete and keep every element far from inversion (sorted
+/// stretches within [0.5, 2]); otherwise the motions are redrawn (gentler), at most this often.
+constexpr int kMotionAttempts = 4;
+
+/// Print case `index` of `seed`; with `run`, simulate its truth, learn with the recipe (default
+/// options), and measure nominal / fitted / learned on the test motion.
+RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, bool run) {
+  RandomRow row;
+  row.index = index;
+  std::printf("\n== random case %d of seed %llu (alone: bench_learning --seed %llu --random-case "
+              "%d)\n",
+      index, static_cast<unsigned long long>(seed), static_cast<unsigned long long>(seed), index);
+  std::fflush(stdout);
+  auto t0 = Clock::now();
+  const RandomObject o = draw_random_object(seed, index, data);
+  row.shape = o.shape_label;
+  row.truth = o.truth_label;
+  row.tets = o.mesh.num_tets();
+  row.in_family = o.truth_in_family;
+  row.visible = o.visible_fraction;
+  row.noise = o.noise_percent;
+  std::printf("   shape: %s\n   truth: %s%s\n   nominal: %s\n   %s\n   (drawn in %.1f s)\n",
+      o.shape_label.c_str(), o.truth_label.c_str(),
+      o.truth_in_family ? "" : " (not in the nominal's family)", o.nominal_label.c_str(),
+      o.setup_label.c_str(), seconds_since(t0));
+  std::fflush(stdout);
+
+  RandomMotions motions;
+  std::vector<VecX> truth_train, truth_test;
+  for (int attempt = 0;; ++attempt) {
+    if (attempt == kMotionAttempts)
+      throw InputError("random case " + std::to_string(index),
+          "the truth failed every drawn motion (" + std::to_string(kMotionAttempts) + " attempts)");
+    motions = draw_random_motions(o, attempt);
+    std::printf("   motions (attempt %d): train: %s\n                        test: %s\n", attempt,
+        motions.train_label.c_str(), motions.test_label.c_str());
+    std::fflush(stdout);
+    if (!run)
+      return row;
+    row.attempts = attempt + 1;
+    std::string problem;
+    t0 = Clock::now();
+    for (const auto* scene : { &motions.train, &motions.test }) {
+      auto result = sim::simulate_positions(with_material(*scene, o.truth));
+      const char* which = scene == &motions.train ? "training" : "test";
+      if (!result.completed) {
+        problem = std::string("the truth's ") + which + " simulation failed: " + result.message;
+        break;
+      }
+      const auto range = learn::trajectory_stretch_range(o.mesh, result.positions);
+      if (range.min.minCoeff() < 0.5 || range.max.maxCoeff() > 2) {
+        problem = std::string("the truth's ") + which
+            + " motion nearly inverts elements: " + learn::describe(range);
+        break;
+      }
+      (scene == &motions.train ? truth_train : truth_test) = std::move(result.positions);
+    }
+    if (problem.empty())
+      break;
+    std::printf("   redrawing the motions: %s\n", problem.c_str());
+  }
+  row.train_deformation = deformation(truth_train, o.mesh);
+  row.test_deformation = deformation(truth_test, o.mesh);
+  std::vector<Positions> frames;
+  for (const auto& x : truth_train)
+    frames.emplace_back(unflatten(x));
+  const auto ids = observe::select_visible_vertices(o.mesh, o.visible_fraction, o.observation_seed);
+  learn::Motion motion;
+  motion.name = "training";
+  motion.scene = motions.train;
+  motion.observed = observe::observe_vertices(
+      frames, o.dt, ids, o.noise_percent / 100 * o.diagonal, o.observation_seed);
+  row.observed = motion.observed.num_observed();
+  std::printf("   truth simulated in %.1f s: max displacement train %.1f %%, test %.1f %% of the "
+              "diagonal; stretches train %s, test %s; observing %d of %zu surface vertices\n",
+      seconds_since(t0), row.train_deformation, row.test_deformation,
+      learn::describe(learn::trajectory_stretch_range(o.mesh, truth_train)).c_str(),
+      learn::describe(learn::trajectory_stretch_range(o.mesh, truth_test)).c_str(), row.observed,
+      o.mesh.surface_vertices().size());
+  std::fflush(stdout);
+
+  // The one recipe, default options: nothing here knows the case.
+  learn::RecipeCallbacks callbacks;
+  callbacks.message = [](const std::string& line) {
+    std::printf("   recipe: %s\n", line.c_str());
+    std::fflush(stdout);
+  };
+  t0 = Clock::now();
+  const auto result = learn::learn_material(std::span<const learn::Motion>(&motion, 1));
+  row.learn_seconds = seconds_since(t0);
+  row.fit_seconds = result.parameter_fit.seconds;
+  row.fit_diverged = result.parameter_fit.diverged;
+  for (const auto& r : result.loop.history)
+    row.loop_diverged += r.forward_completed ? 0 : 1;
+  for (const auto& c : result.candidates)
+    row.validation_diverged += c.completed ? 0 : 1;
+  row.chosen = learn::to_string(result.choice().kind);
+  if (result.choice().iteration >= 0)
+    row.chosen += " " + std::to_string(result.choice().iteration);
+  const auto& p = result.parameter_fit.fitted;
+  std::printf("   learned in %.1f s (parameter fit %.1f s: E %.4g, ν %.3f, α₀ %.3g, α₁ %.3g); "
+              "chosen: %s; divergences in learning: %d in the fit, %d in the loop, %d in "
+              "validation\n",
+      row.learn_seconds, row.fit_seconds, p.young, p.poisson, p.alpha0, p.alpha1,
+      row.chosen.c_str(), row.fit_diverged, row.loop_diverged, row.validation_diverged);
+  std::fflush(stdout);
+
+  t0 = Clock::now();
+  row.err_nominal = err_l(motions.test, truth_test);
+  row.err_fit
+      = err_l(learn::scene_with_parameters(motions.test, result.nominal_type, p), truth_test);
+  row.err_learned = err_l(with_material(motions.test, result.material(o.nominal)), truth_test);
+  row.test_diverged = (row.err_fit < 0 ? 1 : 0) + (row.err_learned < 0 ? 1 : 0);
+  std::printf("   test err_L: nominal %s %%, parameter fit %s %%, learned %s %% (%.1f s)\n",
+      err(row.err_nominal).c_str(), err(row.err_fit).c_str(), err(row.err_learned).c_str(),
+      seconds_since(t0));
+  std::fflush(stdout);
+  return row;
+}
+
+/// learned / baseline err_L: +∞ if the learned test diverged, NaN if the baseline's did (no ratio).
+double learned_ratio(const RandomRow& r) {
+  if (r.err_learned < 0)
+    return std::numeric_limits<double>::infinity();
+  if (r.err_fit < 0)
+    return std::numeric_limits<double>::quiet_NaN();
+  return r.err_fit > 0 ? r.err_learned / r.err_fit : (r.err_learned > 0 ? 1e9 : 1.0);
+}
+
+/// The table and issue 19's targets, each PASS or FAIL.
+void print_random_summary(const std::vector<RandomRow>& rows, int failed) {
+  std::printf(
+      "\n| case | tets | truth in family | observed | noise %% | deform. train/test %% | "
+      "err_L nominal %% | err_L fit %% | err_L learned %% | learned/fit | chosen | learn s | "
+      "fit s | diverged (fit/loop/validation/test) |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const auto& r : rows)
+    std::printf(
+        "| %d | %d | %s | %d (%.0f %%) | %.1f | %.1f / %.1f | %s | %s | %s | %.3f | %s | %.1f "
+        "| %.1f | %d / %d / %d / %d |\n",
+        r.index, r.tets, r.in_family ? "yes" : "no", r.observed, 100 * r.visible, r.noise,
+        r.train_deformation, r.test_deformation, err(r.err_nominal).c_str(), err(r.err_fit).c_str(),
+        err(r.err_learned).c_str(), learned_ratio(r), r.chosen.c_str(), r.learn_seconds,
+        r.fit_seconds, r.fit_diverged, r.loop_diverged, r.validation_diverged, r.test_diverged);
+
+  std::string violators;
+  std::vector<double> ratios;
+  int learning_divergences = 0, test_divergences = 0;
+  for (const auto& r : rows) {
+    const double ratio = learned_ratio(r);
+    if (!(ratio <= 1.05) && !std::isnan(ratio))
+      violators += " " + std::to_string(r.index);
+    if (!r.in_family && !std::isnan(ratio))
+      ratios.push_back(ratio);
+    learning_divergences += r.learning_divergences();
+    test_divergences += r.test_diverged;
+  }
+  std::printf("\n%zu case(s) ran, %d failed to run\n", rows.size(), failed);
+  std::printf("target 1: learned err_L ≤ 1.05 × the parameter fit's in every case: %s%s\n",
+      violators.empty() ? "PASS" : "FAIL (cases",
+      violators.empty() ? "" : (violators + ")").c_str());
+  if (ratios.empty())
+    std::printf("target 2: median(learned / fit) ≤ 1/3 over truths outside the nominal's family: "
+                "n/a (no such case)\n");
+  else {
+    std::sort(ratios.begin(), ratios.end());
+    const size_t n = ratios.size();
+    const double median = n % 2 ? ratios[n / 2] : 0.5 * (ratios[n / 2 - 1] + ratios[n / 2]);
+    std::printf("target 2: median(learned / fit) ≤ 1/3 over truths outside the nominal's family: "
+                "%s (median %.3f over %zu case(s))\n",
+        median <= 1.0 / 3 ? "PASS" : "FAIL", median, n);
+  }
+  std::printf("target 3: no divergence in learning or in the test simulations: %s (%d in "
+              "learning, %d in the fitted and learned test simulations)\n",
+      learning_divergences + test_divergences == 0 ? "PASS" : "FAIL", learning_divergences,
+      test_divergences);
+}
+
+/// --random N / --random-case I: the cases, then the summary (unless draw_only). Non-zero exit
+/// status only if a case failed to run.
+int run_random(int count, int only, const fs::path& data, bool draw_only) {
+  const std::uint64_t seed
+      = g_seed >= 0 ? static_cast<std::uint64_t>(g_seed) : std::random_device {}() & 0x7fffffffu;
+  std::printf("bench_learning --random %d --seed %llu%s: %u hardware threads\n", count,
+      static_cast<unsigned long long>(seed),
+      only >= 0 ? (" --random-case " + std::to_string(only)).c_str() : "",
+      std::thread::hardware_concurrency());
+  std::vector<RandomRow> rows;
+  int failed = 0;
+  const int first = only >= 0 ? only : 0, last = only >= 0 ? only + 1 : count;
+  for (int index = first; index < last; ++index) {
+    try {
+      rows.push_back(run_random_case(seed, index, data, !draw_only));
+      if (!draw_only && index + 1 < last)
+        print_random_summary(rows, failed);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "random case %d failed: %s\n", index, e.what());
+      std::printf("   FAILED TO RUN: %s\n", e.what());
+      ++failed;
+    }
+  }
+  if (!draw_only) {
+    std::printf("\n== summary of seed %llu, %s\n", static_cast<unsigned long long>(seed),
+        only >= 0 ? ("case " + std::to_string(only)).c_str()
+                  : ("cases 0–" + std::to_string(count - 1)).c_str());
+    print_random_summary(rows, failed);
+  }
+  return failed > 0 ? 1 : 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
   bool quick = false;
   fs::path data = fs::temp_directory_path() / "elastolearn-cgal-data";
   std::vector<std::string> names;
+  int random_cases = 0, random_case = -1;
+  bool draw_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick")
@@ -367,6 +603,12 @@ int main(int argc, char** argv) {
       g_full_space_weight = std::stod(argv[++i]);
     else if (a == "--data" && i + 1 < argc)
       data = argv[++i];
+    else if (a == "--random" && i + 1 < argc)
+      random_cases = std::stoi(argv[++i]);
+    else if (a == "--random-case" && i + 1 < argc)
+      random_case = std::stoi(argv[++i]);
+    else if (a == "--draw-only")
+      draw_only = true;
     else if (a == "--help" || a == "-h") {
       std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes "
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
@@ -374,12 +616,17 @@ int main(int argc, char** argv) {
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
                   "[--linear-tail] [--neo-hookean-tail] [--damping-quadratic-tail] [--full-space] "
                   "[--pod-forward-only] [--no-damping] [--position-weight W] "
-                  "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
+                  "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\n"
+                  "       bench_learning --random N [--seed S] [--random-case I] [--draw-only] "
+                  "[--data DIR]\ncases:");
       for (const auto& n : kCases)
         std::printf(" %s", n.c_str());
       std::printf(
           " (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
-          "data/meshes are (extracted there if missing)\n");
+          "data/meshes are (extracted there if missing)\n--random N: N random cases drawn from "
+          "seed S (default: a fresh seed, printed), each learned by learn::learn_material with "
+          "its default options (the learning overrides above do not apply); --random-case I: only "
+          "case I of that draw; --draw-only: print the draws without simulating\n");
       return 0;
     } else if (a == "all")
       names.insert(names.end(), kCases.begin(), kCases.end());
@@ -388,6 +635,8 @@ int main(int argc, char** argv) {
     else
       names.push_back(a);
   }
+  if (random_cases > 0 || random_case >= 0)
+    return run_random(random_cases, random_case, data, draw_only);
   if (names.empty())
     names = kCases;
   std::printf("bench_learning%s: %zu case(s), %u hardware threads\n", quick ? " --quick" : "",
