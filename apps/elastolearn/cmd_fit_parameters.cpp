@@ -10,6 +10,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
@@ -28,31 +29,6 @@ struct FitOptions {
   bool quiet = false;
 };
 
-nlohmann::json to_json(const learn::NominalParameters& p) {
-  return { { "young", p.young }, { "poisson", p.poisson }, { "alpha0", p.alpha0 },
-    { "alpha1", p.alpha1 } };
-}
-
-/// The start values from the scene's "material" object (inline or a referenced material file).
-learn::NominalParameters start_parameters(
-    const io::JsonObject& material, material::ElasticModelType& type) {
-  type = material::elastic_model_type_from_string(
-      material.string("model"), material.file() + ": " + material.field("model"));
-  learn::NominalParameters p;
-  p.young = material.positive("young");
-  p.poisson = material.number("poisson");
-  if (material.has("damping")) {
-    const io::JsonObject damping = material.object("damping");
-    for (const char* key : { "alpha0", "alpha1" })
-      if (damping.has(key) && !damping.json().at(key).is_number())
-        damping.fail(
-            key, "is stretch-dependent; fit-parameters fits constant Rayleigh coefficients");
-    p.alpha0 = damping.number("alpha0", 0.0);
-    p.alpha1 = damping.number("alpha1", 0.0);
-  }
-  return p;
-}
-
 void run_fit(const FitOptions& o) {
   const io::SceneFile scene_file = io::read_scene_file(o.scene);
   const sim::Scene& scene = scene_file.scene;
@@ -68,8 +44,8 @@ void run_fit(const FitOptions& o) {
   const std::string material_source
       = root.at("material").is_string() ? root.at("material").get<std::string>() : o.scene;
   material::ElasticModelType type {};
-  const learn::NominalParameters start
-      = start_parameters(io::JsonObject(fitted.material, material_source, "material"), type);
+  const learn::NominalParameters start = io::nominal_parameters_from_json(
+      io::JsonObject(fitted.material, material_source, "material"), type);
 
   observe::Observation observed = io::read_observation_h5(o.observations);
   observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, o.observations);
@@ -98,32 +74,26 @@ void run_fit(const FitOptions& o) {
     throw CLI::RuntimeError(1);
   }
 
-  nlohmann::json& m = fitted.material;
-  m["young"] = report.fitted.young;
-  m["poisson"] = report.fitted.poisson;
-  const bool fits_damping = o.fit.find("alpha") != std::string::npos;
-  if (m.contains("damping") || fits_damping) {
-    nlohmann::json& damping = m["damping"]; // keeps its other keys (the damping tangent)
-    damping["alpha0"] = report.fitted.alpha0;
-    damping["alpha1"] = report.fitted.alpha1;
-  }
+  fitted.material = io::with_nominal_parameters(
+      fitted.material, report.fitted, o.fit.find("alpha") != std::string::npos);
   nlohmann::json history = nlohmann::json::array();
   for (const auto& it : report.history)
-    history.push_back({ { "iteration", it.iteration }, { "parameters", to_json(it.parameters) },
+    history.push_back({ { "iteration", it.iteration }, { "parameters", io::to_json(it.parameters) },
         { "rms_error_m", it.rms_error }, { "max_error_m", it.max_error }, { "lambda", it.lambda },
         { "rejected_steps", it.rejected_steps }, { "seconds", it.seconds } });
   nlohmann::json fitted_names = nlohmann::json::array();
   for (auto p : options.parameters)
     fitted_names.push_back(learn::to_string(p));
-  fitted.training = { { "method", "parameter_fit" }, { "scene", o.scene },
-    { "observations", o.observations }, { "observed_vertices", observed.num_observed() },
-    { "fitted", fitted_names }, { "frames", report.frames }, { "initial", to_json(report.initial) },
-    { "final", to_json(report.fitted) }, { "initial_rms_error_m", report.initial_rms },
-    { "initial_max_error_m", report.initial_max }, { "final_rms_error_m", report.final_rms },
-    { "final_max_error_m", report.final_max }, { "iterations", report.iterations },
-    { "simulations", report.simulations }, { "diverged_simulations", report.diverged },
-    { "seconds", report.seconds }, { "stop", learn::to_string(report.stop) },
-    { "message", report.message }, { "history", history } };
+  fitted.training
+      = { { "method", "parameter_fit" }, { "scene", o.scene }, { "observations", o.observations },
+          { "observed_vertices", observed.num_observed() }, { "fitted", fitted_names },
+          { "frames", report.frames }, { "initial", io::to_json(report.initial) },
+          { "final", io::to_json(report.fitted) }, { "initial_rms_error_m", report.initial_rms },
+          { "initial_max_error_m", report.initial_max }, { "final_rms_error_m", report.final_rms },
+          { "final_max_error_m", report.final_max }, { "iterations", report.iterations },
+          { "simulations", report.simulations }, { "diverged_simulations", report.diverged },
+          { "seconds", report.seconds }, { "stop", learn::to_string(report.stop) },
+          { "message", report.message }, { "history", history } };
   io::write_material_file(o.output, fitted);
 
   std::printf("%s: %s\n", learn::to_string(report.stop).c_str(), report.message.c_str());

@@ -10,15 +10,17 @@
 #include <elastolearn/io/learning_checkpoint.hpp>
 #include <elastolearn/io/learning_report.hpp>
 #include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
-#include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/material/nn_correction.hpp>
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 namespace {
 
@@ -29,7 +31,8 @@ struct LearnOptions {
   std::string reconstruction = "normal_equations";
   bool no_damping = false;
   bool linear_tail = false;
-  elastolearn::learn::LearningOptions learning;
+  bool no_parameter_fit = false;
+  elastolearn::learn::RecipeOptions recipe;
   // --network: distil the best RBF into the network correction (docs/learning.md).
   bool network = false;
   std::vector<double> network_motion_scales { 0.5, 1.0, 2.0 };
@@ -72,6 +75,57 @@ std::shared_ptr<const elastolearn::material::Correction> distil_network(const Le
       learn::with_teacher_damping(r.correction, teacher));
 }
 
+/// One line per loop iteration (the learning's progress table).
+void print_iteration(const elastolearn::learn::IterationRecord& r, double diagonal) {
+  if (r.forward_fit) {
+    if (r.forward_completed)
+      std::printf("%4d %12.4f %12.4f %14s %6s %6d %9.2f   (forward fit: %s)\n", r.iteration,
+          100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal, "-", "-",
+          r.centres, r.seconds_total(),
+          r.forward_fit_accepted ? "step accepted" : "step rejected, μ × 10");
+    else
+      std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10)\n",
+          r.iteration);
+  } else if (!r.forward_completed) {
+    std::printf(r.damped_update
+            ? "%4d  forward simulation diverged: trying half of this correction's step\n"
+            : "%4d  forward simulation diverged: stopping (the best correction so far is kept)\n",
+        r.iteration);
+  } else {
+    std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, "
+                "space-time %.1f [%d it], reconstruction %.1f)\n",
+        r.iteration, 100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal,
+        r.control_force_rms, r.modes, r.centres, r.seconds_total(), r.seconds_forward,
+        r.seconds_constrained, r.seconds_space_time, r.space_time_iterations,
+        r.seconds_reconstruction);
+  }
+  std::fflush(stdout);
+}
+
+/// What the recipe decided, for the learned file's "training" provenance.
+nlohmann::json recipe_json(const elastolearn::learn::RecipeResult& r) {
+  using namespace elastolearn;
+  nlohmann::json candidates = nlohmann::json::array();
+  for (const auto& c : r.candidates)
+    candidates.push_back({ { "kind", learn::to_string(c.kind) }, { "iteration", c.iteration },
+        { "completed", c.completed }, { "training_rms_error_m", c.training.rms },
+        { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
+        { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr } });
+  return { { "noise_sigma_m", r.noise.sigma }, { "noise_estimated", r.noise.estimated },
+    { "smoothing_rms_change_m", r.noise.smoothing_residual },
+    { "training_frames", r.training_frames }, { "validation_frames", r.validation_frames },
+    { "validation_data", r.validation_data },
+    { "parameter_fit",
+        { { "initial", io::to_json(r.parameter_fit.initial) },
+            { "fitted", io::to_json(r.parameter_fit.fitted) },
+            { "initial_rms_error_m", r.parameter_fit.initial_rms },
+            { "final_rms_error_m", r.parameter_fit.final_rms },
+            { "iterations", r.parameter_fit.iterations },
+            { "seconds", r.parameter_fit.seconds } } },
+    { "candidates", candidates }, { "chosen", r.chosen },
+    { "chosen_kind", learn::to_string(r.choice().kind) } };
+}
+
 void run_learn(const LearnOptions& o) {
   using namespace elastolearn;
   const auto scene_file = io::read_scene_file(o.scene);
@@ -99,121 +153,123 @@ void run_learn(const LearnOptions& o) {
     throw InputError(o.scene,
         "mass: learning needs \"lumped\" mass (the paper's); learn with lumped mass and simulate "
         "the learned material with either (docs/learning_loop.md, \"Lumped mass only\")");
-  observe::Observation observed = io::read_observation_h5(o.observations);
-  observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, o.observations);
+  // The nominal must have parameters to fit: said here with the scene file's field.
+  material::ElasticModelType nominal_type {};
+  io::nominal_parameters_from_json(
+      io::JsonObject(scene_file.nominal_material, o.scene, "material"), nominal_type);
+  std::vector<learn::Motion> motions(1);
+  motions[0].name = o.observations;
+  motions[0].scene = scene;
+  motions[0].observed = io::read_observation_h5(o.observations);
+  motions[0].observed.validate(
+      scene.mesh.num_vertices(), scene.frames + 1, scene.dt, o.observations);
 
-  learn::LearningOptions options = o.learning;
-  options.reconstruction.method
+  learn::RecipeOptions options = o.recipe;
+  learn::LearningOptions& loop = options.loop;
+  loop.reconstruction.method
       = learn::reconstruction_method_from_name(o.reconstruction, "--reconstruction");
-  options.rbf.fit_damping = !o.no_damping;
-  options.rbf.quadratic_tail = !o.linear_tail;
+  loop.rbf.fit_damping = !o.no_damping;
+  loop.rbf.quadratic_tail = !o.linear_tail;
+  options.fit_parameters = !o.no_parameter_fit;
   options.validate();
 
-  const io::LearningInputs inputs { o.scene, o.observations,
-    io::learning_options_to_json(options) };
-  learn::LearningState state;
+  const io::LearningInputs inputs { o.scene, o.observations, io::recipe_options_to_json(options) };
+  std::optional<learn::RecipeResume> resume;
   if (o.resume) {
     if (!std::filesystem::exists(checkpoint))
       throw InputError(
           checkpoint.string(), "no checkpoint to resume from (run without --resume first)");
-    state = io::read_learning_checkpoint(checkpoint, inputs);
-    std::printf(
-        "resuming from %s at iteration %d\n", checkpoint.string().c_str(), state.next_iteration);
+    resume = io::read_learning_checkpoint(checkpoint, inputs);
+    std::printf("resuming from %s at iteration %d\n", checkpoint.string().c_str(),
+        resume->loop.next_iteration);
   }
   std::printf("learning %s: %d vertices, %d tets, %d frames of dt = %g s, %d observed vertices, "
               "nominal %s\n",
       scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(), scene.frames, scene.dt,
-      observed.num_observed(), scene.material.elastic->name().c_str());
+      motions[0].observed.num_observed(), scene.material.elastic->name().c_str());
+  std::fflush(stdout);
   const double diagonal = scene.mesh.bounding_box_diagonal();
-  std::printf("%4s %12s %12s %14s %6s %6s %9s\n", "iter", "err rms [%]", "err max [%]",
-      "control [N]", "modes", "kernels", "time [s]");
 
-  learn::LearningCallbacks callbacks;
-  if (!o.quiet)
-    callbacks.progress = terminal_progress("learn");
-  callbacks.interrupted = [] { return interrupt_requested(); };
-  callbacks.iteration = [&](const learn::IterationRecord& r) {
-    if (r.forward_fit) {
-      if (r.forward_completed)
-        std::printf("%4d %12.4f %12.4f %14s %6s %6d %9.2f   (forward fit: %s)\n", r.iteration,
-            100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal, "-", "-",
-            r.centres, r.seconds_total(),
-            r.forward_fit_accepted ? "step accepted" : "step rejected, μ × 10");
-      else
-        std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10)\n",
-            r.iteration);
-      std::fflush(stdout);
-      return;
-    }
-    if (!r.forward_completed) {
-      std::printf(r.damped_update
-              ? "%4d  forward simulation diverged: trying half of this correction's step\n"
-              : "%4d  forward simulation diverged: stopping (the best correction so far is kept)\n",
-          r.iteration);
-      return;
-    }
-    std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, "
-                "space-time %.1f [%d it], "
-                "reconstruction %.1f)\n",
-        r.iteration, 100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal,
-        r.control_force_rms, r.modes, r.centres, r.seconds_total(), r.seconds_forward,
-        r.seconds_constrained, r.seconds_space_time, r.space_time_iterations,
-        r.seconds_reconstruction);
+  learn::RecipeCallbacks callbacks;
+  learn::ParameterFitReport fitted = resume ? resume->parameter_fit : learn::ParameterFitReport {};
+  callbacks.message = [](const std::string& line) {
+    std::printf("%s\n", line.c_str());
     std::fflush(stdout);
   };
-  callbacks.checkpoint = [&](const learn::LearningState& s) {
-    io::write_learning_checkpoint(checkpoint, inputs, s);
+  callbacks.parameters_fitted = [&](const learn::ParameterFitReport& f) {
+    fitted = f;
+    std::printf("%4s %12s %12s %14s %6s %6s %9s\n", "iter", "err rms [%]", "err max [%]",
+        "control [N]", "modes", "kernels", "time [s]");
+  };
+  if (!o.quiet)
+    callbacks.loop.progress = terminal_progress("learn");
+  callbacks.loop.interrupted = [] { return interrupt_requested(); };
+  callbacks.loop.iteration = [&](const learn::IterationRecord& r) { print_iteration(r, diagonal); };
+  callbacks.loop.checkpoint = [&](const learn::LearningState& s) {
+    io::write_learning_checkpoint(checkpoint, inputs, { fitted, s });
   };
 
-  const bool finished = learn::run_learning(scene, observed, options, state, callbacks);
-  if (!finished) {
+  const learn::RecipeResult result
+      = learn::learn_material(motions, options, callbacks, resume ? &*resume : nullptr);
+  if (result.interrupted) {
     std::fprintf(stderr,
         "elastolearn: interrupted; resume with the same command and --resume (checkpoint %s)\n",
         checkpoint.string().c_str());
     throw CLI::RuntimeError(130);
   }
 
-  double total_seconds = 0;
+  const learn::Candidate& chosen = result.choice();
+  double loop_seconds = 0;
   nlohmann::json history = nlohmann::json::array();
-  for (const auto& r : state.history) {
-    total_seconds += r.seconds_total();
+  for (const auto& r : result.loop.history) {
+    loop_seconds += r.seconds_total();
     history.push_back(io::iteration_record_to_json(r));
   }
   io::MaterialFile learned;
-  learned.material = scene_file.nominal_material;
-  learned.correction = state.best;
-  learned.training_stretches = learn::training_stretch_range(scene, state.best);
+  learned.material = chosen.kind == learn::CandidateKind::Nominal
+      ? scene_file.nominal_material
+      : io::with_nominal_parameters(
+          scene_file.nominal_material, result.parameter_fit.fitted, options.fit_parameters);
+  learned.correction = chosen.correction;
+  sim::Scene training_scene = scene;
+  training_scene.material = result.material(scene.material);
+  training_scene.material.correction = nullptr;
+  learned.training_stretches = learn::training_stretch_range(training_scene, chosen.correction);
   learned.training = { { "scene", o.scene }, { "observations", o.observations },
-    { "observed_vertices", observed.num_observed() }, { "best_iteration", state.best_iteration },
-    { "best_rms_error_m", state.best_error }, { "options", inputs.options },
-    { "seconds", total_seconds }, { "history", history } };
-  if (o.network && state.best) {
+    { "observed_vertices", motions[0].observed.num_observed() },
+    { "best_iteration", result.loop.best_iteration },
+    { "best_rms_error_m", result.loop.best_error }, { "options", inputs.options },
+    { "recipe", recipe_json(result) }, { "seconds", result.seconds },
+    { "loop_seconds", loop_seconds }, { "history", history } };
+  if (o.network && chosen.correction) {
     nlohmann::json provenance;
-    learned.correction = distil_network(o, scene, *state.best, provenance);
+    learned.correction = distil_network(o, training_scene, *chosen.correction, provenance);
     learned.training["teacher"] = provenance["teacher"]; // the RBF, so that nothing is lost
     learned.training["network"] = provenance["network"];
   }
   io::write_material_file(o.output, learned);
   if (!o.report.empty())
-    io::write_learning_report(o.report, state.history, learned.training);
+    io::write_learning_report(o.report, result.loop.history, learned.training);
 
-  const auto& first = state.history.front().forward_error;
-  std::printf("best: iteration %d, observation error rms %.4f %% (nominal %.4f %%), max %.4f %% "
-              "(nominal %.4f %%); "
-              "%.1f s in total\n",
-      state.best_iteration, 100 * state.best_error / diagonal, 100 * first.rms / diagonal,
-      100 * state.history[static_cast<size_t>(std::max(0, state.best_iteration))].forward_error.max
-          / diagonal,
-      100 * first.max / diagonal, total_seconds);
-  std::printf("learned material: %s (%s)\n", o.output.c_str(),
-      learned.correction ? io::describe_correction(*learned.correction).c_str()
-                         : "no correction beat the nominal model");
+  std::printf("validation on %s (error rms, %% of the size %.4g m):\n",
+      result.validation_data.c_str(), diagonal);
+  for (size_t i = 0; i < result.candidates.size(); ++i) {
+    const auto& c = result.candidates[i];
+    const std::string name = learn::to_string(c.kind)
+        + (c.iteration >= 0 ? " (iteration " + std::to_string(c.iteration) + ")" : "");
+    if (c.completed)
+      std::printf("  %-28s %10.4f %%%s\n", name.c_str(), 100 * c.validation.rms / diagonal,
+          static_cast<int>(i) == result.chosen ? "   <- chosen" : "");
+    else
+      std::printf("  %-28s   diverged\n", name.c_str());
+  }
+  std::printf("learned material: %s (%s%s); %.1f s in total\n", o.output.c_str(),
+      learn::to_string(chosen.kind).c_str(),
+      learned.correction ? (", " + io::describe_correction(*learned.correction)).c_str() : "",
+      result.seconds);
   if (learned.training_stretches)
     std::printf("training stretches: %s (simulate and evaluate note where a motion leaves them)\n",
         learn::describe(*learned.training_stretches).c_str());
-  else if (learned.correction)
-    std::printf("training stretches: not recorded (the learned model's training simulation did not "
-                "complete)\n");
   if (!o.report.empty())
     std::printf("report: %s/convergence.csv, report.json\n", o.report.c_str());
 }
@@ -232,7 +288,18 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option(
       "--checkpoint", o->checkpoint, "checkpoint file (default: OUTPUT.checkpoint.json)");
   cmd->add_flag("--resume", o->resume, "continue from the checkpoint");
-  auto& l = o->learning;
+  auto& l = o->recipe.loop;
+  cmd->add_option("--noise", o->recipe.noise,
+         "observation noise σ [m] per coordinate (default: estimated from the data)")
+      ->capture_default_str();
+  cmd->add_option("--validation-fraction", o->recipe.validation_fraction,
+         "fraction of the frames, at the end, held out to choose the material")
+      ->capture_default_str();
+  cmd->add_flag("--no-parameter-fit", o->no_parameter_fit,
+      "learn on the scene's nominal parameters as given (default: fit E, ν, α₀, α₁ first)");
+  cmd->add_option("--parameter-fit-iterations", o->recipe.parameter_fit.max_iterations,
+         "Levenberg-Marquardt iterations of the parameter fit")
+      ->capture_default_str();
   cmd->add_option("--max-iterations", l.max_iterations, "corrections computed at most")
       ->capture_default_str();
   cmd->add_option("--patience", l.patience, "stop after this many iterations without improvement")

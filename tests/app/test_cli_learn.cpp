@@ -66,7 +66,19 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   EXPECT_TRUE(fs::exists(path("learned.json.checkpoint.json")));
   const auto file = elastolearn::io::read_material_file(path("learned.json"));
   ASSERT_NE(file.correction, nullptr) << "a correction beat the nominal model";
-  EXPECT_EQ(file.training.at("history").size(), 4u);
+  // Iterations 0–3 of the loop, then the recipe's three forward-fit steps.
+  EXPECT_EQ(file.training.at("history").size(), 4u + 3u);
+  // The recipe's record: the candidates' validation errors, and the chosen one the lowest.
+  const auto& recipe = file.training.at("recipe");
+  const auto& candidates = recipe.at("candidates");
+  ASSERT_GE(candidates.size(), 3u) << recipe.dump(); // nominal, fitted nominal, corrections
+  EXPECT_EQ(candidates.at(1).at("kind"), "fitted nominal");
+  const auto chosen = recipe.at("chosen").get<size_t>();
+  for (const auto& c : candidates)
+    if (c.at("completed").get<bool>())
+      EXPECT_LE(candidates.at(chosen).at("validation_rms_error_m").get<double>(),
+          c.at("validation_rms_error_m").get<double>());
+  EXPECT_NE(learned.output.find("<- chosen"), std::string::npos) << learned.output;
   ASSERT_TRUE(file.training_stretches.has_value())
       << "learn records the training motion's stretches";
   EXPECT_GT(file.training_stretches->max[0], 1.0) << "the droop stretches the bar";

@@ -64,12 +64,12 @@ void expect_resume_equals_whole(Fixture& f, int stop_after) {
   int saved = 0;
   learn::LearningCallbacks callbacks;
   callbacks.checkpoint = [&](const learn::LearningState& s) {
-    write_learning_checkpoint(f.file, f.inputs, s);
+    write_learning_checkpoint(f.file, f.inputs, { {}, s });
     ++saved;
   };
   callbacks.interrupted = [&] { return saved >= stop_after; };
   EXPECT_FALSE(learn::run_learning(f.nominal, f.observed, f.options, first, callbacks));
-  learn::LearningState resumed = read_learning_checkpoint(f.file, f.inputs);
+  learn::LearningState resumed = read_learning_checkpoint(f.file, f.inputs).loop;
   EXPECT_EQ(resumed.next_iteration, stop_after);
   ASSERT_TRUE(learn::run_learning(f.nominal, f.observed, f.options, resumed));
 
@@ -104,8 +104,17 @@ TEST(LearningCheckpoint, RefusesACheckpointOfOtherInputs) {
   state.divergences_in_a_row = 2;
   state.forward_fit_steps = 1;
   state.forward_fit_damping = 3.3e-3;
-  write_learning_checkpoint(f.file, f.inputs, state);
-  const learn::LearningState read = read_learning_checkpoint(f.file, f.inputs);
+  learn::ParameterFitReport fit;
+  fit.fitted = { 1.25e6, 0.41, 0.5, 0.02 };
+  fit.final_rms = 1.5e-4;
+  fit.stop = learn::FitStop::Converged;
+  write_learning_checkpoint(f.file, f.inputs, { fit, state });
+  const learn::RecipeResume resume = read_learning_checkpoint(f.file, f.inputs);
+  const learn::LearningState& read = resume.loop;
+  EXPECT_EQ(resume.parameter_fit.fitted.young, 1.25e6);
+  EXPECT_EQ(resume.parameter_fit.fitted.alpha1, 0.02);
+  EXPECT_EQ(resume.parameter_fit.final_rms, 1.5e-4);
+  EXPECT_EQ(resume.parameter_fit.stop, learn::FitStop::Converged);
   EXPECT_EQ(read.next_iteration, 3);
   EXPECT_EQ(read.divergences_in_a_row, 2);
   EXPECT_EQ(read.forward_fit_steps, 1);

@@ -2,6 +2,7 @@
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/learning_checkpoint.hpp>
 #include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/nominal_parameters.hpp>
 
 namespace elastolearn::io {
 
@@ -120,15 +121,68 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
             { "elastic_prior", o.forward_fit.elastic_prior } } } };
 }
 
+nlohmann::json recipe_options_to_json(const learn::RecipeOptions& o) {
+  nlohmann::json fitted = nlohmann::json::array();
+  for (auto p : o.parameter_fit.parameters)
+    fitted.push_back(learn::to_string(p));
+  return { { "noise", o.noise }, { "validation_fraction", o.validation_fraction },
+    { "fit_parameters", o.fit_parameters },
+    { "parameter_fit",
+        { { "parameters", fitted }, { "max_iterations", o.parameter_fit.max_iterations },
+            { "frames", o.parameter_fit.frames }, { "tolerance", o.parameter_fit.tolerance } } },
+    { "loop", learning_options_to_json(o.loop) } };
+}
+
+namespace {
+
+nlohmann::json parameter_fit_json(const learn::ParameterFitReport& f) {
+  return { { "initial", to_json(f.initial) }, { "fitted", to_json(f.fitted) },
+    { "initial_rms", f.initial_rms }, { "initial_max", f.initial_max },
+    { "final_rms", f.final_rms }, { "final_max", f.final_max }, { "iterations", f.iterations },
+    { "simulations", f.simulations }, { "diverged", f.diverged }, { "frames", f.frames },
+    { "seconds", f.seconds }, { "stop", learn::to_string(f.stop) }, { "message", f.message } };
+}
+
+learn::NominalParameters read_parameters(const JsonObject& o) {
+  return { o.number("young"), o.number("poisson"), o.number("alpha0"), o.number("alpha1") };
+}
+
+learn::ParameterFitReport read_parameter_fit(const JsonObject& o) {
+  learn::ParameterFitReport f;
+  f.initial = read_parameters(o.object("initial"));
+  f.fitted = read_parameters(o.object("fitted"));
+  f.initial_rms = o.number("initial_rms");
+  f.initial_max = o.number("initial_max");
+  f.final_rms = o.number("final_rms");
+  f.final_max = o.number("final_max");
+  f.iterations = o.integer("iterations");
+  f.simulations = o.integer("simulations");
+  f.diverged = o.integer("diverged");
+  f.frames = o.integer("frames");
+  f.seconds = o.number("seconds");
+  const std::string stop = o.string("stop");
+  for (auto s :
+      { learn::FitStop::Converged, learn::FitStop::MaxIterations, learn::FitStop::NoImprovingStep,
+          learn::FitStop::StartDiverged, learn::FitStop::Interrupted })
+    if (learn::to_string(s) == stop)
+      f.stop = s;
+  f.message = o.string("message");
+  return f;
+}
+
+} // namespace
+
 void write_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs,
-    const learn::LearningState& state) {
+    const learn::RecipeResume& resume) {
+  const learn::LearningState& state = resume.loop;
   nlohmann::json history = nlohmann::json::array();
   for (const auto& r : state.history)
     history.push_back(iteration_record_to_json(r));
-  const nlohmann::json j = { { "format", std::string(k_format) + "/1" },
+  const nlohmann::json j = { { "format", std::string(k_format) + "/2" },
     { "inputs",
         { { "scene", inputs.scene }, { "observations", inputs.observations },
             { "options", inputs.options } } },
+    { "parameter_fit", parameter_fit_json(resume.parameter_fit) },
     { "state",
         { { "next_iteration", state.next_iteration },
             { "correction", correction_json(state.correction) },
@@ -141,11 +195,11 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
   write_json_file(path, j);
 }
 
-learn::LearningState read_learning_checkpoint(
+learn::RecipeResume read_learning_checkpoint(
     const std::filesystem::path& path, const LearningInputs& inputs) {
   const nlohmann::json j = read_json_file(path);
   const JsonObject root(j, path.string());
-  check_format(root, k_format, 1);
+  check_format(root, k_format, 2);
   const JsonObject in = root.object("inputs");
   if (in.string("scene") != inputs.scene)
     in.fail("scene",
@@ -157,21 +211,23 @@ learn::LearningState read_learning_checkpoint(
   if (in.json().at("options") != inputs.options)
     in.fail("options",
         "the checkpoint was made with other learning options: resume with the same options");
+  learn::RecipeResume resume;
+  resume.parameter_fit = read_parameter_fit(root.object("parameter_fit"));
   const JsonObject s = root.object("state");
-  learn::LearningState state;
+  learn::LearningState& state = resume.loop;
   state.next_iteration = s.integer("next_iteration");
   state.correction = read_correction(s, "correction");
   state.best = read_correction(s, "best");
   state.best_error = s.number("best_error");
   state.best_iteration = s.integer("best_iteration");
   state.iterations_without_improvement = s.integer("iterations_without_improvement");
-  state.divergences_in_a_row = s.integer("divergences_in_a_row", 0); // absent in older checkpoints
+  state.divergences_in_a_row = s.integer("divergences_in_a_row");
   state.finished = s.boolean("finished", false);
-  state.forward_fit_steps = s.integer("forward_fit_steps", 0);
-  state.forward_fit_damping = s.number("forward_fit_damping", -1.0);
+  state.forward_fit_steps = s.integer("forward_fit_steps");
+  state.forward_fit_damping = s.number("forward_fit_damping");
   for (const auto& r : s.objects("history"))
     state.history.push_back(read_record(r));
-  return state;
+  return resume;
 }
 
 } // namespace elastolearn::io

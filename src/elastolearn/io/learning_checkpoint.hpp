@@ -1,9 +1,10 @@
 #pragma once
-/// \file Checkpoints of the learning loop (JSON, "format": "elastolearn-learning-checkpoint/1"):
-/// the complete learn::LearningState after an iteration — corrections written with every digit
-/// (correction_to_json), so a resumed run continues bit-for-bit — plus the inputs it belongs to,
-/// so that `learn --resume` refuses a checkpoint of another scene or observation file.
-#include <elastolearn/learn/learning_loop.hpp>
+/// \file Checkpoints of learning (JSON, "format": "elastolearn-learning-checkpoint/2"): the
+/// recipe's parameter fit and the complete learn::LearningState after an iteration — corrections
+/// written with every digit (correction_to_json), so a resumed run continues bit-for-bit — plus the
+/// inputs it belongs to, so that `learn --resume` refuses a checkpoint of another scene or
+/// observation file.
+#include <elastolearn/learn/learning_recipe.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -16,16 +17,16 @@ namespace elastolearn::io {
 struct LearningInputs {
   std::string scene; ///< scene file, as given
   std::string observations; ///< observation file, as given
-  nlohmann::json options; ///< the learning options (learning_options_to_json)
+  nlohmann::json options; ///< the options (recipe_options_to_json)
 };
 
 /// Write atomically. Throws InputError naming the path.
 void write_learning_checkpoint(const std::filesystem::path& path, const LearningInputs& inputs,
-    const learn::LearningState& state);
+    const learn::RecipeResume& resume);
 
 /// Read a checkpoint and check it against `inputs` (same scene and observation paths, same
 /// options). Throws InputError naming the file and the field that differs or is invalid.
-learn::LearningState read_learning_checkpoint(
+learn::RecipeResume read_learning_checkpoint(
     const std::filesystem::path& path, const LearningInputs& inputs);
 
 /// One iteration's record as JSON (also used in reports and in the learned material's
@@ -34,5 +35,7 @@ nlohmann::json iteration_record_to_json(const learn::IterationRecord& record);
 
 /// The options that determine the result, as JSON.
 nlohmann::json learning_options_to_json(const learn::LearningOptions& options);
+/// The recipe's options (its loop's with learning_options_to_json), as JSON.
+nlohmann::json recipe_options_to_json(const learn::RecipeOptions& options);
 
 } // namespace elastolearn::io

@@ -37,6 +37,9 @@ struct RecipeOptions {
   ParameterFitOptions parameter_fit;
   /// Stage 3 (the loop's forward_fit.max_iterations steps follow it).
   LearningOptions loop;
+  /// The recipe's defaults: a parameter fit of ≤ 10 Levenberg–Marquardt iterations and 3
+  /// forward-fit steps after the loop.
+  RecipeOptions();
   /// Throws InputError("learn.<field>", ...) for an out-of-range field.
   void validate() const;
 };
@@ -76,6 +79,7 @@ struct RecipeResult {
   std::vector<Candidate> candidates;
   int chosen = -1; ///< index into candidates
   double seconds = 0;
+  bool interrupted = false; ///< stopped at a checkpoint; nothing was chosen
   const Candidate& choice() const { return candidates.at(static_cast<size_t>(chosen)); }
   /// The chosen material: the fitted nominal (or the given one) with the chosen correction.
   fem::MaterialModel material(const fem::MaterialModel& given_nominal) const;
@@ -83,7 +87,15 @@ struct RecipeResult {
 
 struct RecipeCallbacks {
   std::function<void(const std::string&)> message; ///< one line per stage event
+  /// After stage 2 (a checkpoint stores it with the loop's state: RecipeResume).
+  std::function<void(const ParameterFitReport&)> parameters_fitted;
   LearningCallbacks loop; ///< the loop's (its checkpoint is the caller's business)
+};
+
+/// Where a resumed run continues: the stage-2 result and the loop's state, both from a checkpoint.
+struct RecipeResume {
+  ParameterFitReport parameter_fit;
+  LearningState loop;
 };
 
 /// The nominal parameters (E, ν, α₀, α₁) and model type of a scene's material; throws
@@ -92,9 +104,11 @@ struct RecipeCallbacks {
 NominalParameters nominal_parameters_of(
     const fem::MaterialModel& material, material::ElasticModelType& type);
 
-/// Run all stages. Throws InputError for invalid inputs (no motion, motions of different
-/// materials, an observation that does not fit its scene).
+/// Run all stages (from `resume` on, if given: stage 2 is then not repeated). Returns with
+/// `interrupted` set if callbacks.loop.interrupted asked to stop (the last checkpoint holds the
+/// state). Throws InputError for invalid inputs (no motion, an observation that does not fit its
+/// scene, a nominal material with a correction or without parameters to fit).
 RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions& options = {},
-    const RecipeCallbacks& callbacks = {});
+    const RecipeCallbacks& callbacks = {}, const RecipeResume* resume = nullptr);
 
 } // namespace elastolearn::learn

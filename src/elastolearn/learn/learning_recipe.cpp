@@ -1,0 +1,345 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/core/timing.hpp>
+#include <elastolearn/learn/learning_recipe.hpp>
+#include <elastolearn/material/corotated.hpp>
+#include <elastolearn/material/neohookean.hpp>
+#include <elastolearn/material/rayleigh_damping.hpp>
+#include <elastolearn/material/spline_edited.hpp>
+#include <elastolearn/material/stvk.hpp>
+#include <elastolearn/observe/observation_noise.hpp>
+#include <elastolearn/sim/forward_run.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace elastolearn::learn {
+
+std::string to_string(CandidateKind kind) {
+  switch (kind) {
+  case CandidateKind::Nominal:
+    return "nominal";
+  case CandidateKind::FittedNominal:
+    return "fitted nominal";
+  case CandidateKind::Loop:
+    return "loop";
+  case CandidateKind::ForwardFit:
+    return "forward fit";
+  }
+  return "?";
+}
+
+RecipeOptions::RecipeOptions() {
+  parameter_fit.max_iterations = 10;
+  loop.forward_fit.max_iterations = 3;
+}
+
+void RecipeOptions::validate() const {
+  if (!std::isfinite(noise))
+    throw InputError("learn.noise", "must be finite (< 0: estimate it)");
+  if (!(validation_fraction > 0 && validation_fraction < 0.5))
+    throw InputError("learn.validation_fraction", "must be in (0, 0.5)");
+  parameter_fit.validate();
+  loop.validate();
+}
+
+fem::MaterialModel RecipeResult::material(const fem::MaterialModel& given_nominal) const {
+  const Candidate& c = choice();
+  fem::MaterialModel m = c.kind == CandidateKind::Nominal ? given_nominal : fitted_nominal;
+  m.correction = c.correction;
+  return m;
+}
+
+NominalParameters nominal_parameters_of(
+    const fem::MaterialModel& material, material::ElasticModelType& type) {
+  using namespace material;
+  const ElasticModel* elastic = material.elastic.get();
+  const Lame* lame = nullptr;
+  if (const auto* m = dynamic_cast<const CorotatedModel*>(elastic)) {
+    type = ElasticModelType::Corotated;
+    lame = &m->lame();
+  } else if (const auto* s = dynamic_cast<const StVKModel*>(elastic)) {
+    type = ElasticModelType::StVK;
+    lame = &s->lame();
+  } else if (const auto* n = dynamic_cast<const NeoHookeanModel*>(elastic)) {
+    type = ElasticModelType::NeoHookean;
+    lame = &n->lame();
+  } else if (const auto* e = dynamic_cast<const SplineEditedModel*>(elastic)) {
+    type = ElasticModelType::SplineEdited;
+    lame = &e->lame();
+  } else {
+    throw InputError("material",
+        "the nominal elastic model has no Young's modulus and Poisson "
+        "ratio to fit");
+  }
+  NominalParameters p;
+  p.young = lame->mu * (3 * lame->lambda + 2 * lame->mu) / (lame->lambda + lame->mu);
+  p.poisson = lame->lambda / (2 * (lame->lambda + lame->mu));
+  if (material.damping) {
+    const auto* rayleigh = dynamic_cast<const RayleighDamping*>(material.damping.get());
+    if (!rayleigh)
+      throw InputError("material.damping",
+          "learning fits constant Rayleigh coefficients first; the nominal damping is "
+          "stretch-dependent");
+    const RayleighCoefficients c = rayleigh->coefficients(1.0);
+    p.alpha0 = c.alpha0;
+    p.alpha1 = c.alpha1;
+  }
+  return p;
+}
+
+namespace {
+
+/// How many of the loop's corrections are validated (those with the lowest training errors).
+constexpr size_t kLoopCandidates = 3;
+
+/// Frames [first, last] of an observation (first becomes frame 0).
+observe::Observation frame_range(const observe::Observation& o, int first, int last) {
+  observe::Observation out;
+  out.vertex_ids = o.vertex_ids;
+  out.dt = o.dt;
+  out.start_time = o.start_time + first * o.dt;
+  out.positions.assign(o.positions.begin() + first, o.positions.begin() + last + 1);
+  return out;
+}
+
+/// The training and validation data of stage 1.
+struct Split {
+  std::vector<Motion> training; ///< observations smoothed to the noise level
+  std::vector<Motion> raw_training; ///< the same with the observations as recorded
+  Motion validation; ///< scene simulated in full; observed = its frames compared
+  int first_validation_frame = 0; ///< frame of the validation scene's run that observed[0] is
+  std::string description;
+};
+
+/// `smoothed`: every motion's observation smoothed to the noise level, in order.
+Split split_motions(std::span<const Motion> motions, double validation_fraction,
+    std::vector<observe::Observation> smoothed) {
+  Split split;
+  if (motions.size() >= 2) {
+    for (size_t i = 0; i + 1 < motions.size(); ++i) {
+      split.raw_training.push_back(motions[i]);
+      Motion m = motions[i];
+      m.observed = std::move(smoothed[i]);
+      split.training.push_back(std::move(m));
+    }
+    split.validation = motions.back();
+    // Frame 0 is the initial state the scene prescribes, not a prediction.
+    split.validation.observed
+        = frame_range(motions.back().observed, 1, motions.back().observed.num_frames() - 1);
+    split.first_validation_frame = 1;
+    split.description = "motion " + motions.back().name;
+    return split;
+  }
+  const Motion& only = motions.front();
+  const int frames = only.scene.frames;
+  const int held_out = std::max(1, static_cast<int>(std::lround(validation_fraction * frames)));
+  const int train_frames = frames - held_out;
+  if (train_frames < 4)
+    throw InputError(only.name,
+        "too few frames (" + std::to_string(frames) + ") to hold out the last "
+            + std::to_string(held_out) + " for validation");
+  Motion raw = only;
+  raw.scene.frames = train_frames;
+  raw.observed = frame_range(only.observed, 0, train_frames);
+  Motion train = raw;
+  train.observed = frame_range(smoothed.front(), 0, train_frames);
+  split.raw_training.push_back(std::move(raw));
+  split.training.push_back(std::move(train));
+  split.validation = only;
+  split.validation.observed = frame_range(only.observed, train_frames + 1, frames);
+  split.first_validation_frame = train_frames + 1;
+  char text[160];
+  std::snprintf(text, sizeof text, "the last %d of %d frames (%.0f %%) of %s", held_out, frames,
+      100.0 * held_out / frames, only.name.c_str());
+  split.description = text;
+  return split;
+}
+
+/// The candidate's error on the held-out data (completed false if its simulation diverged).
+void validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
+  sim::Scene scene = split.validation.scene;
+  scene.material = nominal;
+  scene.material.correction = c.correction;
+  const sim::ForwardRun run = sim::simulate_positions(scene);
+  c.completed = run.completed;
+  if (!run.completed)
+    return;
+  const std::vector<VecX> compared(
+      run.positions.begin() + split.first_validation_frame, run.positions.end());
+  c.validation = observation_error(compared, split.validation.observed);
+}
+
+void say(const RecipeCallbacks& callbacks, const std::string& line) {
+  if (callbacks.message)
+    callbacks.message(line);
+}
+
+std::string format(const char* pattern, double a, double b = 0, double c = 0, double d = 0) {
+  char text[256];
+  std::snprintf(text, sizeof text, pattern, a, b, c, d);
+  return text;
+}
+
+} // namespace
+
+RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions& options,
+    const RecipeCallbacks& callbacks, const RecipeResume* resume) {
+  const auto start = Clock::now();
+  options.validate();
+  if (motions.empty())
+    throw InputError("training set", "no motion to learn from");
+  for (const Motion& m : motions) {
+    m.scene.validate();
+    if (m.scene.material.correction)
+      throw InputError(m.name, "the nominal material must not carry a correction already");
+    m.observed.validate(m.scene.mesh.num_vertices(), m.scene.frames + 1, m.scene.dt, m.name);
+  }
+  RecipeResult result;
+  const fem::MaterialModel& given = motions.front().scene.material;
+  const NominalParameters given_parameters = nominal_parameters_of(given, result.nominal_type);
+  const double size = motions.front().scene.mesh.bounding_box_diagonal();
+
+  // Stage 0: the noise and the smoothed positions the loop follows.
+  if (options.noise >= 0) {
+    result.noise.sigma = options.noise;
+    result.noise.estimated = false;
+  } else {
+    double sum = 0;
+    long weight = 0;
+    for (const Motion& m : motions) {
+      const double s = observe::estimate_noise(m.observed);
+      const long n = static_cast<long>(m.observed.num_frames()) * m.observed.num_observed();
+      sum += s * s * static_cast<double>(n);
+      weight += n;
+    }
+    result.noise.sigma = weight > 0 ? std::sqrt(sum / static_cast<double>(weight)) : 0;
+  }
+  std::vector<observe::Observation> smoothed;
+  double change = 0;
+  for (const Motion& m : motions) {
+    auto s = observe::smooth_to_noise(m.observed, result.noise.sigma);
+    change = std::max(change, s.rms_change);
+    smoothed.push_back(std::move(s.smoothed));
+  }
+  result.noise.smoothing_residual = change;
+  say(callbacks,
+      format("noise: σ = %.3g m (%.3f %% of the size, ", result.noise.sigma,
+          100 * result.noise.sigma / size)
+          + (result.noise.estimated ? "estimated" : "given") + "); positions smoothed in time by "
+          + format("%.3g m RMS", change));
+
+  // Stage 1: training and validation data.
+  const Split split = split_motions(motions, options.validation_fraction, std::move(smoothed));
+  result.training_frames = split.training.front().scene.frames;
+  result.validation_frames = split.validation.observed.num_frames();
+  result.validation_data = split.description;
+  say(callbacks, "validation: " + split.description);
+
+  // Stage 2: the nominal model's parameters.
+  const Motion& train = split.raw_training.front();
+  if (resume) {
+    result.parameter_fit = resume->parameter_fit;
+    result.loop = resume->loop;
+  } else if (options.fit_parameters) {
+    result.parameter_fit = fit_parameters(train.scene, result.nominal_type, given_parameters,
+        train.observed, options.parameter_fit, {});
+    const auto& f = result.parameter_fit;
+    say(callbacks,
+        format("parameter fit: E %.4g Pa, ν %.3f, α₀ %.3g 1/s, ", f.fitted.young, f.fitted.poisson,
+            f.fitted.alpha0)
+            + format("α₁ %.3g s; training error rms %.4f %% -> %.4f %% (%.1f s)", f.fitted.alpha1,
+                100 * f.initial_rms / size, 100 * f.final_rms / size, f.seconds));
+  } else {
+    result.parameter_fit.initial = result.parameter_fit.fitted = given_parameters;
+  }
+  if (!resume && callbacks.parameters_fitted)
+    callbacks.parameters_fitted(result.parameter_fit);
+  result.fitted_nominal
+      = scene_with_parameters(train.scene, result.nominal_type, result.parameter_fit.fitted)
+            .material;
+
+  // Stage 3: the loop (and its forward fit) on the fitted nominal, following smoothed positions.
+  sim::Scene loop_scene = split.training.front().scene;
+  loop_scene.material = result.fitted_nominal;
+  std::map<int, std::shared_ptr<const material::RbfCorrection>> tried; // C_k per iteration
+  std::shared_ptr<const material::RbfCorrection> current = result.loop.correction; // next C_k
+  LearningCallbacks loop_callbacks = callbacks.loop;
+  loop_callbacks.checkpoint = [&](const LearningState& s) {
+    const IterationRecord& r = s.history.back();
+    if (r.forward_fit) {
+      if (r.forward_fit_accepted)
+        tried[r.iteration] = s.correction;
+    } else {
+      if (r.forward_completed && current)
+        tried[r.iteration] = current;
+      current = s.correction;
+    }
+    if (callbacks.loop.checkpoint)
+      callbacks.loop.checkpoint(s);
+  };
+  if (!run_learning(
+          loop_scene, split.training.front().observed, options.loop, result.loop, loop_callbacks)) {
+    result.interrupted = true;
+    return result;
+  }
+
+  // Stage 4: every candidate on the held-out data.
+  auto add = [&](CandidateKind kind, int iteration,
+                 std::shared_ptr<const material::RbfCorrection> correction, double training) {
+    Candidate c;
+    c.kind = kind;
+    c.iteration = iteration;
+    c.correction = std::move(correction);
+    c.training.rms = training;
+    validate_candidate(c, split, kind == CandidateKind::Nominal ? given : result.fitted_nominal);
+    say(callbacks,
+        "candidate " + to_string(kind) + (iteration >= 0 ? " " + std::to_string(iteration) : "")
+            + (c.completed ? format(": validation error rms %.4f %%, max %.4f %%",
+                   100 * c.validation.rms / size, 100 * c.validation.max / size)
+                           : ": its simulation of the held-out data diverged"));
+    result.candidates.push_back(std::move(c));
+  };
+  add(CandidateKind::Nominal, -1, nullptr, result.parameter_fit.initial_rms);
+  if (options.fit_parameters)
+    add(CandidateKind::FittedNominal, -1, nullptr, result.parameter_fit.final_rms);
+  // The loop's corrections with the lowest training errors, and the forward fit's last
+  // accepted step: each validation costs a simulation of the held-out data.
+  std::vector<const IterationRecord*> loop_records;
+  const IterationRecord* forward_fit = nullptr;
+  for (const auto& r : result.loop.history) {
+    const auto it = tried.find(r.iteration);
+    if (it == tried.end() || !it->second || !r.forward_completed)
+      continue;
+    if (r.forward_fit)
+      forward_fit = &r;
+    else
+      loop_records.push_back(&r);
+  }
+  std::sort(loop_records.begin(), loop_records.end(),
+      [](const IterationRecord* a, const IterationRecord* b) {
+        return a->forward_error.rms < b->forward_error.rms;
+      });
+  loop_records.resize(std::min(loop_records.size(), kLoopCandidates));
+  if (forward_fit)
+    loop_records.push_back(forward_fit);
+  for (const IterationRecord* r : loop_records)
+    add(r->forward_fit ? CandidateKind::ForwardFit : CandidateKind::Loop, r->iteration,
+        tried.at(r->iteration), r->forward_error.rms);
+  // A resumed run knows the earlier iterations only through the best one.
+  if (result.loop.best && tried.find(result.loop.best_iteration) == tried.end())
+    add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best, result.loop.best_error);
+  for (size_t i = 0; i < result.candidates.size(); ++i) {
+    const Candidate& c = result.candidates[i];
+    if (c.completed && (result.chosen < 0 || c.validation.rms < result.choice().validation.rms))
+      result.chosen = static_cast<int>(i);
+  }
+  if (result.chosen < 0)
+    throw InputError(split.validation.name,
+        "no candidate, not even the nominal material, simulates the held-out data");
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+} // namespace elastolearn::learn
