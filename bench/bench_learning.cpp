@@ -433,11 +433,14 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
   if (result.choice().iteration >= 0)
     row.chosen += " " + std::to_string(result.choice().iteration);
   const auto& p = result.parameter_fit.fitted;
-  std::printf("   learned in %.1f s (parameter fit %.1f s: E %.4g, ν %.3f, α₀ %.3g, α₁ %.3g); "
-              "chosen: %s; divergences in learning: %d in the fit, %d in the loop, %d in "
-              "validation\n",
+  std::printf("   learned in %.1f s (parameter fit %.1f s: E %.4g, ν %.3f, α₀ %.3g, α₁ %.3g, "
+              "observation rms %.3f %% -> %.3f %% of the diagonal, %s); chosen: %s; divergences "
+              "in learning: %d in the fit, %d in the loop, %d in validation\n",
       row.learn_seconds, row.fit_seconds, p.young, p.poisson, p.alpha0, p.alpha1,
-      row.chosen.c_str(), row.fit_diverged, row.loop_diverged, row.validation_diverged);
+      100 * result.parameter_fit.initial_rms / o.diagonal,
+      100 * result.parameter_fit.final_rms / o.diagonal,
+      learn::to_string(result.parameter_fit.stop).c_str(), row.chosen.c_str(), row.fit_diverged,
+      row.loop_diverged, row.validation_diverged);
   std::fflush(stdout);
 
   t0 = Clock::now();

@@ -228,7 +228,7 @@ inline RandomObject draw_random_object(std::uint64_t seed, int index, const fs::
 
   // Materials. The nominal's E puts its static droop under gravity at `droop` of the diagonal;
   // the truth's stiffness is the nominal's times a ratio in [0.5, 2].
-  const double droop_target = d.log_uniform(0.005, 0.03);
+  const double droop_target = d.log_uniform(0.01, 0.03);
   const double ratio = d.log_uniform(0.5, 2);
   const double nu_truth = d.uniform(0.3, 0.45), nu_nominal = d.uniform(0.3, 0.45);
   o.nominal_parameters.poisson = nu_nominal;
@@ -385,7 +385,7 @@ inline RandomMotions draw_random_motions(const RandomObject& o, int attempt) {
 
   RandomMotions m;
   const auto train_kind = static_cast<RandomMotion>(d.index(4));
-  const double a_train = scale * d.log_uniform(0.015, 0.04);
+  const double a_train = scale * d.log_uniform(0.02, 0.05);
   const double growth = d.uniform(1.3, 2);
   // The test: the training's kind (unless a droop) or another, never a droop (gravity acts in
   // every motion: a droop test would be the smallest motion of all).
