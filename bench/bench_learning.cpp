@@ -421,7 +421,8 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
     std::fflush(stdout);
   };
   t0 = Clock::now();
-  const auto result = learn::learn_material(std::span<const learn::Motion>(&motion, 1));
+  const auto result
+      = learn::learn_material(std::span<const learn::Motion>(&motion, 1), {}, callbacks);
   row.learn_seconds = seconds_since(t0);
   row.fit_seconds = result.parameter_fit.seconds;
   row.fit_diverged = result.parameter_fit.diverged;

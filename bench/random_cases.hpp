@@ -114,6 +114,7 @@ struct RandomObject {
   std::vector<int> fixed; ///< held at rest
   std::vector<int> cap; ///< keyframed or loaded by the motions (the free end / the top)
   Vec3 swing_center = Vec3::Zero(); ///< the base, where swings turn about
+  Vec3 out = Vec3::UnitY(); ///< from the base outwards (swings turn about an axis ⊥ to it)
   fem::MaterialModel truth, nominal;
   learn::NominalParameters nominal_parameters;
   bool truth_in_family = false; ///< corotated truth with constant Rayleigh damping
@@ -200,6 +201,7 @@ inline RandomObject draw_random_object(std::uint64_t seed, int index, const fs::
     o.fixed = mesh::vertices_with_min_coordinate(o.mesh, 0, 1e-9);
     o.cap = mesh::vertices_with_max_coordinate(o.mesh, 0, 1e-9);
     o.swing_center = Vec3(0, dims.y() / 2, dims.z() / 2);
+    o.out = Vec3::UnitX();
     o.shape_label = format("box bar %.3g×%.3g×%.3g m", dims.x(), dims.y(), dims.z()) + " ("
         + std::to_string(cells[0]) + "×" + std::to_string(cells[1]) + "×" + std::to_string(cells[2])
         + " cells)" + " clamped at x = 0, free end = the cap";
@@ -329,10 +331,11 @@ inline RandomObject draw_random_object(std::uint64_t seed, int index, const fs::
 /// Training and test motions of `o`, attempt `attempt` (0, 1, ...): each attempt draws from its
 /// own stream and scales the amplitudes by 0.7^attempt, so a redraw is both different and
 /// gentler. Amplitudes are fractions a of the diagonal D: a swing's initial angular velocity
-/// moves the fastest vertex at a·D·ω; a keyframed cap moves a·D at 0.3–0.8 ω; a released cap
-/// load is 3/8 · weight · a·D / droop (a tip load deflecting a cantilever as far as its weight
-/// would at 8/3 of it). The test motion is 1.3–2× the training's amplitude, of the same kind or
-/// another; gravity acts in every motion, so a droop is never the larger test of itself.
+/// (about an axis across the object) moves the fastest vertex at a·D·ω; a keyframed cap moves a·D
+/// at 0.3–0.8 ω; a released cap load is 3/8 · weight · a·D / droop (a tip load deflecting a
+/// cantilever as far as its weight would at 8/3 of it). The test motion is 1.3–2× the training's
+/// amplitude, of the same kind or another; gravity acts in every motion, so a droop is never the
+/// larger test of itself.
 inline RandomMotions draw_random_motions(const RandomObject& o, int attempt) {
   using detail::format;
   Draw d(o.seed, o.index, 1 + attempt);
@@ -348,7 +351,9 @@ inline RandomMotions draw_random_motions(const RandomObject& o, int attempt) {
       label = "droop from rest under gravity";
       break;
     case RandomMotion::Swing: {
-      const Vec3 axis = d.direction();
+      // About an axis across the object (a bending swing, not a twist about its own axis).
+      Vec3 axis = d.direction();
+      axis = (axis - axis.dot(o.out) * o.out).normalized();
       double fastest = 0; // at unit angular velocity
       const auto& rest = o.mesh.rest_positions();
       for (Eigen::Index v = 0; v < rest.rows(); ++v)
