@@ -450,9 +450,10 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
       = err_l(learn::scene_with_parameters(motions.test, result.nominal_type, p), truth_test);
   row.err_learned = err_l(with_material(motions.test, result.material(o.nominal)), truth_test);
   row.test_diverged = (row.err_fit < 0 ? 1 : 0) + (row.err_learned < 0 ? 1 : 0);
-  std::printf("   test err_L: nominal %s %%, parameter fit %s %%, learned %s %% (%.1f s)\n",
-      err(row.err_nominal).c_str(), err(row.err_fit).c_str(), err(row.err_learned).c_str(),
-      seconds_since(t0));
+  auto percent = [](double e) { return e < 0 ? err(e) : err(e) + " %"; };
+  std::printf("   test err_L: nominal %s, parameter fit %s, learned %s (%.1f s)\n",
+      percent(row.err_nominal).c_str(), percent(row.err_fit).c_str(),
+      percent(row.err_learned).c_str(), seconds_since(t0));
   std::fflush(stdout);
   return row;
 }
