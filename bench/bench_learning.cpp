@@ -334,8 +334,11 @@ struct RandomRow {
 };
 
 /// The truth's motions must complete and keep every element far from inversion (sorted
-/// stretches within [0.5, 2]); otherwise the motions are redrawn (gentler), at most this often.
-constexpr int kMotionAttempts = 4;
+/// stretches within [0.5, 2]), and the training motion must tell the nominal from the truth
+/// (their RMS vertex distance over the training ≥ kInformative); otherwise the motions are
+/// redrawn, at most kMotionAttempts times (× 0.7 in amplitude after a failure of the truth).
+constexpr int kMotionAttempts = 6;
+constexpr double kInformative = 0.25; ///< [% of the rest bounding-box diagonal]
 
 /// Print case `index` of `seed`; with `run`, simulate its truth, learn with the recipe (default
 /// options), and measure nominal / fitted / learned on the test motion.
@@ -362,11 +365,12 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
 
   RandomMotions motions;
   std::vector<VecX> truth_train, truth_test;
+  double scale = 1;
   for (int attempt = 0;; ++attempt) {
     if (attempt == kMotionAttempts)
       throw InputError("random case " + std::to_string(index),
-          "the truth failed every drawn motion (" + std::to_string(kMotionAttempts) + " attempts)");
-    motions = draw_random_motions(o, attempt);
+          "no drawn motion passed (" + std::to_string(kMotionAttempts) + " attempts)");
+    motions = draw_random_motions(o, attempt, scale);
     std::printf("   motions (attempt %d): train: %s\n                        test: %s\n", attempt,
         motions.train_label.c_str(), motions.test_label.c_str());
     std::fflush(stdout);
@@ -380,15 +384,31 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
       const char* which = scene == &motions.train ? "training" : "test";
       if (!result.completed) {
         problem = std::string("the truth's ") + which + " simulation failed: " + result.message;
+        scale *= 0.7;
         break;
       }
       const auto range = learn::trajectory_stretch_range(o.mesh, result.positions);
       if (range.min.minCoeff() < 0.5 || range.max.maxCoeff() > 2) {
         problem = std::string("the truth's ") + which
             + " motion nearly inverts elements: " + learn::describe(range);
+        scale *= 0.7;
         break;
       }
       (scene == &motions.train ? truth_train : truth_test) = std::move(result.positions);
+    }
+    if (problem.empty()) {
+      // A training motion the nominal already follows (e.g. a keyframed cap that prescribes the
+      // shape) holds nothing to learn: no recipe can beat the fit there.
+      const auto nominal = sim::simulate_positions(motions.train);
+      const double floor = kInformative;
+      if (!nominal.completed)
+        problem = "the nominal's training simulation failed: " + nominal.message;
+      else if (const double rms = learn::as_percent_of(
+                   learn::position_error(nominal.positions, truth_train), o.diagonal)
+                                      .rms;
+               rms < floor)
+        problem = "the training motion cannot tell the nominal from the truth (RMS distance "
+            + err(rms) + " % < " + err(floor) + " % of the diagonal)";
     }
     if (problem.empty())
       break;

@@ -331,17 +331,16 @@ inline RandomObject draw_random_object(std::uint64_t seed, int index, const fs::
 }
 
 /// Training and test motions of `o`, attempt `attempt` (0, 1, ...): each attempt draws from its
-/// own stream and scales the amplitudes by 0.7^attempt, so a redraw is both different and
-/// gentler. Amplitudes are fractions a of the diagonal D: a swing's initial angular velocity
-/// (about an axis across the object) moves the fastest vertex at a·D·ω; a keyframed cap moves a·D
-/// at 0.5–1.5 ω; a released cap load is 3/8 · weight · a·D / droop (a tip load deflecting a
-/// cantilever as far as its weight would at 8/3 of it). The test motion is 1.3–2× the training's
+/// own stream, with the amplitudes times `scale` (the caller makes a redraw gentler after the
+/// truth failed a motion). Amplitudes are fractions a of the diagonal D: a swing's initial angular
+/// velocity (about an axis across the object) moves the fastest vertex at a·D·ω; a keyframed cap
+/// moves a·D at 0.5–1.5 ω; a released cap load is 3/8 · weight · a·D / droop (a tip load deflecting
+/// a cantilever as far as its weight would at 8/3 of it). The test motion is 1.3–2× the training's
 /// amplitude, of the same kind or another; gravity acts in every motion, so a droop is never the
 /// larger test of itself.
-inline RandomMotions draw_random_motions(const RandomObject& o, int attempt) {
+inline RandomMotions draw_random_motions(const RandomObject& o, int attempt, double scale = 1) {
   using detail::format;
   Draw d(o.seed, o.index, 1 + attempt);
-  const double scale = std::pow(0.7, attempt);
   sim::Scene base = base_scene(o.mesh, o.nominal, o.dt, o.frames);
   base.fixed_vertices = o.fixed;
 
