@@ -352,6 +352,8 @@ void add_learn_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")
       ->capture_default_str();
+  cmd->add_flag("!--stress-kernels", l.rbf.energy_kernels,
+      "RBF kernels of the principal stress (paper Eq. 10) instead of an energy's (default)");
   cmd->add_flag("--neo-hookean-tail", l.rbf.neo_hookean_tail,
       "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");
   cmd->add_flag("--damping-quadratic-tail", l.rbf.damping_quadratic_tail,

@@ -33,6 +33,8 @@ std::string to_string(CandidateKind kind) {
 RecipeOptions::RecipeOptions() {
   parameter_fit.max_iterations = 10;
   loop.forward_fit.max_iterations = 3;
+  loop.rbf.energy_kernels = true;
+  loop.rbf.epsilon = 0.03;
 }
 
 void RecipeOptions::validate() const {
