@@ -5,6 +5,7 @@
 
 #include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/core/interrupt.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/io/learning_checkpoint.hpp>
@@ -83,14 +84,18 @@ void print_iteration(const elastolearn::learn::IterationRecord& r, double diagon
           100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal, "-", "-",
           r.centres, r.seconds_total(),
           r.forward_fit_accepted ? "step accepted" : "step rejected, μ × 10");
+    else if (r.forward_unstable)
+      std::printf("%4d  forward fit: trial step rejected, μ × 10 (%s)\n", r.iteration,
+          r.forward_message.c_str());
     else
-      std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10)\n",
-          r.iteration);
+      std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10): %s\n",
+          r.iteration, r.forward_message.c_str());
   } else if (!r.forward_completed) {
     std::printf(r.damped_update
-            ? "%4d  forward simulation diverged: trying half of this correction's step\n"
-            : "%4d  forward simulation diverged: stopping (the best correction so far is kept)\n",
-        r.iteration);
+            ? "%4d  forward simulation diverged (%s): trying half of this correction's step\n"
+            : "%4d  forward simulation diverged (%s): stopping (the best correction so far is "
+              "kept)\n",
+        r.iteration, r.forward_message.c_str());
   } else {
     std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, "
                 "space-time %.1f [%d it], reconstruction %.1f)\n",
@@ -98,6 +103,12 @@ void print_iteration(const elastolearn::learn::IterationRecord& r, double diagon
         r.control_force_rms, r.modes, r.centres, r.seconds_total(), r.seconds_forward,
         r.seconds_constrained, r.seconds_space_time, r.space_time_iterations,
         r.seconds_reconstruction);
+    if (r.step_kept < 1)
+      std::printf("      the reconstructed correction is unstable within the training stretches "
+                  "(smallest tangent eigenvalue %.2f × the nominal's): %s\n",
+          r.stability,
+          r.step_kept > 0 ? ("kept " + elastolearn::to_text(r.step_kept) + " of its step").c_str()
+                          : "kept the best correction instead");
   }
   std::fflush(stdout);
 }

@@ -1,6 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
 #include <elastolearn/learn/levenberg_marquardt.hpp>
+#include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/trajectory_physics.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 #include <elastolearn/sim/simulator.hpp>
@@ -209,6 +210,20 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
   };
   problem.evaluate = [&](const VecX& step) {
     trial_unknowns = result.unknowns + step;
+    if (options.stability_stretches.rows() > 0) {
+      const material::RbfCorrection c = design.correction(trial_unknowns);
+      const StabilityReport stability
+          = material_stability(*scene.material.elastic, &c, options.stability_stretches);
+      if (!stability.stable()) {
+        trial = {};
+        trial.unstable = true;
+        trial.message = "not simulated: the trial's material is unstable at "
+            + std::to_string(stability.unstable_samples) + " of "
+            + std::to_string(stability.samples) + " stretch samples";
+        result.rms_history.push_back(-1.0);
+        return TrialEvaluation { .completed = false };
+      }
+    }
     trial = simulate_with_sensitivities(
         scene, observed, mesh, design, trial_unknowns, options.sensitivities, progress);
     result.rms_history.push_back(trial.completed ? trial.error.rms : -1.0);

@@ -27,6 +27,8 @@ namespace elastolearn::learn {
 /// the Gauss–Newton normal equations of E at its unknowns.
 struct ForwardSensitivityPass {
   bool completed = false;
+  /// Not simulated: the correction is unstable at ForwardFitOptions::stability_stretches.
+  bool unstable = false;
   std::string message; ///< why the simulation stopped, if it did
   ErrorSummary error; ///< at the observed vertices, all frames [m]
   double squared_error = 0; ///< E [m²]
@@ -72,6 +74,10 @@ struct ForwardFitOptions {
   /// stiffness damping from an elastic softening, and a free fit may split the two wrongly
   /// (docs/learning.md, "Forward fit"). 0 turns the prior off.
   double elastic_prior = 0;
+  /// Principal stretches (N × 3) where every trial's material must be stable
+  /// (material_stability.hpp); a trial that is not is rejected without being simulated (its
+  /// simulation would diverge or stall). Empty: no check.
+  MatX stability_stretches;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;
 };

@@ -1,9 +1,11 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -128,6 +130,47 @@ MatX rbf_centres(const ReconstructionMesh& mesh, const std::vector<VecX>& positi
   return kmeans(stretches, kmeans_options).centres;
 }
 
+/// Where a correction must be stable: the trajectory's stretches σ and the same strains
+/// amplified, 1 + a (σ − 1) for a = 1.5, 2 (a forward simulation with a softening correction
+/// strains more than the trajectory it was fitted to, and there the correction's tails
+/// extrapolate), at most `max_rows` rows in all (every k-th sample).
+MatX stability_samples(const MatX& stretches, Eigen::Index max_rows) {
+  constexpr std::array<double, 3> amplification { 1.0, 1.5, 2.0 };
+  const Eigen::Index step = std::max<Eigen::Index>(
+      1, (3 * stretches.rows() + max_rows - 1) / std::max<Eigen::Index>(max_rows, 1));
+  const Eigen::Index kept = (stretches.rows() + step - 1) / step;
+  MatX out(3 * kept, 3);
+  Eigen::Index row = 0;
+  for (const double a : amplification)
+    for (Eigen::Index i = 0; i < stretches.rows(); i += step)
+      out.row(row++) = (stretches.row(i).array() - 1.0) * a + 1.0;
+  return out;
+}
+
+/// The new correction, or the largest fraction ½ᵏ (k ≤ 4) of its step from the best one whose
+/// material is stable at every stability sample (material_stability); the best one itself if
+/// none is. A reconstruction from noisy or sparse data can produce a correction that removes
+/// more stiffness than the nominal has somewhere; its simulations then diverge, which no later
+/// halving of the step repairs as cheaply as this check.
+std::shared_ptr<const material::RbfCorrection> stable_step(const material::RbfCorrection& fitted,
+    const material::RbfCorrection* best, const fem::MaterialModel& nominal, const MatX& stretches,
+    IterationRecord& record) {
+  double kept = 1;
+  for (int k = 0; k <= 4; ++k, kept *= 0.5) {
+    auto step = std::make_shared<material::RbfCorrection>(
+        k == 0 ? fitted : material::blend(fitted, best, 1 - kept));
+    const StabilityReport stability = material_stability(*nominal.elastic, step.get(), stretches);
+    if (k == 0)
+      record.stability = stability.min_relative_eigenvalue;
+    if (stability.stable()) {
+      record.step_kept = kept;
+      return step;
+    }
+  }
+  record.step_kept = 0;
+  return best ? std::make_shared<material::RbfCorrection>(*best) : nullptr;
+}
+
 /// The stage after the loop: Levenberg–Marquardt on the forward error from the best correction
 /// (LearningOptions::forward_fit). Each step is one IterationRecord and one checkpoint; a resumed
 /// run restarts from the best correction with the saved μ, so it takes the same steps.
@@ -140,14 +183,11 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
   if (callbacks.interrupted && callbacks.interrupted())
     return false;
   // Centres: the best correction's, or (nothing learned) k-means over the nominal motion's
-  // stretches.
-  MatX centres;
-  if (state.best) {
-    centres = state.best->parameters().centres;
-  } else {
-    centres = rbf_centres(
-        mesh, sim::simulate_positions(scene, callbacks.progress).positions, options, options.seed);
-  }
+  // stretches. Trials must be stable where the best correction's motion goes (and beyond).
+  const sim::ForwardRun best_run
+      = sim::simulate_positions(sim::with_correction(scene, state.best), callbacks.progress);
+  const MatX centres = state.best ? MatX(state.best->parameters().centres)
+                                  : rbf_centres(mesh, best_run.positions, options, options.seed);
   const RbfDesign design(centres, options.rbf);
   const VecX start
       = state.best ? design.unknowns(*state.best) : VecX(VecX::Zero(design.num_unknowns()));
@@ -155,6 +195,9 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
   fit_options.max_iterations = remaining;
   if (state.forward_fit_damping > 0)
     fit_options.damping = state.forward_fit_damping;
+  if (best_run.completed)
+    fit_options.stability_stretches = stability_samples(
+        collect_stretches(mesh, best_run.positions, options.stretch_samples), 30000);
   bool stopped = false;
   fit_to_observations(scene, observed, mesh, design, start, fit_options, callbacks.progress,
       [&](const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping) {
@@ -163,6 +206,8 @@ bool run_forward_fit(const sim::Scene& scene, const observe::Observation& observ
         record.forward_fit = true;
         record.forward_fit_accepted = accepted;
         record.forward_completed = trial.completed;
+        record.forward_message = trial.message;
+        record.forward_unstable = trial.unstable;
         if (trial.completed)
           record.forward_error = trial.error;
         record.centres = design.num_centres();
@@ -229,6 +274,7 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
     const sim::ForwardRun forward = sim::simulate_positions(current, callbacks.progress);
     record.seconds_forward = seconds_since(t0);
     record.forward_completed = forward.completed;
+    record.forward_message = forward.message;
     if (!forward.completed && record.iteration == 0)
       throw InputError(
           "scene", "the nominal model's forward simulation failed: " + forward.message);
@@ -333,8 +379,12 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       record.centres = design.num_centres();
       record.correction_misfit = reconstructed.misfit.rms_residual;
       record.correction_target = reconstructed.misfit.rms_target;
+      next.correction = stable_step(reconstructed.correction, next.best.get(), scene.material,
+          stability_samples(
+              collect_stretches(reconstruction_mesh, optimized.positions, options.stretch_samples),
+              30000),
+          record);
       record.seconds_reconstruction = seconds_since(t0);
-      next.correction = std::make_shared<material::RbfCorrection>(reconstructed.correction);
     }
     next.next_iteration = record.iteration + 1;
     next.history.push_back(record);

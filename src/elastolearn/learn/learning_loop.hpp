@@ -88,6 +88,10 @@ struct IterationRecord {
   int iteration = 0; ///< k (0: the nominal model)
   ErrorSummary forward_error; ///< of C_k's forward simulation at the observed vertices [m]
   bool forward_completed = true; ///< false if C_k's forward simulation diverged
+  std::string forward_message; ///< why it diverged (names the frame); empty when it completed
+  /// A forward-fit trial rejected unsimulated: its material is unstable (forward_completed is
+  /// false, but nothing diverged).
+  bool forward_unstable = false;
   /// C_k diverged and C_{k+1} = ½ (C_k + best) was tried instead (a damped update).
   bool damped_update = false;
   /// A step of the forward fit after the loop (no trajectory stages): C_k is the trial, and
@@ -101,6 +105,11 @@ struct IterationRecord {
   int modes = 0;
   int centres = 0;
   double correction_misfit = 0; ///< RMS force misfit of C_{k+1} against its targets [N]
+  /// The reconstructed correction's material_stability over its trajectory's stretches
+  /// (min_relative_eigenvalue: < 0 where it is unstable).
+  double stability = 0;
+  /// The fraction of the reconstructed step from the best correction kept to stay stable (1: all).
+  double step_kept = 1;
   double correction_target = 0; ///< RMS of those targets [N]
   double seconds_forward = 0, seconds_pod = 0, seconds_constrained = 0, seconds_space_time = 0,
          seconds_reconstruction = 0;

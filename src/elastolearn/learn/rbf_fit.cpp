@@ -254,7 +254,7 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   const double prestress = p.constant + p.weights.dot(m_rest_kernels);
   if (m_constant < 0
       && std::abs(prestress)
-          > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels) + 1))
+          > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels.cwiseAbs()) + 1))
     fail("correction", "it is not stress-free at rest (N(1) = " + to_text(prestress) + " Pa)");
   if (m_damping > 0) {
     if (p.damping_weights.size() == m)
