@@ -60,7 +60,8 @@ double test_error(const fem::MaterialModel& material, const sim::Scene& truth_sw
   if (!run.completed)
     return -1;
   const auto truth = sim::simulate_positions(truth_swing);
-  return as_percent_of(position_error(run.positions, truth.positions), s.mesh.bounding_box_diagonal())
+  return as_percent_of(
+      position_error(run.positions, truth.positions), s.mesh.bounding_box_diagonal())
       .max;
 }
 
