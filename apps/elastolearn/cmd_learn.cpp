@@ -107,8 +107,8 @@ void print_iteration(const elastolearn::learn::IterationRecord& r, double diagon
       std::printf("      the reconstructed correction is unstable within the training stretches "
                   "(smallest tangent eigenvalue %.2f × the nominal's): %s\n",
           r.stability,
-          r.step_kept > 0 ? ("kept " + elastolearn::to_text(r.step_kept) + " of its step").c_str()
-                          : "kept the best correction instead");
+          r.step_kept > 0 ? ("kept " + elastolearn::to_text(r.step_kept) + " of it").c_str()
+                          : "dropped it (the next iteration simulates the nominal)");
   }
   std::fflush(stdout);
 }

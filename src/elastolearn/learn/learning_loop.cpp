@@ -130,45 +130,51 @@ MatX rbf_centres(const ReconstructionMesh& mesh, const std::vector<VecX>& positi
   return kmeans(stretches, kmeans_options).centres;
 }
 
-/// Where a correction must be stable: the trajectory's stretches σ and the same strains
-/// amplified, 1 + a (σ − 1) for a = 1.5, 2 (a forward simulation with a softening correction
+/// Where a correction must be stable: the trajectory's stretches σ and the same deformations
+/// amplified in log-stretch, σᵃ for a = 1.25 (a forward simulation with a softening correction
 /// strains more than the trajectory it was fitted to, and there the correction's tails
-/// extrapolate), at most `max_rows` rows in all (every k-th sample).
+/// extrapolate). Log-stretches keep J = 1 states at J = 1: amplifying σ − 1 instead would turn a
+/// nearly incompressible motion into large volume changes, where even the truth may be unstable.
+/// Inverted samples (σ₃ ≤ 0) are kept as they are. At most `max_rows` rows in all.
 MatX stability_samples(const MatX& stretches, Eigen::Index max_rows) {
-  constexpr std::array<double, 3> amplification { 1.0, 1.5, 2.0 };
-  const Eigen::Index step = std::max<Eigen::Index>(
-      1, (3 * stretches.rows() + max_rows - 1) / std::max<Eigen::Index>(max_rows, 1));
+  constexpr std::array<double, 2> amplification { 1.0, 1.25 };
+  const Eigen::Index step = std::max<Eigen::Index>(1,
+      (static_cast<Eigen::Index>(amplification.size()) * stretches.rows() + max_rows - 1)
+          / std::max<Eigen::Index>(max_rows, 1));
   const Eigen::Index kept = (stretches.rows() + step - 1) / step;
-  MatX out(3 * kept, 3);
+  MatX out(static_cast<Eigen::Index>(amplification.size()) * kept, 3);
   Eigen::Index row = 0;
   for (const double a : amplification)
-    for (Eigen::Index i = 0; i < stretches.rows(); i += step)
-      out.row(row++) = (stretches.row(i).array() - 1.0) * a + 1.0;
+    for (Eigen::Index i = 0; i < stretches.rows(); i += step, ++row)
+      for (int c = 0; c < 3; ++c)
+        out(row, c) = stretches(i, c) > 0 ? std::pow(stretches(i, c), a) : stretches(i, c);
   return out;
 }
 
-/// The new correction, or the largest fraction ½ᵏ (k ≤ 4) of its step from the best one whose
-/// material is stable at every stability sample (material_stability); the best one itself if
-/// none is. A reconstruction from noisy or sparse data can produce a correction that removes
-/// more stiffness than the nominal has somewhere; its simulations then diverge, which no later
-/// halving of the step repairs as cheaply as this check.
-std::shared_ptr<const material::RbfCorrection> stable_step(const material::RbfCorrection& fitted,
-    const material::RbfCorrection* best, const fem::MaterialModel& nominal, const MatX& stretches,
+/// The reconstructed correction, or the largest fraction ½ᵏ (k ≤ 4) of it whose material is
+/// stable at every stability sample (material_stability); none (the nominal) if no fraction is.
+/// A correction is reconstructed whole on the nominal (not as a step from the last one), so
+/// shrinking it moves towards the nominal, which is stable, and keeps its centres. A
+/// reconstruction from noisy or sparse data can remove more stiffness than the nominal has
+/// somewhere; its simulations then diverge, which no later halving of the step repairs as
+/// cheaply as this check.
+std::shared_ptr<const material::RbfCorrection> stable_fraction(
+    const material::RbfCorrection& fitted, const fem::MaterialModel& nominal, const MatX& stretches,
     IterationRecord& record) {
   double kept = 1;
   for (int k = 0; k <= 4; ++k, kept *= 0.5) {
-    auto step = std::make_shared<material::RbfCorrection>(
-        k == 0 ? fitted : material::blend(fitted, best, 1 - kept));
-    const StabilityReport stability = material_stability(*nominal.elastic, step.get(), stretches);
+    auto shrunk = std::make_shared<material::RbfCorrection>(
+        k == 0 ? fitted : material::blend(fitted, nullptr, 1 - kept));
+    const StabilityReport stability = material_stability(*nominal.elastic, shrunk.get(), stretches);
     if (k == 0)
       record.stability = stability.min_relative_eigenvalue;
     if (stability.stable()) {
       record.step_kept = kept;
-      return step;
+      return shrunk;
     }
   }
   record.step_kept = 0;
-  return best ? std::make_shared<material::RbfCorrection>(*best) : nullptr;
+  return nullptr;
 }
 
 /// The stage after the loop: Levenberg–Marquardt on the forward error from the best correction
@@ -379,7 +385,7 @@ bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
       record.centres = design.num_centres();
       record.correction_misfit = reconstructed.misfit.rms_residual;
       record.correction_target = reconstructed.misfit.rms_target;
-      next.correction = stable_step(reconstructed.correction, next.best.get(), scene.material,
+      next.correction = stable_fraction(reconstructed.correction, scene.material,
           stability_samples(
               collect_stretches(reconstruction_mesh, optimized.positions, options.stretch_samples),
               30000),

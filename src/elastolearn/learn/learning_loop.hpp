@@ -108,7 +108,8 @@ struct IterationRecord {
   /// The reconstructed correction's material_stability over its trajectory's stretches
   /// (min_relative_eigenvalue: < 0 where it is unstable).
   double stability = 0;
-  /// The fraction of the reconstructed step from the best correction kept to stay stable (1: all).
+  /// The fraction of the reconstructed correction kept to stay stable (1: all; 0: none, the
+  /// next iteration simulates the nominal).
   double step_kept = 1;
   double correction_target = 0; ///< RMS of those targets [N]
   double seconds_forward = 0, seconds_pod = 0, seconds_constrained = 0, seconds_space_time = 0,
