@@ -351,6 +351,75 @@ TEST(StressReconstruction, RejectsInconsistentFrames) {
       InputError);
 }
 
+TEST(StressReconstruction, SeveralMotionsFitOneCorrectionToAllTheirEquations) {
+  // A training set's reconstruction sums every motion's equations. Split into two motions of the
+  // same mesh, ten frames give the same fit as one motion of all ten (only the summation order
+  // differs: measured 1e-15, allowed 1e-10); a motion whose frames are left out or counted twice
+  // moves the weights by O(1) (the Tikhonov weight is tiny). A second motion of another mesh,
+  // with targets from the same correction, is fitted jointly: the truth comes back, and the
+  // misfit covers every motion's frames.
+  const KnownAnswer k(1e-13);
+  const auto head = [](const std::vector<VecX>& v, size_t n) {
+    return std::vector<VecX>(v.begin(), v.begin() + long(n));
+  };
+  const auto tail = [](const std::vector<VecX>& v, size_t n) {
+    return std::vector<VecX>(v.begin() + long(n), v.end());
+  };
+  const std::vector<VecX> x0 = head(k.frames.positions, 4), x1 = tail(k.frames.positions, 4),
+                          v0 = head(k.frames.velocities, 4), v1 = tail(k.frames.velocities, 4),
+                          g0 = head(k.targets, 4), g1 = tail(k.targets, 4);
+  const MatX none;
+  const std::vector<ReconstructionMotion> split { { k.geometry, k.dofs, x0, v0, g0, none },
+    { k.geometry, k.dofs, x1, v1, g1, none } };
+  const StressReconstructionResult whole = reconstruct_rbf_correction(
+      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, k.targets);
+  const StressReconstructionResult joint = reconstruct_rbf_correction(split, k.design);
+  EXPECT_LT((joint.unknowns - whole.unknowns).norm(), 1e-10 * whole.unknowns.norm());
+  EXPECT_EQ(joint.misfit.frames, 10);
+  EXPECT_NEAR(joint.misfit.rms_target, whole.misfit.rms_target, 1e-12 * whole.misfit.rms_target);
+  EXPECT_EQ(joint.rows_per_frame, 2 * k.dofs.num_free());
+  // One motion through the span is the single-motion fit, bit for bit.
+  const StressReconstructionResult one = reconstruct_rbf_correction(
+      std::span(split).first(1), k.design, StressReconstructionOptions {});
+  const StressReconstructionResult first
+      = reconstruct_rbf_correction(k.geometry, k.dofs, k.design, x0, v0, g0);
+  EXPECT_EQ(one.unknowns, first.unknowns);
+  EXPECT_EQ(one.misfit.rms_residual, first.misfit.rms_residual);
+
+  // Another mesh, the same correction.
+  const mesh::TetMesh other = mesh::make_box_bar(Vec3(0.3, 0.08, 0.06), { 4, 2, 1 });
+  const ReconstructionMesh other_geometry(other, nominal_material(k.alpha1));
+  const fem::DofMap other_dofs(other.num_vertices(), left_face(other));
+  const Frames other_frames = make_frames(other, 6, 9);
+  const material::RbfCorrection truth = k.design.correction(k.truth);
+  std::vector<VecX> other_targets;
+  for (size_t t = 0; t < other_frames.positions.size(); ++t)
+    other_targets.push_back(elastic_force_difference(
+        other, truth, other_frames.positions[t], other_frames.velocities[t], k.alpha1));
+  const std::vector<ReconstructionMotion> meshes { { k.geometry, k.dofs, x0, v0, g0, none },
+    { other_geometry, other_dofs, other_frames.positions, other_frames.velocities, other_targets,
+        none } };
+  const StressReconstructionResult both = reconstruct_rbf_correction(meshes, k.design);
+  EXPECT_LT((both.unknowns - k.truth).norm(), 1e-6 * k.truth.norm());
+  EXPECT_EQ(both.misfit.frames, 10);
+  EXPECT_LT(both.misfit.rms_residual, 1e-8 * both.misfit.rms_target);
+  // A misfit over both meshes: each motion's mean square weighted by its frames × free vertices.
+  const ForceMisfit a = correction_force_misfit(k.geometry, k.dofs, truth, x0, v0, g0),
+                    b = correction_force_misfit(other_geometry, other_dofs, truth,
+                        other_frames.positions, other_frames.velocities, other_targets);
+  const double wa = 4.0 * k.dofs.num_free(), wb = 6.0 * other_dofs.num_free();
+  EXPECT_NEAR(both.misfit.rms_target,
+      std::sqrt((wa * a.rms_target * a.rms_target + wb * b.rms_target * b.rms_target) / (wa + wb)),
+      1e-12 * both.misfit.rms_target);
+
+  // No motion, and the lsqr method with several, are refused.
+  EXPECT_THROW(
+      reconstruct_rbf_correction(std::span<const ReconstructionMotion>(), k.design), InputError);
+  StressReconstructionOptions lsqr;
+  lsqr.method = ReconstructionMethod::lsqr;
+  EXPECT_THROW(reconstruct_rbf_correction(meshes, k.design, lsqr), InputError);
+}
+
 TEST(StressReconstructionLsqr, MinimumNormLeastSquaresStresses) {
   // 12 tets (36 stresses) and 12 vertices, 2 fixed: 30 free dofs, so B has a null space. No
   // nominal model: correction_force is then the elastic part B p̂ alone.
