@@ -123,18 +123,6 @@ void accumulate_normal_equations(const ReconstructionMotion& motion, const RbfDe
   }
 }
 
-/// The misfit of the union of two sets of frames (each ForceMisfit an RMS over its frames ×
-/// free vertices).
-ForceMisfit merged(const ForceMisfit& a, double a_count, const ForceMisfit& b, double b_count) {
-  const double count = a_count + b_count;
-  return { std::sqrt((a_count * a.rms_residual * a.rms_residual
-                         + b_count * b.rms_residual * b.rms_residual)
-               / count),
-    std::sqrt(
-        (a_count * a.rms_target * a.rms_target + b_count * b.rms_target * b.rms_target) / count),
-    a.frames + b.frames };
-}
-
 } // namespace
 
 StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& mesh,
@@ -155,11 +143,7 @@ StressReconstructionResult reconstruct_rbf_correction(std::span<const Reconstruc
     for (const ReconstructionMotion& motion : motions)
       if (motion.projection.size() > 0)
         fail("method", "the lsqr method has no force projection: use normal_equations");
-    if (motions.size() > 1)
-      fail("method", "the lsqr method reconstructs from one motion: use normal_equations");
-    const ReconstructionMotion& motion = motions.front();
-    return reconstruct_rbf_correction_via_lsqr(motion.mesh, motion.dofs, design, motion.positions,
-        motion.velocities, motion.target_forces, options);
+    return reconstruct_rbf_correction_via_lsqr(motions, design, options);
   }
   for (const ReconstructionMotion& motion : motions)
     check_motion(motion, design);
@@ -183,25 +167,41 @@ StressReconstructionResult reconstruct_rbf_correction(std::span<const Reconstruc
   material::RbfCorrection correction = design.correction(x);
   const double solve_seconds = seconds_since(solve_start);
 
-  // The unprojected misfit over all motions' frames: each motion's RMS weighted by its
-  // (frames × free vertices).
   const auto misfit_start = Clock::now();
-  ForceMisfit misfit;
-  double count = 0;
+  const ForceMisfit misfit = correction_force_misfit(motions, correction, options.frame_stride);
   int rows = 0;
-  for (const ReconstructionMotion& motion : motions) {
-    const ForceMisfit part = correction_force_misfit(motion.mesh, motion.dofs, correction,
-        motion.positions, motion.velocities, motion.target_forces, options.frame_stride);
-    const double part_count = double(part.frames) * (motion.dofs.num_free() / 3.0);
-    misfit = count == 0 ? part : merged(misfit, count, part, part_count);
-    count += part_count;
+  for (const ReconstructionMotion& motion : motions)
     rows += motion.dofs.num_free();
-  }
   StressReconstructionResult result { std::move(correction), std::move(x), misfit, rows };
   result.assembly_seconds = assembly_seconds;
   result.solve_seconds = solve_seconds;
   result.misfit_seconds = seconds_since(misfit_start);
   return result;
+}
+
+ForceMisfit correction_force_misfit(std::span<const ReconstructionMotion> motions,
+    const material::Correction& correction, int frame_stride) {
+  ForceMisfit out;
+  double count = 0; // frames × free vertices so far
+  double residual = 0, target = 0; // their sums of squares
+  for (const ReconstructionMotion& motion : motions) {
+    const ForceMisfit part = correction_force_misfit(motion.mesh, motion.dofs, correction,
+        motion.positions, motion.velocities, motion.target_forces, frame_stride);
+    const double part_count = double(part.frames) * (motion.dofs.num_free() / 3.0);
+    if (count == 0) {
+      out = part;
+    } else {
+      out.rms_residual = std::sqrt(
+          (residual + part_count * part.rms_residual * part.rms_residual) / (count + part_count));
+      out.rms_target = std::sqrt(
+          (target + part_count * part.rms_target * part.rms_target) / (count + part_count));
+      out.frames += part.frames;
+    }
+    count += part_count;
+    residual += part_count * part.rms_residual * part.rms_residual;
+    target += part_count * part.rms_target * part.rms_target;
+  }
+  return out;
 }
 
 } // namespace elastolearn::learn

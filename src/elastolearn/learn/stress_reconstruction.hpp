@@ -103,9 +103,15 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
 /// that one correction explains every motion. The equations of each motion are accumulated as
 /// above (its own blocks of frames) and the motions' sums added in order, so that one motion
 /// gives exactly the single-motion result. `misfit` is over all motions' frames together.
-/// options.frame_stride applies to every motion. The lsqr method takes exactly one motion.
-/// Throws InputError as above, and for no motion or the lsqr method with several.
+/// options.frame_stride applies to every motion. The lsqr method fits one RBF to every motion's
+/// element-stress samples. Throws InputError as above, and for no motion.
 StressReconstructionResult reconstruct_rbf_correction(std::span<const ReconstructionMotion> motions,
     const RbfDesign& design, const StressReconstructionOptions& options = {});
+
+/// The misfit of `correction` over every motion's frames 0, stride, 2·stride, …: the RMS over
+/// all of them (each motion's correction_force_misfit weighted by its frames × free vertices;
+/// one motion's is returned as it is). Same checks as correction_force_misfit.
+ForceMisfit correction_force_misfit(std::span<const ReconstructionMotion> motions,
+    const material::Correction& correction, int frame_stride = 1);
 
 } // namespace elastolearn::learn
