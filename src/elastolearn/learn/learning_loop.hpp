@@ -98,13 +98,15 @@ struct IterationRecord {
   /// forward_fit_accepted says whether it lowered the error (and became the best).
   bool forward_fit = false;
   bool forward_fit_accepted = false;
-  double control_force_rms = 0; ///< √(mean r²) of the optimised trajectory [N]
+  /// √(mean r²) of the optimised trajectories (over every motion's steps and free dofs) [N]
+  double control_force_rms = 0;
   double space_time_initial = 0; ///< E at the constrained simulation
   double space_time_objective = 0; ///< E after optimisation
   int space_time_iterations = 0;
   int modes = 0; ///< POD modes (summed over the motions)
   int centres = 0;
-  double correction_misfit = 0; ///< RMS force misfit of C_{k+1} against its targets [N]
+  /// RMS force misfit of C_{k+1} against its targets (every motion's frames) [N]
+  double correction_misfit = 0;
   double correction_target = 0; ///< RMS of those targets [N]
   double seconds_forward = 0, seconds_pod = 0, seconds_constrained = 0, seconds_space_time = 0,
          seconds_reconstruction = 0;
