@@ -343,6 +343,8 @@ int main(int argc, char** argv) {
       g_kernel_smoothing = std::stod(argv[++i]);
     else if (a == "--damping-regularization" && i + 1 < argc)
       g_damping_regularization = std::stod(argv[++i]);
+    else if (a == "--stress-kernels")
+      g_recipe.loop.rbf.energy_kernels = false;
     else if (a == "--linear-tail")
       g_linear_tail = true;
     else if (a == "--neo-hookean-tail")
@@ -368,7 +370,8 @@ int main(int argc, char** argv) {
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
                   "[--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
-                  "[--linear-tail] [--neo-hookean-tail] [--damping-quadratic-tail] [--full-space] "
+                  "[--stress-kernels] [--linear-tail] [--neo-hookean-tail] "
+                  "[--damping-quadratic-tail] [--full-space] "
                   "[--pod-forward-only] [--no-damping] [--position-weight W] "
                   "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\ncases:");
       for (const auto& n : kCases)

@@ -12,12 +12,14 @@
 /// factorisation and a solve with one right-hand side per unknown.
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/correction_force.hpp>
+#include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
 #include <elastolearn/learn/trajectory_error.hpp>
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>
 
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,16 @@ enum class Sensitivities {
 ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
     const observe::Observation& observed, const ReconstructionMesh& mesh, const RbfDesign& design,
     const VecX& unknowns, Sensitivities sensitivities, const ProgressCallback& progress = {});
+
+/// The same pass over several motions (a training set) with the same unknowns: E and its normal
+/// equations are the sums over motions, `error` the statistics over all their observations
+/// (combined_error) and `seconds` the sum. `meshes[i]` is the reconstruction mesh of
+/// motions[i].scene. The pass stops at the first motion whose simulation diverges (with two or
+/// more motions its message names the motion). One motion gives exactly its own pass.
+/// Throws InputError if the spans differ in length or are empty.
+ForwardSensitivityPass simulate_with_sensitivities(std::span<const Motion> motions,
+    std::span<const ReconstructionMesh> meshes, const RbfDesign& design, const VecX& unknowns,
+    Sensitivities sensitivities, const ProgressCallback& progress = {});
 
 struct ForwardFitOptions {
   int max_iterations = 0; ///< trial steps (one forward simulation each) after the start
@@ -95,7 +107,16 @@ using ForwardFitStepCallback = std::function<bool(
     const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping)>;
 
 /// Levenberg–Marquardt from `start` (unknowns in design's layout), with options.damping as the
-/// first μ. Throws InputError for invalid options or if the start's simulation diverges.
+/// first μ, on E summed over `motions` (each with its reconstruction mesh `meshes[i]`; the
+/// motions share the nominal material, their meshes may differ). A trial is rejected if any
+/// motion's simulation diverges. Throws InputError for invalid options, spans that differ in
+/// length or are empty, or if the start's simulation diverges.
+ForwardFitResult fit_to_observations(std::span<const Motion> motions,
+    std::span<const ReconstructionMesh> meshes, const RbfDesign& design, const VecX& start,
+    const ForwardFitOptions& options, const ProgressCallback& progress = {},
+    const ForwardFitStepCallback& on_step = {});
+
+/// One motion: `scene` (the nominal model) against `observed`, `mesh` its reconstruction mesh.
 ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Observation& observed,
     const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start,
     const ForwardFitOptions& options, const ProgressCallback& progress = {},
