@@ -1,8 +1,7 @@
 // The learning benchmark of issue 3 (paper 000's Table 1, with our own simulator as ground
 // truth): per case, simulate the truth's training motion, observe a fraction of the surface
-// vertices, learn a correction of the nominal model (learn::run_learning), fit the nominal
-// model's parameters to the same observations (the baseline, learn::fit_parameters), then compare
-// nominal / fitted / learned with the truth on a different, larger test motion.
+// vertices, learn with the one recipe (learn::learn_material: its parameter fit is the baseline),
+// then compare nominal / fitted / learned with the truth on a different, larger test motion.
 // err_L = max vertex position error over the test trajectory, % of the rest bounding-box diagonal.
 //
 //   bench_learning [--quick] [--data DIR] [--modes R --kernels M ...] [CASE ...]   (no case = all;
@@ -34,16 +33,15 @@ using namespace bench_learning;
 
 struct Row {
   std::string name;
-  int tets = 0, frames = 0, observed = 0, modes = 0, iterations = 0, kernels = 0,
-      best_iteration = -1;
+  int tets = 0, frames = 0, observed = 0, modes = 0, iterations = 0, kernels = 0;
   double visible = 1;
   double train_deformation = 0, test_deformation = 0; ///< max displacement, % of diagonal
   double forward = 0, constrained = 0, space_time = 0, reconstruction = 0, pod = 0, learn_total = 0;
   double fit_seconds = 0;
   double err_nominal = -1, err_fit = -1, err_learned = -1; ///< test err_L [%] (−1: diverged)
-  double train_nominal = -1, train_learned = -1; ///< training err_L at the observed vertices [%]
   double target = 0;
-  std::string fitted;
+  int divergences = 0; ///< forward simulations of the learning that diverged
+  std::string fitted, chosen;
 };
 
 sim::Scene with_material(sim::Scene s, const fem::MaterialModel& m) {
@@ -83,7 +81,9 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
 
 bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and the nominal test,
                            ///< then stop (for tuning scenes)
-bool g_no_fit = false; ///< --no-fit: skip the parameter-fit baseline (for tuning the learning)
+/// The recipe every case learns with: its defaults, changed only by the expert flags below, which
+/// act on every case alike.
+learn::RecipeOptions g_recipe;
 /// Overrides of the learning options for every case (−1: keep the case's).
 int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_halvings = -1,
     g_forward_fit = -1;
@@ -185,10 +185,13 @@ Row run_case(const LearningCase& c) {
     return row;
   }
 
-  // Learning.
-  learn::LearningState state;
-  learn::LearningCallbacks callbacks;
-  callbacks.iteration = [&](const learn::IterationRecord& r) {
+  // Learning: the one recipe (its stage 2, the parameter fit, is the baseline).
+  learn::RecipeCallbacks callbacks;
+  callbacks.message = [](const std::string& line) {
+    std::printf("   %s\n", line.c_str());
+    std::fflush(stdout);
+  };
+  callbacks.loop.iteration = [&](const learn::IterationRecord& r) {
     if (r.forward_completed)
       std::printf("   iteration %d: forward rms %.4f %%, max %.4f %%", r.iteration,
           100 * r.forward_error.rms / size, 100 * r.forward_error.max / size);
@@ -196,28 +199,31 @@ Row run_case(const LearningCase& c) {
       std::printf("   iteration %d:", r.iteration);
     if (r.forward_fit)
       std::printf(" (forward fit: %s, %d kernels, %.1f s)\n",
-          !r.forward_completed         ? "trial DIVERGED, rejected"
+          r.forward_unstable           ? "trial unstable, rejected unsimulated"
+              : !r.forward_completed   ? "trial DIVERGED, rejected"
               : r.forward_fit_accepted ? "accepted"
                                        : "rejected",
           r.centres, r.seconds_forward);
     else if (r.modes > 0)
       std::printf(
-          "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N; "
+          "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N, step kept %.3g; "
           "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
           r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target,
-          r.seconds_forward, r.seconds_constrained, r.seconds_space_time, r.space_time_iterations,
-          r.seconds_reconstruction);
+          r.step_kept, r.seconds_forward, r.seconds_constrained, r.seconds_space_time,
+          r.space_time_iterations, r.seconds_reconstruction);
     else if (!r.forward_completed)
-      std::printf(" -> this correction's forward simulation DIVERGED (%.1f s); %s\n",
-          r.seconds_forward, r.damped_update ? "trying half its step" : "the loop stops");
+      std::printf(" -> this correction's forward simulation DIVERGED (%.1f s: %s); %s\n",
+          r.seconds_forward, r.forward_message.c_str(),
+          r.damped_update ? "trying half its step" : "the loop stops");
     else
       std::printf(" (final forward check, %.1f s)\n", r.seconds_forward);
     std::fflush(stdout);
   };
   t0 = Clock::now();
-  learn::run_learning(c.train, observed, c.options, state, callbacks);
+  const std::vector<learn::Motion> motions { { c.name + " training", c.train, observed } };
+  const learn::RecipeResult learned = learn::learn_material(motions, g_recipe, callbacks);
   row.learn_total = seconds_since(t0);
-  for (const auto& r : state.history) {
+  for (const auto& r : learned.loop.history) {
     row.forward += r.seconds_forward;
     row.pod += r.seconds_pod;
     row.constrained += r.seconds_constrained;
@@ -225,42 +231,30 @@ Row run_case(const LearningCase& c) {
     row.reconstruction += r.seconds_reconstruction;
     if (r.modes > 0)
       ++row.iterations;
+    if (!r.forward_completed && !r.forward_unstable)
+      ++row.divergences;
     row.modes = std::max(row.modes, r.modes);
     row.kernels = std::max(row.kernels, r.centres);
   }
-  row.best_iteration = state.best_iteration;
-  if (!state.history.empty())
-    row.train_nominal = 100 * state.history.front().forward_error.max / size;
-  for (const auto& r : state.history)
-    if (r.iteration == state.best_iteration)
-      row.train_learned = 100 * r.forward_error.max / size;
-  std::printf("   learned in %.1f s (%d corrections, best: iteration %d)\n", row.learn_total,
-      row.iterations, state.best_iteration);
+  row.fit_seconds = learned.parameter_fit.seconds;
+  row.chosen = learn::to_string(learned.choice().kind);
+  if (learned.choice().iteration >= 0)
+    row.chosen += " " + std::to_string(learned.choice().iteration);
+  const auto& fitted = learned.parameter_fit.fitted;
+  char text[256];
+  std::snprintf(text, sizeof text, "E %.3g, ν %.3f, α₀ %.3g, α₁ %.3g", fitted.young, fitted.poisson,
+      fitted.alpha0, fitted.alpha1);
+  row.fitted = text;
+  std::printf("   learned in %.1f s (parameter fit %.1f s; %d corrections; chosen: %s)\n",
+      row.learn_total, row.fit_seconds, row.iterations, row.chosen.c_str());
   std::fflush(stdout);
-
-  // Parameter-fit baseline on the same observations (all parameters nominal with --no-fit).
-  t0 = Clock::now();
-  learn::ParameterFitReport fit;
-  fit.fitted = c.nominal;
-  if (!g_no_fit) {
-    fit = learn::fit_parameters(c.train, c.nominal_type, c.nominal, observed, c.fit);
-    row.fit_seconds = seconds_since(t0);
-    char fitted[256];
-    std::snprintf(fitted, sizeof fitted, "E %.3g, ν %.3f, α₀ %.3g, α₁ %.3g", fit.fitted.young,
-        fit.fitted.poisson, fit.fitted.alpha0, fit.fitted.alpha1);
-    row.fitted = fitted;
-    std::printf("   parameter fit in %.1f s (%d iterations, %d simulations, %s): %s; observation "
-                "rms %.3f %% -> %.3f %%\n",
-        row.fit_seconds, fit.iterations, fit.simulations, learn::to_string(fit.stop).c_str(),
-        fitted, 100 * fit.initial_rms / size, 100 * fit.final_rms / size);
-    std::fflush(stdout);
-  }
 
   // Test motion.
   t0 = Clock::now();
   row.err_nominal = err_l(c.test, truth_test);
-  row.err_fit = err_l(learn::scene_with_parameters(c.test, c.nominal_type, fit.fitted), truth_test);
-  row.err_learned = err_l(sim::with_correction(c.test, state.best), truth_test);
+  row.err_fit
+      = err_l(learn::scene_with_parameters(c.test, learned.nominal_type, fitted), truth_test);
+  row.err_learned = err_l(with_material(c.test, learned.material(c.train.material)), truth_test);
   std::printf("   test err_L: nominal %.3f %%, parameter fit %.3f %%, learned %.3f %% (target ≤ "
               "%.1f %%; %.1f s)\n",
       row.err_nominal, row.err_fit, row.err_learned, row.target, seconds_since(t0));
@@ -300,20 +294,22 @@ std::string err(double e) {
 }
 
 void print_table(const std::vector<Row>& rows) {
-  std::printf("\n| case | tets | frames | observed | modes | iter | kernels | forward s | "
-              "constrained s | space-time s | "
-              "reconstr. s | learn total s | fit s | deform. train/test %% | err_L nominal %% | "
-              "err_L fit %% | "
-              "err_L learned %% | target %% "
-              "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "\n| case | tets | frames | observed | modes | iter | kernels | forward s | "
+      "constrained s | space-time s | "
+      "reconstr. s | learn total s | fit s | deform. train/test %% | err_L nominal %% | "
+      "err_L fit %% | "
+      "err_L learned %% | target %% | chosen | divergences "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& r : rows)
     std::printf("| %s | %d | %d | %d (%.0f %%) | %d | %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | "
                 "%.1f | %.1f / %.1f | "
-                "%s | %s | %s | ≤ %.1f |\n",
+                "%s | %s | %s | ≤ %.1f | %s | %d |\n",
         r.name.c_str(), r.tets, r.frames, r.observed, 100 * r.visible, r.modes, r.iterations,
         r.kernels, r.forward, r.constrained, r.space_time, r.reconstruction, r.learn_total,
         r.fit_seconds, r.train_deformation, r.test_deformation, err(r.err_nominal).c_str(),
-        err(r.err_fit).c_str(), err(r.err_learned).c_str(), r.target);
+        err(r.err_fit).c_str(), err(r.err_learned).c_str(), r.target, r.chosen.c_str(),
+        r.divergences);
 }
 
 // --- Random cases (bench_learning --random N --seed S; random_cases.hpp) ---------------------
@@ -583,7 +579,7 @@ int main(int argc, char** argv) {
     else if (a == "--truth-only")
       g_truth_only = true;
     else if (a == "--no-fit")
-      g_no_fit = true;
+      g_recipe.fit_parameters = false;
     else if (a == "--modes" && i + 1 < argc)
       g_modes = std::stoi(argv[++i]);
     else if (a == "--kernels" && i + 1 < argc)
@@ -608,6 +604,8 @@ int main(int argc, char** argv) {
       g_kernel_smoothing = std::stod(argv[++i]);
     else if (a == "--damping-regularization" && i + 1 < argc)
       g_damping_regularization = std::stod(argv[++i]);
+    else if (a == "--stress-kernels")
+      g_recipe.loop.rbf.energy_kernels = false;
     else if (a == "--linear-tail")
       g_linear_tail = true;
     else if (a == "--neo-hookean-tail")
@@ -639,7 +637,8 @@ int main(int argc, char** argv) {
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
                   "[--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
-                  "[--linear-tail] [--neo-hookean-tail] [--damping-quadratic-tail] [--full-space] "
+                  "[--stress-kernels] [--linear-tail] [--neo-hookean-tail] "
+                  "[--damping-quadratic-tail] [--full-space] "
                   "[--pod-forward-only] [--no-damping] [--position-weight W] "
                   "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\n"
                   "       bench_learning --random N [--seed S] [--random-case I] [--draw-only] "
@@ -666,15 +665,18 @@ int main(int argc, char** argv) {
     names = kCases;
   std::printf("bench_learning%s: %zu case(s), %u hardware threads\n", quick ? " --quick" : "",
       names.size(), std::thread::hardware_concurrency());
+  apply_overrides(g_recipe.loop);
+  std::printf("the recipe: ≤ %d POD modes, %d kernels (%s), ≤ %d iterations, patience %d, %d "
+              "forward-fit steps, parameter fit %s\n",
+      g_recipe.loop.pod.max_modes, g_recipe.loop.centres,
+      g_recipe.loop.rbf.energy_kernels ? "energy" : "stress", g_recipe.loop.max_iterations,
+      g_recipe.loop.patience, g_recipe.loop.forward_fit.max_iterations,
+      g_recipe.fit_parameters ? "on" : "off");
   std::vector<Row> rows;
   int status = 0;
   for (const auto& name : names) {
     try {
       LearningCase c = make_case(name, data, quick);
-      apply_overrides(c.options);
-      std::printf("\n%s: learning with ≤ %d modes, %d kernels, ≤ %d iterations, patience %d\n",
-          name.c_str(), c.options.pod.max_modes, c.options.centres, c.options.max_iterations,
-          c.options.patience);
       rows.push_back(run_case(c));
       print_table(rows);
     } catch (const std::exception& e) {

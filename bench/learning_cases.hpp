@@ -1,10 +1,11 @@
 #pragma once
 // The scenes of bench_learning (the learning benchmark of issue 3, paper 000's Table 1): for each
-// case a training and a test motion with the nominal material, the ground-truth material, the
-// observed fraction and the options of the learning loop and of the parameter-fit baseline.
-// Set-up and reasoning per case: docs/benchmarks_learning.md.
+// case a training and a test motion with the nominal material, the ground-truth material and the
+// observed fraction. Every case learns with the one default recipe (learn/learning_recipe.hpp):
+// cases differ in what is observed, never in how it is learned. Set-up per case:
+// docs/benchmarks_learning.md.
 #include <elastolearn/core/error.hpp>
-#include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
@@ -36,13 +37,8 @@ struct LearningCase {
   sim::Scene train; ///< nominal material
   sim::Scene test; ///< nominal material, a different and larger motion
   fem::MaterialModel truth;
-  material::ElasticModelType nominal_type = material::ElasticModelType::Corotated;
-  learn::NominalParameters nominal;
   double visible_fraction = 1.0;
-  learn::LearningOptions options;
-  learn::ParameterFitOptions fit;
   double target_err_l = 0; ///< issue 3's target [% of the rest bounding-box diagonal]
-  LearningCase() { fit.max_iterations = 10; } // the baseline's budget (converges in fewer here)
 };
 
 inline fem::MaterialModel make_material(material::ElasticModelType type, double young,
@@ -137,7 +133,6 @@ inline LearningCase turtle(const fs::path& data, bool quick, double fraction) {
   auto mesh
       = real_mesh(cgal_mesh(data, "bear.off"), 1, height, quick ? 600 : 1200, false, c.mesh_label);
   c.truth = make_material(material::ElasticModelType::NeoHookean, 2e4, 0.43, 0, 0);
-  c.nominal = { 3.5e4, 0.43, 0, 0 };
   const auto nominal = make_material(material::ElasticModelType::Corotated, 3.5e4, 0.43, 0, 0);
   c.train = base_scene(std::move(mesh), nominal, 4e-3, 200);
   c.train.fixed_vertices = base_vertices(c.train.mesh, 0.08);
@@ -161,7 +156,6 @@ inline LearningCase dragon(const fs::path& data, bool quick) {
   auto mesh = real_mesh(
       cgal_mesh(data, "ChineseDragon-10kv.off"), 0, 0.12, quick ? 1300 : 2800, true, c.mesh_label);
   c.truth = make_material(material::ElasticModelType::StVK, 1e5, 0.40, 0, 0);
-  c.nominal = { 1.2e5, 0.40, 0, 0 };
   const auto nominal = make_material(material::ElasticModelType::Corotated, 1.2e5, 0.40, 0, 0);
   c.train = base_scene(std::move(mesh), nominal, 3e-3, 200);
   c.train.fixed_vertices = base_vertices(c.train.mesh, 0.08);
@@ -178,10 +172,6 @@ inline LearningCase dragon(const fs::path& data, bool quick) {
   c.motion_label = "train: droop from rest under gravity; test: gravity + swing ω = (3, 0, 3) "
                    "rad/s about the base";
   c.target_err_l = 0.2;
-  // 30 POD modes instead of the default 20: with 20 the test error misses the 0.2 % target, and
-  // so it does with 20 kernels or a weaker regularisation instead (the comparison:
-  // docs/benchmarks_learning.md).
-  c.options.pod.max_modes = 30;
   return c;
 }
 
@@ -207,7 +197,6 @@ inline LearningCase sphere(bool compression, bool quick) {
       spline);
   c.truth.damping = std::make_shared<material::RayleighDamping>(0.0, 0.2);
   c.truth.density = 1000;
-  c.nominal = { 1.2e5, 0.43, 0, 0.2 };
   const auto nominal = make_material(material::ElasticModelType::Corotated, 1.2e5, 0.43, 0, 0.2);
   c.train = base_scene(std::move(mesh), nominal, 5e-3, 200);
   c.train.fixed_vertices = mesh::vertices_with_min_coordinate(c.train.mesh, 1, 0.15 * radius);
@@ -229,25 +218,6 @@ inline LearningCase sphere(bool compression, bool quick) {
   c.motion_label
       = "top cap keyframed y = A sin 2πft; train A 0.2 r, f 1 Hz; test A 0.3 r, f 1.25 Hz";
   c.target_err_l = 2.0;
-  // Learned by the forward fit alone: at 12.7k tets the space-time loop's corrections are wrong
-  // near the keyframed cap's rim (its interior is held at the current model's equilibrium) and
-  // stall at a training RMS of 0.75 % after 8 iterations, where three Levenberg–Marquardt steps
-  // on the forward error reach 0.03 % (docs/learning_loop.md). Kernel smoothing ε = 0.03: with
-  // 10⁻³ the fitted correction's test simulation stalls Newton where the larger test stretches
-  // cross centres (docs/benchmarks_learning.md, "the forward fit; a stress-free rest").
-  c.options.max_iterations = 0;
-  c.options.forward_fit.max_iterations = 3;
-  c.options.rbf.epsilon = 0.03;
-  // The test motion compresses and stretches beyond the training's: the neo-Hookean tail
-  // extrapolates the elastic correction, and a prior on Δα₁ keeps the damping correction from
-  // extrapolating what the training stretches cannot pin down (docs/learning.md, "Forward fit").
-  c.options.rbf.neo_hookean_tail = true;
-  c.options.forward_fit.damping_prior = 1.0;
-  // The 12.7k-tet sphere: fit E and ν only (α₁ is right) and with fewer iterations, to keep the
-  // baseline within minutes (the first 100 of the 200 frames).
-  c.fit.parameters = { learn::FitParameter::Young, learn::FitParameter::Poisson };
-  c.fit.max_iterations = quick ? 10 : 5;
-  c.fit.frames = 100;
   return c;
 }
 
@@ -268,7 +238,6 @@ inline LearningCase bar_damping(int variant, bool quick) {
                                    : material::StretchPolynomial({ 0.2, 83.0 / 6, -50.0 / 3 });
   c.truth.damping = std::make_shared<material::StretchDependentRayleigh>(
       material::CubicSpline({ 1.0 }, { 0.0 }), alpha1);
-  c.nominal = { 4e4, 0.43, 0, 0.2 };
   const auto nominal = make_material(material::ElasticModelType::Corotated, 4e4, 0.43, 0, 0.2);
   c.train = base_scene(std::move(mesh), nominal, 5e-3, 300);
   c.train.gravity = Vec3::Zero();
@@ -296,16 +265,6 @@ inline LearningCase bar_damping(int variant, bool quick) {
       + (variant == 1 ? "(30, 0, 0.8)" : "(70, 0, 0.6)")
       + " rad/s about the clamp; test: released from a static tip load (0, −2.5, 0.8) N";
   c.target_err_l = variant == 1 ? 0.1 : 0.4;
-  // The truth differs from the nominal in damping only, and the user of this case knows the
-  // elasticity is right: the forward fit alone, with a prior holding the elastic correction at 0
-  // (ρ_e = 10⁶), learns Δα₁ on 10 kernels and the quadratic damping tail. The space-time loop, a
-  // free elastic correction and 40 kernels let the elastic part absorb what damping explains, and
-  // test worse (docs/benchmarks_learning.md).
-  c.options.max_iterations = 0;
-  c.options.forward_fit.max_iterations = 6;
-  c.options.forward_fit.elastic_prior = 1e6;
-  c.options.centres = 10;
-  c.options.rbf.damping_quadratic_tail = true;
   return c;
 }
 

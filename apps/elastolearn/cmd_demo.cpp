@@ -9,11 +9,12 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/scene_output.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
-#include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 #include <elastolearn/sim/forward_run.hpp>
@@ -76,12 +77,20 @@ void run_demo(const fs::path& out, double fraction) {
   std::printf("2. observed %d of %zu surface vertices: %s\n", observed.num_observed(),
       train.mesh.surface_vertices().size(), (out / "observations.h5").c_str());
 
-  std::printf("3. learning (forward error at the observed vertices, %% of the size)\n");
+  std::printf(
+      "3. learning with the one recipe (errors at the observed vertices, %% of the size)\n");
   const double size = train.mesh.bounding_box_diagonal();
-  learn::LearningState state;
-  learn::LearningCallbacks callbacks;
-  callbacks.progress = terminal_progress("learn");
-  callbacks.iteration = [&](const learn::IterationRecord& r) {
+  learn::RecipeCallbacks callbacks;
+  callbacks.message = [](const std::string& line) {
+    std::printf("   %s\n", line.c_str());
+    std::fflush(stdout);
+  };
+  callbacks.loop.progress = terminal_progress("learn");
+  callbacks.loop.iteration = [&](const learn::IterationRecord& r) {
+    if (!r.forward_completed) {
+      std::printf("   iteration %d: %s\n", r.iteration, r.forward_message.c_str());
+      return;
+    }
     std::printf("   iteration %d: rms %.4f %%, max %.4f %%", r.iteration,
         100 * r.forward_error.rms / size, 100 * r.forward_error.max / size);
     if (r.forward_fit)
@@ -93,37 +102,47 @@ void run_demo(const fs::path& out, double fraction) {
       std::printf("  (last forward check)\n");
     std::fflush(stdout);
   };
-  learn::LearningOptions options;
-  // After the space-time loop, two Levenberg–Marquardt steps on the forward error itself
-  // (docs/learning_loop.md, "Forward fit"): test err_L 0.026 % → 0.005 % here, ~10 s more.
-  options.forward_fit.max_iterations = 2;
-  learn::run_learning(train, observed, options, state, callbacks);
-  io::MaterialFile learned { nlohmann::json::parse(app::kDemoTrainScene).at("material"), state.best,
-    { { "demo", true }, { "best_iteration", state.best_iteration } },
-    learn::training_stretch_range(train, state.best) };
+  const std::vector<learn::Motion> motions { { "the droop", train, observed } };
+  const learn::RecipeResult result = learn::learn_material(motions, {}, callbacks);
+  const learn::Candidate& chosen = result.choice();
+  const nlohmann::json nominal_json = nlohmann::json::parse(app::kDemoTrainScene).at("material");
+  sim::Scene fitted = train;
+  fitted.material = result.fitted_nominal;
+  io::MaterialFile learned { chosen.kind == learn::CandidateKind::Nominal
+        ? nominal_json
+        : io::with_nominal_parameters(nominal_json, result.parameter_fit.fitted, true),
+    chosen.correction, { { "demo", true }, { "chosen", learn::to_string(chosen.kind) } },
+    learn::training_stretch_range(fitted, chosen.correction) };
   io::write_material_file(out / "learned.json", learned);
-  std::printf("   learned material: %s\n", (out / "learned.json").c_str());
+  std::printf("   chose %s by its error on %s; learned material: %s\n",
+      learn::to_string(chosen.kind).c_str(), result.validation_data.c_str(),
+      (out / "learned.json").c_str());
 
-  std::printf("4. a different test motion (thrown upward): truth, nominal, learned\n");
+  std::printf("4. a different test motion (thrown upward): truth, nominal, fitted, learned\n");
   const auto test_truth = simulate_and_save(with_material(test, truth), out, "test_truth");
   const auto test_nominal = simulate_and_save(test, out, "test_nominal");
-  const auto test_learned
-      = simulate_and_save(sim::with_correction(test, state.best), out, "test_learned");
+  const auto test_fitted
+      = simulate_and_save(with_material(test, result.fitted_nominal), out, "test_fitted");
+  const auto test_learned = simulate_and_save(
+      with_material(test, result.material(train.material)), out, "test_learned");
   const auto e_nominal
       = learn::as_percent_of(learn::position_error(test_nominal, test_truth), size);
+  const auto e_fitted = learn::as_percent_of(learn::position_error(test_fitted, test_truth), size);
   const auto e_learned
       = learn::as_percent_of(learn::position_error(test_learned, test_truth), size);
-  std::printf("\n   %-8s %10s %10s\n", "model", "err_L [%]", "mean [%]");
-  std::printf("   %-8s %10.3f %10.4f\n   %-8s %10.3f %10.4f\n", "nominal", e_nominal.max,
-      e_nominal.mean, "learned", e_learned.max, e_learned.mean);
+  std::printf("\n   %-16s %10s %10s\n", "model", "err_L [%]", "mean [%]");
+  std::printf("   %-16s %10.3f %10.4f\n   %-16s %10.3f %10.4f\n   %-16s %10.4f %10.5f\n", "nominal",
+      e_nominal.max, e_nominal.mean, "fitted nominal", e_fitted.max, e_fitted.mean, "learned",
+      e_learned.max, e_learned.mean);
   if (learned.training_stretches) {
     learn::StretchCoverage coverage(test.mesh, learned.training_stretches);
     for (const auto& x : test_learned)
       coverage.add_frame(x);
     std::fputs(learn::coverage_report(coverage, "   ").c_str(), stdout);
   }
-  std::printf("   err_L %.0fx lower with the learned correction; demo took %.0f s\n",
-      e_nominal.max / e_learned.max, seconds_since(start));
+  std::printf("   err_L %.0fx lower than the nominal's and %.1fx lower than the fitted nominal's; "
+              "demo took %.0f s\n",
+      e_nominal.max / e_learned.max, e_fitted.max / e_learned.max, seconds_since(start));
 }
 
 void add_demo_command(CLI::App& root) {

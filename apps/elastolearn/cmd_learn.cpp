@@ -5,6 +5,7 @@
 
 #include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/core/interrupt.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/io/learning_checkpoint.hpp>
@@ -13,6 +14,7 @@
 #include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
+#include <elastolearn/io/training_set.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
@@ -83,14 +85,18 @@ void print_iteration(const elastolearn::learn::IterationRecord& r, double diagon
           100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal, "-", "-",
           r.centres, r.seconds_total(),
           r.forward_fit_accepted ? "step accepted" : "step rejected, μ × 10");
+    else if (r.forward_unstable)
+      std::printf("%4d  forward fit: trial step rejected, μ × 10 (%s)\n", r.iteration,
+          r.forward_message.c_str());
     else
-      std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10)\n",
-          r.iteration);
+      std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10): %s\n",
+          r.iteration, r.forward_message.c_str());
   } else if (!r.forward_completed) {
     std::printf(r.damped_update
-            ? "%4d  forward simulation diverged: trying half of this correction's step\n"
-            : "%4d  forward simulation diverged: stopping (the best correction so far is kept)\n",
-        r.iteration);
+            ? "%4d  forward simulation diverged (%s): trying half of this correction's step\n"
+            : "%4d  forward simulation diverged (%s): stopping (the best correction so far is "
+              "kept)\n",
+        r.iteration, r.forward_message.c_str());
   } else {
     std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, "
                 "space-time %.1f [%d it], reconstruction %.1f)\n",
@@ -98,6 +104,12 @@ void print_iteration(const elastolearn::learn::IterationRecord& r, double diagon
         r.control_force_rms, r.modes, r.centres, r.seconds_total(), r.seconds_forward,
         r.seconds_constrained, r.seconds_space_time, r.space_time_iterations,
         r.seconds_reconstruction);
+    if (r.step_kept < 1)
+      std::printf("      the reconstructed correction is unstable within the training stretches "
+                  "(smallest tangent eigenvalue %.2f × the nominal's): %s\n",
+          r.stability,
+          r.step_kept > 0 ? ("kept " + elastolearn::to_text(r.step_kept) + " of it").c_str()
+                          : "dropped it (the next iteration simulates the nominal)");
   }
   std::fflush(stdout);
 }
@@ -128,13 +140,19 @@ nlohmann::json recipe_json(const elastolearn::learn::RecipeResult& r) {
 
 void run_learn(const LearnOptions& o) {
   using namespace elastolearn;
-  const auto scene_file = io::read_scene_file(o.scene);
-  const sim::Scene& scene = scene_file.scene;
+  const bool training_set = io::is_training_set_file(o.scene);
+  if (!training_set && o.observations.empty())
+    throw InputError("--observations",
+        "is required with a scene file (or give a training-set file instead of the scene: "
+        "docs/observations.md, \"Training sets\")");
+  if (training_set && !o.observations.empty())
+    throw InputError("--observations",
+        "not with a training set, which names its observation files (" + o.scene + ")");
+  const io::TrainingSet set = training_set ? io::read_training_set(o.scene)
+                                           : io::read_training_motion(o.scene, o.observations);
   const std::filesystem::path checkpoint
       = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
   {
-    std::vector<CommandInput> inputs = scene_file.inputs;
-    inputs.push_back({ o.observations, "observations (--observations)" });
     // With --resume the checkpoint is read and then rewritten on purpose: it is an output only.
     std::vector<CommandOutput> outputs
         = { { o.output, "learned material output (-o)" }, { checkpoint, "checkpoint" } };
@@ -144,25 +162,15 @@ void run_learn(const LearnOptions& o) {
       outputs.push_back({ report / "convergence.csv", "report's convergence.csv" });
       outputs.push_back({ report / "report.json", "report's report.json" });
     }
-    check_command_paths(inputs, outputs);
+    check_command_paths(set.inputs, outputs);
   }
-  if (scene.material.correction)
-    throw InputError(o.scene,
-        "material: the scene's material already carries a correction; learn from a nominal one");
-  if (scene.mass != fem::MassType::Lumped)
-    throw InputError(o.scene,
-        "mass: learning needs \"lumped\" mass (the paper's); learn with lumped mass and simulate "
-        "the learned material with either (docs/learning_loop.md, \"Lumped mass only\")");
   // The nominal must have parameters to fit: said here with the scene file's field.
   material::ElasticModelType nominal_type {};
   io::nominal_parameters_from_json(
-      io::JsonObject(scene_file.nominal_material, o.scene, "material"), nominal_type);
-  std::vector<learn::Motion> motions(1);
-  motions[0].name = o.observations;
-  motions[0].scene = scene;
-  motions[0].observed = io::read_observation_h5(o.observations);
-  motions[0].observed.validate(
-      scene.mesh.num_vertices(), scene.frames + 1, scene.dt, o.observations);
+      io::JsonObject(set.nominal_material, set.files.front().paths.scene.string(), "material"),
+      nominal_type);
+  const std::vector<learn::Motion>& motions = set.motions;
+  const sim::Scene& scene = motions.front().scene;
 
   learn::RecipeOptions options = o.recipe;
   learn::LearningOptions& loop = options.loop;
@@ -183,10 +191,11 @@ void run_learn(const LearnOptions& o) {
     std::printf("resuming from %s at iteration %d\n", checkpoint.string().c_str(),
         resume->loop.next_iteration);
   }
-  std::printf("learning %s: %d vertices, %d tets, %d frames of dt = %g s, %d observed vertices, "
-              "nominal %s\n",
-      scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(), scene.frames, scene.dt,
-      motions[0].observed.num_observed(), scene.material.elastic->name().c_str());
+  for (const learn::Motion& m : motions)
+    std::printf("learning from %s: %d vertices, %d tets, %d frames of dt = %g s, %d observed "
+                "vertices, nominal %s\n",
+        m.name.c_str(), m.scene.mesh.num_vertices(), m.scene.mesh.num_tets(), m.scene.frames,
+        m.scene.dt, m.observed.num_observed(), m.scene.material.elastic->name().c_str());
   std::fflush(stdout);
   const double diagonal = scene.mesh.bounding_box_diagonal();
 
@@ -227,16 +236,20 @@ void run_learn(const LearnOptions& o) {
   }
   io::MaterialFile learned;
   learned.material = chosen.kind == learn::CandidateKind::Nominal
-      ? scene_file.nominal_material
+      ? set.nominal_material
       : io::with_nominal_parameters(
-          scene_file.nominal_material, result.parameter_fit.fitted, options.fit_parameters);
+          set.nominal_material, result.parameter_fit.fitted, options.fit_parameters);
   learned.correction = chosen.correction;
   sim::Scene training_scene = scene;
   training_scene.material = result.material(scene.material);
   training_scene.material.correction = nullptr;
   learned.training_stretches = learn::training_stretch_range(training_scene, chosen.correction);
-  learned.training = { { "scene", o.scene }, { "observations", o.observations },
-    { "observed_vertices", motions[0].observed.num_observed() },
+  nlohmann::json motion_names = nlohmann::json::array();
+  for (const auto& f : set.files)
+    motion_names.push_back(
+        { { "scene", f.paths.scene.string() }, { "observations", f.paths.observations.string() } });
+  learned.training = { { training_set ? "training_set" : "scene", o.scene },
+    { "motions", motion_names }, { "observed_vertices", motions[0].observed.num_observed() },
     { "best_iteration", result.loop.best_iteration },
     { "best_rms_error_m", result.loop.best_error }, { "options", inputs.options },
     { "recipe", recipe_json(result) }, { "seconds", result.seconds },
@@ -278,11 +291,13 @@ void add_learn_command(CLI::App& root) {
   auto o = std::make_shared<LearnOptions>();
   auto* cmd = root.add_subcommand(
       "learn", "Learn a material correction from observed vertex trajectories");
-  cmd->add_option("scene", o->scene, "scene with the nominal material (elastolearn-scene/1 JSON)")
+  cmd->add_option("scene", o->scene,
+         "scene with the nominal material (elastolearn-scene/1 JSON), or a training set of "
+         "several motions (elastolearn-training/1 JSON)")
       ->required();
-  cmd->add_option(
-         "--observations", o->observations, "observation HDF5 (from observe, or your capture)")
-      ->required();
+  cmd->add_option("--observations", o->observations,
+      "observation HDF5 of the scene's motion (from observe, or your capture); not with a "
+      "training set");
   cmd->add_option("-o,--output", o->output, "learned material JSON to write")->required();
   cmd->add_option("--report", o->report, "folder for convergence.csv and report.json");
   cmd->add_option(
@@ -352,6 +367,8 @@ void add_learn_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--kernel-smoothing", l.rbf.epsilon, "RBF kernel smoothing ε (in stretch units)")
       ->capture_default_str();
+  cmd->add_flag("!--stress-kernels", l.rbf.energy_kernels,
+      "RBF kernels of the principal stress (paper Eq. 10) instead of an energy's (default)");
   cmd->add_flag("--neo-hookean-tail", l.rbf.neo_hookean_tail,
       "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");
   cmd->add_flag("--damping-quadratic-tail", l.rbf.damping_quadratic_tail,

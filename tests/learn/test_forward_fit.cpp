@@ -197,6 +197,82 @@ TEST(ForwardFit, ElasticPriorHoldsTheElasticCorrectionNearZero) {
   EXPECT_LT(free.rms_history.back(), held.rms_history.back());
 }
 
+TEST(ForwardFit, SeveralMotionsSumTheirNormalEquationsAndFitTogether) {
+  // A training set of two motions of one material on different meshes: the droop of the small
+  // bar and the swing of a shorter, coarser one, both of the truth = nominal + a correction the
+  // design expresses. The pass over both is the sum of their passes (exactly: the sums are formed
+  // in motion order), one motion through the span is that motion's pass, and the fit over both
+  // recovers the correction as the single-motion fit does.
+  RbfFitOptions rbf;
+  rbf.fit_damping = false;
+  const RbfDesign design(centres(), rbf);
+  VecX truth_unknowns = VecX::Zero(design.num_unknowns());
+  truth_unknowns[0] = -2e3;
+  truth_unknowns[4] = 8e3;
+  truth_unknowns[5] = 2e3;
+  const auto truth = std::make_shared<material::RbfCorrection>(design.correction(truth_unknowns));
+  sim::Scene droop = small_bar(),
+             swing = test::bar_scene({ .size = { 0.25, 0.06, 0.06 },
+                 .cells = { 3, 1, 1 },
+                 .young = 2e4,
+                 .alpha0 = 0.5,
+                 .dt = 5e-3,
+                 .frames = 30 });
+  swing.initial.kind = sim::InitialCondition::Kind::Velocity;
+  swing.initial.angular_velocity = Vec3(0, 0, 3.0);
+  const std::vector<Motion> motions { { "droop", droop,
+                                          observe_run(sim::with_correction(droop, truth)) },
+    { "swing", swing, observe_run(sim::with_correction(swing, truth)) } };
+  const std::vector<ReconstructionMesh> meshes { ReconstructionMesh(droop.mesh, droop.material),
+    ReconstructionMesh(swing.mesh, swing.material) };
+
+  VecX w = 0.5 * truth_unknowns;
+  const ForwardSensitivityPass both
+      = simulate_with_sensitivities(motions, meshes, design, w, Sensitivities::projected);
+  const ForwardSensitivityPass a = simulate_with_sensitivities(
+      droop, motions[0].observed, meshes[0], design, w, Sensitivities::projected);
+  const ForwardSensitivityPass b = simulate_with_sensitivities(
+      swing, motions[1].observed, meshes[1], design, w, Sensitivities::projected);
+  ASSERT_TRUE(both.completed && a.completed && b.completed) << both.message;
+  EXPECT_GT(b.squared_error, 0);
+  EXPECT_EQ(both.normal, MatX(a.normal + b.normal));
+  EXPECT_EQ(both.gradient, VecX(a.gradient + b.gradient));
+  EXPECT_EQ(both.squared_error, a.squared_error + b.squared_error);
+  EXPECT_EQ(both.error.samples, a.error.samples + b.error.samples);
+  EXPECT_EQ(both.error.max, std::max(a.error.max, b.error.max));
+  EXPECT_NEAR(both.error.rms * both.error.rms * double(both.error.samples), both.squared_error,
+      1e-12 * both.squared_error);
+  const ForwardSensitivityPass one = simulate_with_sensitivities(
+      std::span(motions).first(1), std::span(meshes).first(1), design, w, Sensitivities::projected);
+  EXPECT_EQ(one.normal, a.normal);
+  EXPECT_EQ(one.squared_error, a.squared_error);
+  EXPECT_EQ(one.error.rms, a.error.rms);
+
+  ForwardFitOptions options;
+  options.max_iterations = 4;
+  const ForwardFitResult fit
+      = fit_to_observations(motions, meshes, design, VecX::Zero(design.num_unknowns()), options);
+  ASSERT_EQ(fit.rms_history.size(), 5u);
+  EXPECT_LT(fit.rms_history.back(), 1e-2 * fit.rms_history.front())
+      << "rms " << fit.rms_history.front() << " → " << fit.rms_history.back();
+  const Vec3 probe(1.03, 0.99, 0.985);
+  const Vec3 want = truth->correction(probe, Vec3::Zero());
+  const Vec3 got = design.correction(fit.unknowns).correction(probe, Vec3::Zero());
+  EXPECT_LE((got - want).norm(), 0.05 * want.norm())
+      << "got " << got.transpose() << ", want " << want.transpose();
+
+  // A correction whose simulation diverges: the pass stops and names the motion.
+  VecX unstable = VecX::Zero(design.num_unknowns());
+  unstable[4] = -1e6; // own slope 50× the nominal's 2μ + λ, negative
+  const ForwardSensitivityPass diverged
+      = simulate_with_sensitivities(motions, meshes, design, unstable, Sensitivities::none);
+  EXPECT_FALSE(diverged.completed);
+  EXPECT_EQ(diverged.message.rfind("motion droop: ", 0), 0u) << diverged.message;
+  EXPECT_THROW(simulate_with_sensitivities(
+                   std::span(motions), std::span(meshes).first(1), design, w, Sensitivities::none),
+      InputError);
+}
+
 TEST(ForwardFit, RejectsBadOptions) {
   ForwardFitOptions options;
   options.max_iterations = -1;

@@ -240,30 +240,67 @@ TEST(RbfDesign, OutputGradientMatchesFiniteDifferences) {
   // layout error is O(1).
   MatX centres(3, 3);
   centres << 1.1, 1.0, 0.9, 1.0, 0.95, 0.9, 1.2, 1.1, 0.8;
-  RbfFitOptions options;
-  options.neo_hookean_tail = true; // every column type
-  const RbfDesign design(centres, options);
-  const int u = design.elastic_unknowns();
-  RbfDesign::OutputMatrix a(3, u), plus(3, u), minus(3, u), again(3, u);
-  RbfDesign::OutputGradient gradient(9, u);
-  for (const Vec3& s : { Vec3(1.05, 0.93, 0.97), Vec3(0.8, 1.2, 1.0), Vec3(1.3, 0.9, 0.7) }) {
-    design.output_matrix(s, a, gradient);
-    design.output_matrix(s, again);
-    EXPECT_EQ(a, again); // the same A as the plain call
-    for (int j = 0; j < 3; ++j) {
-      const double h = 1e-6;
-      Vec3 sp = s, sm = s;
-      sp[j] += h;
-      sm[j] -= h;
-      design.output_matrix(sp, plus);
-      design.output_matrix(sm, minus);
-      for (int k = 0; k < 3; ++k)
-        for (int i = 0; i < u; ++i)
-          EXPECT_NEAR(gradient(3 * j + k, i), (plus(k, i) - minus(k, i)) / (2 * h), 1e-7)
-              << "σ = " << s.transpose() << ", ∂/∂σ_" << j << " of output " << k << ", unknown "
-              << i;
+  for (const bool energy : { false, true }) {
+    SCOPED_TRACE(energy ? "energy kernels" : "stress kernels");
+    RbfFitOptions options;
+    options.neo_hookean_tail = true; // every column type
+    options.energy_kernels = energy;
+    options.epsilon = energy ? 0.03 : 1e-3;
+    const RbfDesign design(centres, options);
+    const int u = design.elastic_unknowns();
+    RbfDesign::OutputMatrix a(3, u), plus(3, u), minus(3, u), again(3, u);
+    RbfDesign::OutputGradient gradient(9, u);
+    for (const Vec3& s : { Vec3(1.05, 0.93, 0.97), Vec3(0.8, 1.2, 1.0), Vec3(1.3, 0.9, 0.7) }) {
+      design.output_matrix(s, a, gradient);
+      design.output_matrix(s, again);
+      EXPECT_EQ(a, again); // the same A as the plain call
+      for (int j = 0; j < 3; ++j) {
+        const double h = 1e-6;
+        Vec3 sp = s, sm = s;
+        sp[j] += h;
+        sm[j] -= h;
+        design.output_matrix(sp, plus);
+        design.output_matrix(sm, minus);
+        for (int k = 0; k < 3; ++k)
+          for (int i = 0; i < u; ++i)
+            EXPECT_NEAR(gradient(3 * j + k, i), (plus(k, i) - minus(k, i)) / (2 * h), 1e-7)
+                << "σ = " << s.transpose() << ", ∂/∂σ_" << j << " of output " << k << ", unknown "
+                << i;
+      }
     }
   }
+}
+
+TEST(RbfDesign, EnergyKernelsRoundTripAndMatchTheCorrection) {
+  // A x is the correction built from x (what the reconstruction fits is what the simulator
+  // evaluates), unknowns() inverts correction(), and the correction is an energy.
+  MatX centres(3, 3);
+  centres << 1.1, 1.0, 0.9, 1.0, 0.95, 0.9, 1.2, 1.1, 0.8;
+  RbfFitOptions options;
+  options.energy_kernels = true;
+  options.neo_hookean_tail = true;
+  options.epsilon = 0.03;
+  const RbfDesign design(centres, options);
+  EXPECT_EQ(design.elastic_unknowns(), 3 + 2 + 3 + 2); // kernels, a b, 3 cubic energies, r
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0.0, 1e3);
+  VecX x(design.num_unknowns());
+  for (auto& v : x)
+    v = g(rng);
+  const material::RbfCorrection n = design.correction(x);
+  EXPECT_TRUE(n.parameters().energy_kernels);
+  EXPECT_LE((design.unknowns(n) - x).norm(), 1e-12 * x.norm());
+  RbfDesign::OutputMatrix a(3, design.elastic_unknowns());
+  for (const Vec3& s : { Vec3(1.05, 0.93, 0.97), Vec3(0.8, 1.2, 1.0), Vec3(1, 1, 1) }) {
+    design.output_matrix(s, a);
+    const Vec3 fitted = a * x.head(design.elastic_unknowns());
+    EXPECT_LE((fitted - n.correction(s, Vec3::Zero())).norm(), 1e-9 * x.norm())
+        << "σ = " << s.transpose();
+  }
+  EXPECT_LE(n.correction(Vec3::Ones(), Vec3::Zero()).norm(), 1e-10 * x.norm()) << "stress-free";
+  RbfFitOptions stress = options;
+  stress.energy_kernels = false;
+  EXPECT_THROW(RbfDesign(centres, stress).unknowns(n), InputError);
 }
 
 TEST(RbfDesign, StressFreeRestKeepsTheRestShapeUnstressed) {

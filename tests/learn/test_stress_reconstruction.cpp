@@ -351,6 +351,112 @@ TEST(StressReconstruction, RejectsInconsistentFrames) {
       InputError);
 }
 
+TEST(StressReconstruction, SeveralMotionsFitOneCorrectionToAllTheirEquations) {
+  // A training set's reconstruction sums every motion's equations. With targets that no
+  // correction explains exactly (the known correction's forces plus 30 % noise), the fit depends
+  // on which equations it sees: ten frames split into two motions of the same mesh must give the
+  // fit of one motion of all ten (bit for bit here: with at most 16 frames each frame's sums
+  // form their own block, added in the same order; 1e-10 allows for other block splits), while
+  // a dropped or doubled frame moves it far more. A second motion of another mesh, with exact
+  // targets of the same correction, is fitted jointly: the truth comes back, and the misfit
+  // covers every motion's frames. The lsqr method joins the motions' samples.
+  const KnownAnswer k(1e-13);
+  std::mt19937 random(3);
+  std::normal_distribution<double> normal;
+  std::vector<VecX> noisy = k.targets;
+  for (VecX& target : noisy) {
+    VecX noise(target.size());
+    for (Eigen::Index i = 0; i < noise.size(); ++i)
+      noise[i] = normal(random);
+    target += 0.3 * target.norm() / noise.norm() * noise;
+  }
+  const auto head = [](const std::vector<VecX>& v, size_t n) {
+    return std::vector<VecX>(v.begin(), v.begin() + long(n));
+  };
+  const auto tail = [](const std::vector<VecX>& v, size_t n) {
+    return std::vector<VecX>(v.begin() + long(n), v.end());
+  };
+  const std::vector<VecX> x0 = head(k.frames.positions, 4), x1 = tail(k.frames.positions, 4),
+                          v0 = head(k.frames.velocities, 4), v1 = tail(k.frames.velocities, 4),
+                          g0 = head(noisy, 4), g1 = tail(noisy, 4);
+  const MatX none;
+  const std::vector<ReconstructionMotion> split { { k.geometry, k.dofs, x0, v0, g0, none },
+    { k.geometry, k.dofs, x1, v1, g1, none } };
+  const StressReconstructionResult whole = reconstruct_rbf_correction(
+      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, noisy);
+  const StressReconstructionResult joint = reconstruct_rbf_correction(split, k.design);
+  const auto distance = [&](const StressReconstructionResult& r) {
+    return (r.unknowns - whole.unknowns).norm() / whole.unknowns.norm();
+  };
+  EXPECT_LT(distance(joint), 1e-10);
+  EXPECT_EQ(joint.misfit.frames, 10);
+  EXPECT_NEAR(
+      joint.misfit.rms_residual, whole.misfit.rms_residual, 1e-12 * whole.misfit.rms_residual);
+  EXPECT_NEAR(joint.misfit.rms_target, whole.misfit.rms_target, 1e-12 * whole.misfit.rms_target);
+  EXPECT_EQ(joint.rows_per_frame, 2 * k.dofs.num_free());
+  const std::vector<VecX> x1_doubled = tail(k.frames.positions, 3),
+                          v1_doubled = tail(k.frames.velocities, 3), g1_doubled = tail(noisy, 3);
+  const std::vector<ReconstructionMotion> overlapping { { k.geometry, k.dofs, x0, v0, g0, none },
+    { k.geometry, k.dofs, x1_doubled, v1_doubled, g1_doubled, none } };
+  const double doubled = distance(reconstruct_rbf_correction(overlapping, k.design));
+  const double dropped = distance(reconstruct_rbf_correction(std::span(split).first(1), k.design));
+  std::printf("[ measured ] fit moved by a doubled frame %.1e, by dropping a motion %.1e\n",
+      doubled, dropped);
+  EXPECT_GT(doubled, 1e-2); // measured 0.11
+  EXPECT_GT(dropped, 1e-2); // measured 0.58
+  // One motion through the span is the single-motion fit, bit for bit.
+  const StressReconstructionResult one = reconstruct_rbf_correction(
+      std::span(split).first(1), k.design, StressReconstructionOptions {});
+  const StressReconstructionResult first
+      = reconstruct_rbf_correction(k.geometry, k.dofs, k.design, x0, v0, g0);
+  EXPECT_EQ(one.unknowns, first.unknowns);
+  EXPECT_EQ(one.misfit.rms_residual, first.misfit.rms_residual);
+
+  // Another mesh, the same correction.
+  const mesh::TetMesh other = mesh::make_box_bar(Vec3(0.3, 0.08, 0.06), { 4, 2, 1 });
+  const ReconstructionMesh other_geometry(other, nominal_material(k.alpha1));
+  const fem::DofMap other_dofs(other.num_vertices(), left_face(other));
+  const Frames other_frames = make_frames(other, 6, 9);
+  const material::RbfCorrection truth = k.design.correction(k.truth);
+  std::vector<VecX> other_targets;
+  for (size_t t = 0; t < other_frames.positions.size(); ++t)
+    other_targets.push_back(elastic_force_difference(
+        other, truth, other_frames.positions[t], other_frames.velocities[t], k.alpha1));
+  const std::vector<VecX> exact0 = head(k.targets, 4);
+  const std::vector<ReconstructionMotion> meshes { { k.geometry, k.dofs, x0, v0, exact0, none },
+    { other_geometry, other_dofs, other_frames.positions, other_frames.velocities, other_targets,
+        none } };
+  const StressReconstructionResult both = reconstruct_rbf_correction(meshes, k.design);
+  EXPECT_LT((both.unknowns - k.truth).norm(), 1e-6 * k.truth.norm());
+  EXPECT_EQ(both.misfit.frames, 10);
+  EXPECT_LT(both.misfit.rms_residual, 1e-8 * both.misfit.rms_target);
+  // A misfit over both meshes: each motion's mean square weighted by its frames × free vertices.
+  const ForceMisfit a = correction_force_misfit(k.geometry, k.dofs, truth, x0, v0, exact0),
+                    b = correction_force_misfit(other_geometry, other_dofs, truth,
+                        other_frames.positions, other_frames.velocities, other_targets);
+  const double wa = 4.0 * k.dofs.num_free(), wb = 6.0 * other_dofs.num_free();
+  EXPECT_NEAR(both.misfit.rms_target,
+      std::sqrt((wa * a.rms_target * a.rms_target + wb * b.rms_target * b.rms_target) / (wa + wb)),
+      1e-12 * both.misfit.rms_target);
+
+  // The lsqr method fits one RBF to every motion's element-stress samples, in motion then frame
+  // order: split into two motions, the samples are those of the whole, and so is the fit.
+  StressReconstructionOptions lsqr;
+  lsqr.method = ReconstructionMethod::lsqr;
+  const StressReconstructionResult lsqr_whole = reconstruct_rbf_correction(
+      k.geometry, k.dofs, k.design, k.frames.positions, k.frames.velocities, noisy, lsqr);
+  const StressReconstructionResult lsqr_joint = reconstruct_rbf_correction(split, k.design, lsqr);
+  EXPECT_EQ(lsqr_joint.unknowns, lsqr_whole.unknowns);
+  EXPECT_EQ(lsqr_joint.stress_rms_residual, lsqr_whole.stress_rms_residual);
+  EXPECT_EQ(lsqr_joint.lsqr_max_iterations, lsqr_whole.lsqr_max_iterations);
+  EXPECT_EQ(lsqr_joint.misfit.frames, 10);
+  EXPECT_EQ(reconstruct_rbf_correction(meshes, k.design, lsqr).misfit.frames, 10);
+
+  // No motion is refused.
+  EXPECT_THROW(
+      reconstruct_rbf_correction(std::span<const ReconstructionMotion>(), k.design), InputError);
+}
+
 TEST(StressReconstructionLsqr, MinimumNormLeastSquaresStresses) {
   // 12 tets (36 stresses) and 12 vertices, 2 fixed: 30 free dofs, so B has a null space. No
   // nominal model: correction_force is then the elastic part B p̂ alone.

@@ -106,3 +106,28 @@ TEST(TrajectoryError, RejectsEmptyAndMismatchedInput) {
   EXPECT_THROW(position_error(a, a, { 4 }), InputError);
   EXPECT_THROW(position_error(a, a, { -1 }), InputError);
 }
+
+TEST(TrajectoryError, CombinedErrorIsTheErrorOverTheUnionOfThePairs) {
+  // Two motions of different sizes: the combined summary is the one of all their pairs at once
+  // (the second motion's error 5 is the max, at its own frame and vertex); one part is returned
+  // as it is, and no part is the empty summary.
+  const auto a = ramp(3, 4), c = ramp(2, 3);
+  auto b = a, d = c;
+  b[2].segment<3>(3 * 0) += Vec3(0, 0, 1); // error 1 in the first motion
+  d[1].segment<3>(3 * 2) += Vec3(3, 4, 0); // error 5 at frame 1, vertex 2 of the second
+  const ErrorSummary first = position_error(a, b), second = position_error(c, d);
+  const std::vector<ErrorSummary> parts { first, second };
+  const ErrorSummary both = combined_error(parts);
+  EXPECT_EQ(both.samples, 12 + 6);
+  EXPECT_DOUBLE_EQ(both.max, 5.0);
+  EXPECT_EQ(both.worst_frame, 1);
+  EXPECT_EQ(both.worst_vertex, 2);
+  EXPECT_DOUBLE_EQ(both.mean, 6.0 / 18.0);
+  EXPECT_DOUBLE_EQ(both.rms, std::sqrt(26.0 / 18.0));
+  const ErrorSummary one = combined_error(std::span(parts).first(1));
+  EXPECT_EQ(one.rms, first.rms);
+  EXPECT_EQ(one.mean, first.mean);
+  EXPECT_EQ(one.samples, first.samples);
+  EXPECT_EQ(combined_error({}).samples, 0);
+  EXPECT_EQ(combined_error({}).worst_frame, -1);
+}

@@ -3,7 +3,10 @@
 // parameter validation.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/material/corotated.hpp>
+#include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/material/rbf_correction.hpp>
+
+#include <Eigen/Eigenvalues>
 
 #include <support/finite_difference.hpp>
 
@@ -297,4 +300,97 @@ TEST(RbfCorrection, RepeatedBlendsWithTheSameCorrectionKeepSharedCentresOnce) {
     EXPECT_NEAR(quarter.stiffness_damping(s),
         0.25 * c.stiffness_damping(s) + 0.75 * best.stiffness_damping(s), 1e-14);
   }
+}
+
+namespace {
+
+/// test_parameters with energy kernels: the quadratic tail moved into the energy subspace
+/// (q₁ = 2 q₂), ε large enough that every stencil is smooth.
+RbfCorrection energy_correction() {
+  RbfCorrection::Parameters p = test_parameters(0.03);
+  p.energy_kernels = true;
+  p.quadratic[1] = 2 * p.quadratic[2];
+  return RbfCorrection(std::move(p));
+}
+
+const std::vector<Vec3> k_energy_states { Vec3(1.15, 0.97, 0.88), Vec3(1.4, 1.2, 0.6),
+  Vec3(0.9, 1.25, 1.02), Vec3(1.05, 1.05, 0.9) /* a tie */, Vec3(1.0, 1.0, 1.0) };
+
+} // namespace
+
+TEST(RbfCorrectionEnergy, StressIsTheGradientOfTheEnergy) {
+  // N = ∇ΔΨ by 4th-order central differences of elastic_energy (h = 1e-4: truncation
+  // ~ (h/ε)⁴ ≈ 1e-10 relative; round-off 1e-16·|Ψ| / h with |Ψ| ~ 1e4 J/m³: 1e-8 Pa).
+  const RbfCorrection n = energy_correction();
+  for (const Vec3& s : k_energy_states) {
+    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+    Eigen::MatrixXd stress(1, 3);
+    stress.row(0) = n.elastic_correction(s).transpose();
+    const FdFunction energy = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+      return Eigen::VectorXd::Constant(1, n.elastic_energy(y.head<3>()));
+    };
+    expect_jacobian_matches(stress, energy, Eigen::VectorXd(s), 1e-7, 1e-4);
+  }
+}
+
+TEST(RbfCorrectionEnergy, TangentIsSymmetricAndMatchesFiniteDifferences) {
+  const RbfCorrection n = energy_correction();
+  for (const Vec3& s : k_energy_states) {
+    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+    expect_gradient_matches_fd(n, s, Vec3::Zero(), 1e-7);
+    Mat3 ds, dr;
+    n.correction_gradient(s, Vec3::Zero(), ds, dr);
+    EXPECT_LE((ds - ds.transpose()).norm(), 1e-10 * ds.norm()) << ds;
+  }
+}
+
+TEST(RbfCorrectionEnergy, EqualStretchesGiveEqualStresses) {
+  // Continuity of P = U diag(P̂ + N) Vᵀ at repeated stretches, where U, V are not unique.
+  const RbfCorrection n = energy_correction();
+  const Vec3 a = n.elastic_correction(Vec3(1.05, 1.05, 0.9));
+  EXPECT_NEAR(a[0], a[1], 1e-9 * a.norm());
+  const Vec3 rest = n.elastic_correction(Vec3::Ones());
+  EXPECT_NEAR(rest[0], rest[2], 1e-9 * (rest.norm() + 1));
+}
+
+TEST(RbfCorrectionEnergy, StressKernelsAreNotAnEnergy) {
+  // What the energy kernels fix: the stress kernels' tangent is not symmetric in general.
+  const RbfCorrection n(test_parameters(0.03));
+  Mat3 ds, dr;
+  n.correction_gradient(Vec3(1.15, 0.97, 0.88), Vec3::Zero(), ds, dr);
+  EXPECT_GT((ds - ds.transpose()).norm(), 1e-3 * ds.norm());
+  EXPECT_THROW(n.elastic_energy(Vec3::Ones()), InputError);
+}
+
+TEST(RbfCorrectionEnergy, RefusesAQuadraticTailThatIsNotAGradient) {
+  RbfCorrection::Parameters p = test_parameters(0.03);
+  p.energy_kernels = true; // q = (3e4, −2e4, 1e4, 4e4): q₁ ≠ 2 q₂
+  EXPECT_THROW(RbfCorrection(std::move(p)), InputError);
+}
+
+TEST(RbfCorrectionEnergy, ProjectedTangentOfTheCorrectedModelIsPositiveSemiDefinite) {
+  // A correction that softens the model beyond stability (weights ~ the stiffness): the exact
+  // tangent of P̂ + N has negative eigenvalues, and the projected one (Newton's) is PSD.
+  RbfCorrection::Parameters p = test_parameters(0.03);
+  p.energy_kernels = true;
+  p.quadratic[1] = 2 * p.quadratic[2];
+  p.weights *= 200;
+  const RbfCorrection n(std::move(p));
+  const CorotatedModel model(Lame::from_young_poisson(1e5, 0.4));
+  bool some_negative = false;
+  for (const Vec3& s : k_energy_states) {
+    Mat3 F = Mat3::Zero();
+    F.diagonal() = s;
+    const Mat3 R = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    const PrincipalFrame frame = principal_frame(R * F);
+    const CorrectedStress c = corrected_principal_stress(model, &n, frame.stretches, Vec3::Zero());
+    const Mat9 exact = first_piola_derivative(frame, c.stress, c.d_stretches, false);
+    const Mat9 projected = first_piola_derivative(frame, c.stress, c.d_stretches, true);
+    EXPECT_LE((exact - exact.transpose()).norm(), 1e-8 * exact.norm()) << "an energy's Hessian";
+    some_negative
+        = some_negative || Eigen::SelfAdjointEigenSolver<Mat9>(exact).eigenvalues().minCoeff() < 0;
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Mat9>(projected).eigenvalues().minCoeff(),
+        -1e-9 * projected.norm());
+  }
+  EXPECT_TRUE(some_negative) << "the test's correction must make the exact tangent indefinite";
 }

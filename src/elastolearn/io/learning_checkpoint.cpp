@@ -46,6 +46,8 @@ learn::IterationRecord read_record(const JsonObject& o) {
   r.iteration = o.integer("iteration");
   r.forward_error = read_error(o.object("forward_error"));
   r.forward_completed = o.boolean("forward_completed", true);
+  r.forward_message = o.string("forward_message", "");
+  r.forward_unstable = o.boolean("forward_unstable", false);
   r.damped_update = o.boolean("damped_update", false);
   r.forward_fit = o.boolean("forward_fit", false);
   r.forward_fit_accepted = o.boolean("forward_fit_accepted", false);
@@ -56,6 +58,8 @@ learn::IterationRecord read_record(const JsonObject& o) {
   r.modes = o.integer("modes");
   r.centres = o.integer("centres");
   r.correction_misfit = o.number("correction_misfit");
+  r.stability = o.number("stability", 0.0);
+  r.step_kept = o.number("step_kept", 1.0);
   r.correction_target = o.number("correction_target");
   const JsonObject s = o.object("seconds");
   r.seconds_forward = s.number("forward");
@@ -70,12 +74,14 @@ learn::IterationRecord read_record(const JsonObject& o) {
 
 nlohmann::json iteration_record_to_json(const learn::IterationRecord& r) {
   return { { "iteration", r.iteration }, { "forward_error", error_json(r.forward_error) },
-    { "forward_completed", r.forward_completed }, { "damped_update", r.damped_update },
+    { "forward_completed", r.forward_completed }, { "forward_message", r.forward_message },
+    { "forward_unstable", r.forward_unstable }, { "damped_update", r.damped_update },
     { "forward_fit", r.forward_fit }, { "forward_fit_accepted", r.forward_fit_accepted },
     { "control_force_rms", r.control_force_rms }, { "space_time_initial", r.space_time_initial },
     { "space_time_objective", r.space_time_objective },
     { "space_time_iterations", r.space_time_iterations }, { "modes", r.modes },
     { "centres", r.centres }, { "correction_misfit", r.correction_misfit },
+    { "stability", r.stability }, { "step_kept", r.step_kept },
     { "correction_target", r.correction_target },
     { "seconds",
         { { "forward", r.seconds_forward }, { "pod", r.seconds_pod },
@@ -98,7 +104,8 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
     { "centres", o.centres }, { "full_space", o.full_space },
     { "max_reconstruction_frames", o.max_reconstruction_frames },
     { "rbf",
-        { { "epsilon", o.rbf.epsilon }, { "elastic_polynomial", o.rbf.elastic_polynomial },
+        { { "epsilon", o.rbf.epsilon }, { "energy_kernels", o.rbf.energy_kernels },
+            { "elastic_polynomial", o.rbf.elastic_polynomial },
             { "quadratic_tail", o.rbf.quadratic_tail },
             { "stress_free_rest", o.rbf.stress_free_rest },
             { "neo_hookean_tail", o.rbf.neo_hookean_tail }, { "fit_damping", o.rbf.fit_damping },

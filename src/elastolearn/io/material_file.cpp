@@ -41,9 +41,9 @@ Json rbf_to_json(const material::RbfCorrection& c) {
   const auto& p = c.parameters();
   // JSON has no infinity: "no floor" (−∞) is written as null.
   const Json floor = std::isfinite(p.damping_floor) ? Json(p.damping_floor) : Json(nullptr);
-  return Json { { "type", "rbf" }, { "epsilon", p.epsilon }, { "centres", rows_to_json(p.centres) },
-    { "weights", vector_to_json(p.weights) }, { "own_slope", p.own_slope },
-    { "other_slope", p.other_slope }, { "constant", p.constant },
+  return Json { { "type", "rbf" }, { "energy_kernels", p.energy_kernels }, { "epsilon", p.epsilon },
+    { "centres", rows_to_json(p.centres) }, { "weights", vector_to_json(p.weights) },
+    { "own_slope", p.own_slope }, { "other_slope", p.other_slope }, { "constant", p.constant },
     { "quadratic", vector_to_json(p.quadratic) }, { "neo_hookean", vector_to_json(p.neo_hookean) },
     { "damping_weights", vector_to_json(p.damping_weights) },
     { "damping_slopes", vector_to_json(p.damping_slopes) },
@@ -126,10 +126,11 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
 }
 
 std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o) {
-  o.reject_unknown_keys({ "type", "epsilon", "centres", "weights", "own_slope", "other_slope",
-      "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes", "damping_slope",
-      "damping_constant", "damping_quadratic", "damping_floor" });
+  o.reject_unknown_keys({ "type", "energy_kernels", "epsilon", "centres", "weights", "own_slope",
+      "other_slope", "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes",
+      "damping_slope", "damping_constant", "damping_quadratic", "damping_floor" });
   material::RbfCorrection::Parameters p;
+  p.energy_kernels = o.boolean("energy_kernels", false); // absent: the stress kernels
   p.epsilon = o.number("epsilon");
   p.centres = read_rows(o, "centres", -1, 3);
   p.weights = read_vector(o, "weights", p.centres.rows());

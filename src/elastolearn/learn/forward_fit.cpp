@@ -1,6 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
 #include <elastolearn/learn/levenberg_marquardt.hpp>
+#include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/trajectory_physics.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 #include <elastolearn/sim/simulator.hpp>
@@ -168,8 +169,53 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
   return pass;
 }
 
+ForwardSensitivityPass simulate_with_sensitivities(std::span<const Motion> motions,
+    std::span<const ReconstructionMesh> meshes, const RbfDesign& design, const VecX& unknowns,
+    Sensitivities mode, const ProgressCallback& progress) {
+  if (motions.empty() || motions.size() != meshes.size())
+    throw InputError("forward_fit.motions",
+        "needs one reconstruction mesh per motion and at least one motion (got "
+            + std::to_string(motions.size()) + " motions, " + std::to_string(meshes.size())
+            + " meshes)");
+  ForwardSensitivityPass total;
+  std::vector<ErrorSummary> errors;
+  errors.reserve(motions.size());
+  for (size_t i = 0; i < motions.size(); ++i) {
+    ForwardSensitivityPass pass = simulate_with_sensitivities(
+        motions[i].scene, motions[i].observed, meshes[i], design, unknowns, mode, progress);
+    if (!pass.completed) {
+      if (motions.size() > 1)
+        pass.message = "motion " + motions[i].name + ": " + pass.message;
+      pass.seconds += total.seconds;
+      return pass;
+    }
+    errors.push_back(pass.error);
+    if (i == 0) {
+      total = std::move(pass);
+      continue;
+    }
+    total.squared_error += pass.squared_error;
+    if (mode != Sensitivities::none) {
+      total.normal += pass.normal;
+      total.gradient += pass.gradient;
+    }
+    total.seconds += pass.seconds;
+  }
+  total.error = combined_error(errors);
+  return total;
+}
+
 ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Observation& observed,
     const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start,
+    const ForwardFitOptions& options, const ProgressCallback& progress,
+    const ForwardFitStepCallback& on_step) {
+  const Motion motion { scene.name, scene, observed };
+  return fit_to_observations(
+      std::span(&motion, 1), std::span(&mesh, 1), design, start, options, progress, on_step);
+}
+
+ForwardFitResult fit_to_observations(std::span<const Motion> motions,
+    std::span<const ReconstructionMesh> meshes, const RbfDesign& design, const VecX& start,
     const ForwardFitOptions& options, const ProgressCallback& progress,
     const ForwardFitStepCallback& on_step) {
   options.validate();
@@ -177,7 +223,7 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
   ForwardFitResult result;
   result.unknowns = start;
   ForwardSensitivityPass current = simulate_with_sensitivities(
-      scene, observed, mesh, design, start, options.sensitivities, progress);
+      motions, meshes, design, start, options.sensitivities, progress);
   if (!current.completed)
     throw InputError(
         "forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
@@ -209,8 +255,22 @@ ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Obs
   };
   problem.evaluate = [&](const VecX& step) {
     trial_unknowns = result.unknowns + step;
+    if (options.stability_stretches.rows() > 0) {
+      const material::RbfCorrection c = design.correction(trial_unknowns);
+      const StabilityReport stability = material_stability(
+          *motions.front().scene.material.elastic, &c, options.stability_stretches);
+      if (!stability.stable()) {
+        trial = {};
+        trial.unstable = true;
+        trial.message = "not simulated: the trial's material is unstable at "
+            + std::to_string(stability.unstable_samples) + " of "
+            + std::to_string(stability.samples) + " stretch samples";
+        result.rms_history.push_back(-1.0);
+        return TrialEvaluation { .completed = false };
+      }
+    }
     trial = simulate_with_sensitivities(
-        scene, observed, mesh, design, trial_unknowns, options.sensitivities, progress);
+        motions, meshes, design, trial_unknowns, options.sensitivities, progress);
     result.rms_history.push_back(trial.completed ? trial.error.rms : -1.0);
     TrialEvaluation evaluation { .completed = trial.completed };
     if (trial.completed)

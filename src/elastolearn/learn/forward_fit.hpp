@@ -12,12 +12,14 @@
 /// factorisation and a solve with one right-hand side per unknown.
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/correction_force.hpp>
+#include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
 #include <elastolearn/learn/trajectory_error.hpp>
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>
 
 #include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,8 @@ namespace elastolearn::learn {
 /// the Gauss–Newton normal equations of E at its unknowns.
 struct ForwardSensitivityPass {
   bool completed = false;
+  /// Not simulated: the correction is unstable at ForwardFitOptions::stability_stretches.
+  bool unstable = false;
   std::string message; ///< why the simulation stopped, if it did
   ErrorSummary error; ///< at the observed vertices, all frames [m]
   double squared_error = 0; ///< E [m²]
@@ -48,6 +52,16 @@ enum class Sensitivities {
 ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
     const observe::Observation& observed, const ReconstructionMesh& mesh, const RbfDesign& design,
     const VecX& unknowns, Sensitivities sensitivities, const ProgressCallback& progress = {});
+
+/// The same pass over several motions (a training set) with the same unknowns: E and its normal
+/// equations are the sums over motions, `error` the statistics over all their observations
+/// (combined_error) and `seconds` the sum. `meshes[i]` is the reconstruction mesh of
+/// motions[i].scene. The pass stops at the first motion whose simulation diverges (with two or
+/// more motions its message names the motion). One motion gives exactly its own pass.
+/// Throws InputError if the spans differ in length or are empty.
+ForwardSensitivityPass simulate_with_sensitivities(std::span<const Motion> motions,
+    std::span<const ReconstructionMesh> meshes, const RbfDesign& design, const VecX& unknowns,
+    Sensitivities sensitivities, const ProgressCallback& progress = {});
 
 struct ForwardFitOptions {
   int max_iterations = 0; ///< trial steps (one forward simulation each) after the start
@@ -72,6 +86,10 @@ struct ForwardFitOptions {
   /// stiffness damping from an elastic softening, and a free fit may split the two wrongly
   /// (docs/learning.md, "Forward fit"). 0 turns the prior off.
   double elastic_prior = 0;
+  /// Principal stretches (N × 3) where every trial's material must be stable
+  /// (material_stability.hpp); a trial that is not is rejected without being simulated (its
+  /// simulation would diverge or stall). Empty: no check.
+  MatX stability_stretches;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;
 };
@@ -89,7 +107,16 @@ using ForwardFitStepCallback = std::function<bool(
     const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping)>;
 
 /// Levenberg–Marquardt from `start` (unknowns in design's layout), with options.damping as the
-/// first μ. Throws InputError for invalid options or if the start's simulation diverges.
+/// first μ, on E summed over `motions` (each with its reconstruction mesh `meshes[i]`; the
+/// motions share the nominal material, their meshes may differ). A trial is rejected if any
+/// motion's simulation diverges. Throws InputError for invalid options, spans that differ in
+/// length or are empty, or if the start's simulation diverges.
+ForwardFitResult fit_to_observations(std::span<const Motion> motions,
+    std::span<const ReconstructionMesh> meshes, const RbfDesign& design, const VecX& start,
+    const ForwardFitOptions& options, const ProgressCallback& progress = {},
+    const ForwardFitStepCallback& on_step = {});
+
+/// One motion: `scene` (the nominal model) against `observed`, `mesh` its reconstruction mesh.
 ForwardFitResult fit_to_observations(const sim::Scene& scene, const observe::Observation& observed,
     const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& start,
     const ForwardFitOptions& options, const ProgressCallback& progress = {},

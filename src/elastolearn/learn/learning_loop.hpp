@@ -19,6 +19,7 @@
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
 #include <elastolearn/learn/kmeans.hpp>
+#include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/pod_basis.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
 #include <elastolearn/learn/space_time.hpp>
@@ -30,6 +31,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -65,11 +67,13 @@ struct LearningOptions {
   /// reconstruction"). Not used by the full-space variant (there span Φ is everything) nor by
   /// the lsqr reconstruction method.
   bool projected_reconstruction = true;
-  /// Use at most this many frames in the reconstruction (a larger frame stride when there are
-  /// more; 0 = all). Consecutive frames are nearly the same equations: 150 keep the fit's
-  /// information at a fraction of the cost on long, finely stepped runs.
+  /// Use at most this many frames of each motion in the reconstruction (a larger frame stride,
+  /// the same for every motion, when the longest has more; 0 = all). Consecutive frames are
+  /// nearly the same equations: 150 keep the fit's information at a fraction of the cost on
+  /// long, finely stepped runs.
   int max_reconstruction_frames = 150;
-  /// Samples for k-means; capped so that clustering stays cheap on big meshes and long runs.
+  /// Samples for k-means, per motion; capped so that clustering stays cheap on big meshes and
+  /// long runs.
   StretchSampleOptions stretch_samples = { 1, 100000 };
   std::uint64_t seed = 1; ///< k-means seeding
   /// After the loop: Levenberg–Marquardt steps on the forward simulation's error itself, from
@@ -88,19 +92,31 @@ struct IterationRecord {
   int iteration = 0; ///< k (0: the nominal model)
   ErrorSummary forward_error; ///< of C_k's forward simulation at the observed vertices [m]
   bool forward_completed = true; ///< false if C_k's forward simulation diverged
+  std::string forward_message; ///< why it diverged (names the frame); empty when it completed
+  /// A forward-fit trial rejected unsimulated: its material is unstable (forward_completed is
+  /// false, but nothing diverged).
+  bool forward_unstable = false;
   /// C_k diverged and C_{k+1} = ½ (C_k + best) was tried instead (a damped update).
   bool damped_update = false;
   /// A step of the forward fit after the loop (no trajectory stages): C_k is the trial, and
   /// forward_fit_accepted says whether it lowered the error (and became the best).
   bool forward_fit = false;
   bool forward_fit_accepted = false;
-  double control_force_rms = 0; ///< √(mean r²) of the optimised trajectory [N]
+  /// √(mean r²) of the optimised trajectories (over every motion's steps and free dofs) [N]
+  double control_force_rms = 0;
   double space_time_initial = 0; ///< E at the constrained simulation
   double space_time_objective = 0; ///< E after optimisation
   int space_time_iterations = 0;
-  int modes = 0;
+  int modes = 0; ///< POD modes (summed over the motions)
   int centres = 0;
-  double correction_misfit = 0; ///< RMS force misfit of C_{k+1} against its targets [N]
+  /// RMS force misfit of C_{k+1} against its targets (every motion's frames) [N]
+  double correction_misfit = 0;
+  /// The reconstructed correction's material_stability over its trajectories' stretches
+  /// (min_relative_eigenvalue: < 0 where it is unstable).
+  double stability = 0;
+  /// The fraction of the reconstructed correction kept to stay stable (1: all; 0: none, the
+  /// next iteration simulates the nominal).
+  double step_kept = 1;
   double correction_target = 0; ///< RMS of those targets [N]
   double seconds_forward = 0, seconds_pod = 0, seconds_constrained = 0, seconds_space_time = 0,
          seconds_reconstruction = 0;
@@ -132,11 +148,22 @@ struct LearningCallbacks {
   std::function<bool()> interrupted; ///< polled between stages
 };
 
-/// Run (or continue, from `state`) the loop for `scene` (the nominal model: its material must
-/// not carry a correction) against `observed` (T + 1 frames = scene.frames + 1, same dt).
+/// Run (or continue, from `state`) the loop on `motions` (a training set, at least one): each
+/// scene is the nominal model (its material must not carry a correction; every motion has the
+/// same nominal material, their meshes, boundary conditions and lengths may differ) with its
+/// observations (T + 1 frames = scene.frames + 1, same dt). One correction is learned from all:
+/// each iteration simulates every motion (the convergence signal is the RMS error over all their
+/// observations; the iteration diverged if any motion did), runs stages 2–4 per motion with its
+/// own mesh and basis, and fits one correction to every motion's reconstruction equations
+/// (centres by k-means over all their stretches). The forward fit minimises the error summed
+/// over the motions. The record's counts, objectives and times are sums over the motions.
 /// On return `state.best` is the learned correction (null if nothing beat the nominal model).
 /// Returns false if interrupted (state is then the last checkpoint's). Throws InputError for
-/// invalid inputs.
+/// invalid inputs (with several motions the field names the motion: "motions[i].observations").
+bool run_learning(std::span<const Motion> motions, const LearningOptions& options,
+    LearningState& state, const LearningCallbacks& callbacks = {});
+
+/// One motion: `scene` against `observed` (as a training set of that one motion).
 bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
     const LearningOptions& options, LearningState& state, const LearningCallbacks& callbacks = {});
 

@@ -33,6 +33,8 @@ std::string to_string(CandidateKind kind) {
 RecipeOptions::RecipeOptions() {
   parameter_fit.max_iterations = 10;
   loop.forward_fit.max_iterations = 3;
+  loop.rbf.energy_kernels = true;
+  loop.rbf.epsilon = 0.03;
 }
 
 void RecipeOptions::validate() const {
@@ -237,7 +239,8 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   result.validation_data = split.description;
   say(callbacks, "validation: " + split.description);
 
-  // Stage 2: the nominal model's parameters.
+  // Stage 2: the nominal model's parameters, fitted to the first training motion (the
+  // parameter fit takes one motion).
   const Motion& train = split.raw_training.front();
   if (resume) {
     result.parameter_fit = resume->parameter_fit;
@@ -260,9 +263,11 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
       = scene_with_parameters(train.scene, result.nominal_type, result.parameter_fit.fitted)
             .material;
 
-  // Stage 3: the loop (and its forward fit) on the fitted nominal, following smoothed positions.
-  sim::Scene loop_scene = split.training.front().scene;
-  loop_scene.material = result.fitted_nominal;
+  // Stage 3: the loop (and its forward fit) on the fitted nominal, following smoothed positions,
+  // over every training motion.
+  std::vector<Motion> loop_motions = split.training;
+  for (Motion& m : loop_motions)
+    m.scene.material = result.fitted_nominal;
   std::map<int, std::shared_ptr<const material::RbfCorrection>> tried; // C_k per iteration
   std::shared_ptr<const material::RbfCorrection> current = result.loop.correction; // next C_k
   LearningCallbacks loop_callbacks = callbacks.loop;
@@ -279,8 +284,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     if (callbacks.loop.checkpoint)
       callbacks.loop.checkpoint(s);
   };
-  if (!run_learning(
-          loop_scene, split.training.front().observed, options.loop, result.loop, loop_callbacks)) {
+  if (!run_learning(loop_motions, options.loop, result.loop, loop_callbacks)) {
     result.interrupted = true;
     return result;
   }

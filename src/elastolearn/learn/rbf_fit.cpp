@@ -45,10 +45,14 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options)
   m_centres = centres;
   const int m = static_cast<int>(centres.rows());
   m_rest_kernels = VecX::Zero(m);
+  // A kernel's stress at rest (equal in every direction for energy kernels, by symmetry).
   if (options.stress_free_rest)
     for (int i = 0; i < m; ++i)
-      m_rest_kernels[i] = material::rbf_kernel(
-          (Vec3::Ones() - centres.row(i).transpose()).squaredNorm(), options.epsilon);
+      m_rest_kernels[i] = options.energy_kernels
+          ? material::energy_kernel_gradient(
+              Vec3::Ones(), centres.row(i).transpose(), options.epsilon)[0]
+          : material::rbf_kernel(
+              (Vec3::Ones() - centres.row(i).transpose()).squaredNorm(), options.epsilon);
   m_elastic = m;
   if (options.elastic_polynomial) {
     m_elastic += 2;
@@ -56,7 +60,7 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options)
       m_constant = m_elastic++;
     if (options.quadratic_tail) {
       m_quadratic = m_elastic;
-      m_elastic += 4;
+      m_elastic += options.energy_kernels ? 3 : 4;
     }
     if (options.neo_hookean_tail) {
       m_neo_hookean = m_elastic;
@@ -68,21 +72,43 @@ RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options)
       : 0;
 }
 
+namespace {
+
+/// Columns: the quadratic tail's q of each cubic energy α p₁³, β p₁p₂, γ p₃ (e = σ − 1, p_k the
+/// power sums; material::is_energy_quadratic_tail).
+const Eigen::Matrix<double, 4, 3>& energy_tail_map() {
+  static const Eigen::Matrix<double, 4, 3> map
+      = (Eigen::Matrix<double, 4, 3>() << 3, 3, 3, 6, 2, 0, 3, 1, 0, 0, -2, 0).finished();
+  return map;
+}
+
+} // namespace
+
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
   const Eigen::Index m = m_centres.rows();
   const double eps = m_options.epsilon;
+  if (m_options.energy_kernels)
+    for (Eigen::Index i = 0; i < m; ++i)
+      out.col(i) = material::energy_kernel_gradient(stretches, m_centres.row(i).transpose(), eps)
+          - Vec3::Constant(m_rest_kernels[i]);
   for (int k = 0; k < 3; ++k) {
     const Vec3 y = material::stretch_view(stretches, k);
-    for (Eigen::Index i = 0; i < m; ++i)
-      out(k, i) = material::rbf_kernel((y - m_centres.row(i).transpose()).squaredNorm(), eps)
-          - m_rest_kernels[i];
+    if (!m_options.energy_kernels)
+      for (Eigen::Index i = 0; i < m; ++i)
+        out(k, i) = material::rbf_kernel((y - m_centres.row(i).transpose()).squaredNorm(), eps)
+            - m_rest_kernels[i];
     if (m_options.elastic_polynomial) {
       out(k, m) = y[0] - 1;
       out(k, m + 1) = y[1] + y[2] - 2;
       if (m_constant >= 0)
         out(k, m_constant) = 1;
-      if (m_quadratic >= 0)
-        out.block<1, 4>(k, m_quadratic) = material::quadratic_tail_basis(y).transpose();
+      if (m_quadratic >= 0) {
+        const Eigen::RowVector4d t = material::quadratic_tail_basis(y).transpose();
+        if (m_options.energy_kernels)
+          out.block<1, 3>(k, m_quadratic) = t * energy_tail_map();
+        else
+          out.block<1, 4>(k, m_quadratic) = t;
+      }
       if (m_neo_hookean >= 0)
         out.block<1, 2>(k, m_neo_hookean) = material::neo_hookean_tail_basis(y).transpose();
     }
@@ -102,21 +128,27 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
       for (int c = 0; c < 3; ++c)
         gradient(3 * idx[c] + k, column) += d_y[c];
     };
-    for (Eigen::Index i = 0; i < m; ++i) {
-      const Vec3 d = y - m_centres.row(i).transpose();
-      const double phi = out(k, i) + m_rest_kernels[i];
-      if (phi > 0)
-        add(i, d / phi);
-    }
+    if (!m_options.energy_kernels)
+      for (Eigen::Index i = 0; i < m; ++i) {
+        const Vec3 d = y - m_centres.row(i).transpose();
+        const double phi = out(k, i) + m_rest_kernels[i];
+        if (phi > 0)
+          add(i, d / phi);
+      }
     if (m_options.elastic_polynomial) {
       add(m, Vec3(1, 0, 0));
       add(m + 1, Vec3(0, 1, 1));
       if (m_quadratic >= 0) {
         const double e = y[0] - 1, s = y[1] + y[2] - 2;
-        add(m_quadratic, Vec3(2 * e, 0, 0));
-        add(m_quadratic + 1, Vec3(s, e, e));
-        add(m_quadratic + 2, Vec3(0, 2 * s, 2 * s));
-        add(m_quadratic + 3, Vec3(0, y[2] - 1, y[1] - 1));
+        const Eigen::Matrix<double, 3, 4> d_t = (Eigen::Matrix<double, 3, 4>() << 2 * e, s, 0, 0, 0,
+            e, 2 * s, y[2] - 1, 0, e, 2 * s, y[1] - 1)
+                                                    .finished(); // column j: ∂t_j/∂y
+        if (m_options.energy_kernels)
+          for (int c = 0; c < 3; ++c)
+            add(m_quadratic + c, d_t * energy_tail_map().col(c));
+        else
+          for (int c = 0; c < 4; ++c)
+            add(m_quadratic + c, d_t.col(c));
       }
       if (m_neo_hookean >= 0) {
         Eigen::Matrix<double, 2, 3> d_g;
@@ -124,6 +156,14 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
         add(m_neo_hookean, d_g.row(0).transpose());
         add(m_neo_hookean + 1, d_g.row(1).transpose());
       }
+    }
+  }
+  if (m_options.energy_kernels) {
+    Mat3 hessian; // ∂N_k/∂σ_j of kernel i alone: row 3j + k
+    for (Eigen::Index i = 0; i < m; ++i) {
+      material::energy_kernel_gradient(
+          stretches, m_centres.row(i).transpose(), m_options.epsilon, &hessian);
+      gradient.col(i) = hessian.reshaped();
     }
   }
 }
@@ -151,6 +191,7 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
   material::RbfCorrection::Parameters p;
   p.centres = m_centres;
   p.epsilon = m_options.epsilon;
+  p.energy_kernels = m_options.energy_kernels;
   p.weights = x.head(m);
   p.constant = -p.weights.dot(m_rest_kernels); // N(1) = 0 under stress_free_rest
   if (m_options.elastic_polynomial) {
@@ -159,7 +200,9 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
     if (m_constant >= 0)
       p.constant = x[m_constant];
     if (m_quadratic >= 0)
-      p.quadratic = x.segment<4>(m_quadratic);
+      p.quadratic = m_options.energy_kernels
+          ? Eigen::Vector4d(energy_tail_map() * x.segment<3>(m_quadratic))
+          : Eigen::Vector4d(x.segment<4>(m_quadratic));
     if (m_neo_hookean >= 0)
       p.neo_hookean = x.segment<2>(m_neo_hookean);
   }
@@ -180,8 +223,9 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
 VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   const auto& p = c.parameters();
   const Eigen::Index m = m_centres.rows();
-  if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon)
-    fail("correction", "its centres or kernel smoothing differ from the design's");
+  if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon
+      || p.energy_kernels != m_options.energy_kernels)
+    fail("correction", "its centres, kernel smoothing or kernel kind differ from the design's");
   const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();
   const bool has_damping_tail
       = !p.damping_slopes.isZero(0) || p.damping_constant != 0 || !p.damping_quadratic.isZero(0);
@@ -196,15 +240,21 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
     x[m + 1] = p.other_slope;
     if (m_constant >= 0)
       x[m_constant] = p.constant;
-    if (m_quadratic >= 0)
+    if (m_quadratic >= 0 && m_options.energy_kernels) {
+      // Invert energy_tail_map on its range (q₁ = 2 q₂, which the correction guarantees).
+      const Eigen::Vector4d& q = p.quadratic;
+      const double beta = -0.5 * q[3], alpha = (q[2] - beta) / 3;
+      x.segment<3>(m_quadratic) = Vec3(alpha, beta, (q[0] - 3 * alpha - 3 * beta) / 3);
+    } else if (m_quadratic >= 0) {
       x.segment<4>(m_quadratic) = p.quadratic;
+    }
     if (m_neo_hookean >= 0)
       x.segment<2>(m_neo_hookean) = p.neo_hookean;
   }
   const double prestress = p.constant + p.weights.dot(m_rest_kernels);
   if (m_constant < 0
       && std::abs(prestress)
-          > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels) + 1))
+          > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels.cwiseAbs()) + 1))
     fail("correction", "it is not stress-free at rest (N(1) = " + to_text(prestress) + " Pa)");
   if (m_damping > 0) {
     if (p.damping_weights.size() == m)

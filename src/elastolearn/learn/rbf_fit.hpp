@@ -12,6 +12,10 @@ namespace elastolearn::learn {
 
 struct RbfFitOptions {
   double epsilon = 1e-3; ///< kernel smoothing ε of material::rbf_kernel [-]
+  /// Energy kernels (material::RbfCorrection::Parameters::energy_kernels): the correction is the
+  /// gradient of an energy, its tangent symmetric; the quadratic tail then has 3 unknowns (the
+  /// cubic energies), not 4.
+  bool energy_kernels = false;
   bool elastic_polynomial
       = true; ///< fit the linear tail a, b (and c, see below) of the elastic part
   /// Keep the rest shape stress-free: N(1, 1, 1) = 0, as for every hyperelastic model. The
@@ -62,7 +66,8 @@ class RbfDesign {
   /// `centres` m × 3 (m ≥ 1, finite). Throws InputError for invalid options or centres.
   RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options);
   int num_centres() const { return static_cast<int>(m_centres.rows()); }
-  int elastic_unknowns() const { return m_elastic; } ///< m (+ 2 or 3 with the tail, + 4 quadratic)
+  /// m (+ 2 or 3 with the tail, + 4 quadratic, or 3 with energy kernels, + 2 neo-Hookean)
+  int elastic_unknowns() const { return m_elastic; }
   int damping_unknowns() const { return m_damping; } ///< 0, or m (+ 4 with the tail)
   int num_unknowns() const { return m_elastic + m_damping; }
   const RbfFitOptions& options() const { return m_options; }
@@ -91,7 +96,7 @@ class RbfDesign {
   RbfFitOptions m_options;
   VecX m_rest_kernels; ///< r_i = φ_i(1, 1, 1) under stress_free_rest, else 0
   int m_constant = -1; ///< column of the pressure c, or −1
-  int m_quadratic = -1; ///< first column of q, or −1
+  int m_quadratic = -1; ///< first column of q (or, with energy kernels, of its 3 energies), or −1
   int m_neo_hookean = -1; ///< first column of r, or −1
   int m_elastic = 0;
   int m_damping = 0;

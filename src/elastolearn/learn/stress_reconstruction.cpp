@@ -59,40 +59,37 @@ void StressReconstructionOptions::validate() const {
     fail("full_space_weight", "must be finite and ≥ 0, got " + to_text(full_space_weight));
 }
 
-StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& mesh,
-    const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
-    const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
-    const StressReconstructionOptions& options, ConstRef<MatX> projection) {
-  options.validate();
-  const bool projected = projection.size() > 0;
-  const double full_weight
-      = projected ? options.full_space_weight : 1.0; // of the unprojected misfit
-  if (projected && options.method == ReconstructionMethod::lsqr)
-    fail("method", "the lsqr method has no force projection: use normal_equations");
-  if (options.method == ReconstructionMethod::lsqr)
-    return reconstruct_rbf_correction_via_lsqr(
-        mesh, dofs, design, positions, velocities, target_forces, options);
-  detail::check_frames(mesh, &dofs, positions, &velocities, &target_forces);
-  const int rows = dofs.num_free();
+namespace {
+
+/// Checks one motion's inputs for the normal-equation method (throws InputError).
+void check_motion(const ReconstructionMotion& motion, const RbfDesign& design) {
+  detail::check_frames(
+      motion.mesh, &motion.dofs, motion.positions, &motion.velocities, &motion.target_forces);
+  const int rows = motion.dofs.num_free();
   if (rows == 0)
     fail("dofs", "no free degree of freedom");
-  if (projected && (projection.rows() != rows || !projection.allFinite()))
+  const Eigen::Ref<const MatX>& projection = motion.projection;
+  if (projection.size() > 0 && (projection.rows() != rows || !projection.allFinite()))
     fail("projection",
         "must have one finite row per free dof (" + to_text(rows) + "), got "
             + to_text(projection.rows()));
-  if (design.damping_unknowns() > 0 && mesh.nominal.elastic == nullptr)
+  if (design.damping_unknowns() > 0 && motion.mesh.nominal.elastic == nullptr)
     fail("nominal", "fitting the damping correction needs the nominal elastic model");
-  const auto start = Clock::now();
-  const std::vector<int> frames
-      = detail::selected_frames(int(positions.size()), options.frame_stride);
-  const int u = design.num_unknowns();
+}
 
-  // Frames in k_frame_blocks contiguous blocks; each block's sums are formed serially in frame
-  // order on one thread, and the blocks are added in block order.
+/// Adds one motion's lower-triangular Σ JᵀJ and Σ Jᵀ g (each projected and/or μ-weighted) at
+/// `frames` to `normal` and `rhs`. Frames in k_frame_blocks contiguous blocks; each block's sums
+/// are formed serially in frame order on one thread, and the blocks are added in block order.
+void accumulate_normal_equations(const ReconstructionMotion& motion, const RbfDesign& design,
+    const std::vector<int>& frames, double full_space_weight, MatX& normal, VecX& rhs) {
+  const Eigen::Ref<const MatX>& projection = motion.projection;
+  const bool projected = projection.size() > 0;
+  const double full_weight = projected ? full_space_weight : 1.0; // of the unprojected misfit
+  const int u = design.num_unknowns();
   const int blocks = std::min<int>(k_frame_blocks, int(frames.size()));
   std::vector<BlockSums> sums(blocks);
   tbb::enumerable_thread_specific<AssemblyScratch> scratch([&] {
-    AssemblyScratch s { CorrectionForceJacobian(mesh, dofs, design), VecX(),
+    AssemblyScratch s { CorrectionForceJacobian(motion.mesh, motion.dofs, design), VecX(),
       MatX(u, projection.cols()), VecX(projection.cols()) };
     return s;
   });
@@ -105,8 +102,8 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
       const size_t first = frames.size() * b / blocks, last = frames.size() * (b + 1) / blocks;
       for (size_t i = first; i < last; ++i) {
         const int t = frames[i];
-        const MatX& jt = s.jacobian.transposed(positions[t], velocities[t]);
-        dofs.restrict_into(target_forces[t], s.target);
+        const MatX& jt = s.jacobian.transposed(motion.positions[t], motion.velocities[t]);
+        motion.dofs.restrict_into(motion.target_forces[t], s.target);
         if (projected) {
           s.projected_jt.noalias() = jt * projection;
           s.projected_target.noalias() = projection.transpose() * s.target;
@@ -120,29 +117,91 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
       }
     }
   });
-  MatX normal = MatX::Zero(u, u);
-  VecX rhs = VecX::Zero(u);
   for (const BlockSums& sum : sums) {
     normal += sum.normal;
     rhs += sum.rhs;
+  }
+}
+
+} // namespace
+
+StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& mesh,
+    const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
+    const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
+    const StressReconstructionOptions& options, ConstRef<MatX> projection) {
+  const ReconstructionMotion motion { mesh, dofs, positions, velocities, target_forces,
+    projection };
+  return reconstruct_rbf_correction(std::span(&motion, 1), design, options);
+}
+
+StressReconstructionResult reconstruct_rbf_correction(std::span<const ReconstructionMotion> motions,
+    const RbfDesign& design, const StressReconstructionOptions& options) {
+  options.validate();
+  if (motions.empty())
+    fail("motions", "no motion to reconstruct from");
+  if (options.method == ReconstructionMethod::lsqr) {
+    for (const ReconstructionMotion& motion : motions)
+      if (motion.projection.size() > 0)
+        fail("method", "the lsqr method has no force projection: use normal_equations");
+    return reconstruct_rbf_correction_via_lsqr(motions, design, options);
+  }
+  for (const ReconstructionMotion& motion : motions)
+    check_motion(motion, design);
+  const auto start = Clock::now();
+  const int u = design.num_unknowns();
+  MatX normal = MatX::Zero(u, u);
+  VecX rhs = VecX::Zero(u);
+  long samples = 0; // frames used, for the singular-system message
+  for (const ReconstructionMotion& motion : motions) {
+    const std::vector<int> frames
+        = detail::selected_frames(int(motion.positions.size()), options.frame_stride);
+    accumulate_normal_equations(motion, design, frames, options.full_space_weight, normal, rhs);
+    samples += long(frames.size());
   }
   normal.triangularView<Eigen::StrictlyUpper>() = normal.transpose();
   const double assembly_seconds = seconds_since(start);
 
   const auto solve_start = Clock::now();
   VecX x = solve_regularised_normal_equations(
-      std::move(normal), rhs, design.regularization_weights(), long(frames.size()));
+      std::move(normal), rhs, design.regularization_weights(), samples);
   material::RbfCorrection correction = design.correction(x);
   const double solve_seconds = seconds_since(solve_start);
 
   const auto misfit_start = Clock::now();
-  const ForceMisfit misfit = correction_force_misfit(
-      mesh, dofs, correction, positions, velocities, target_forces, options.frame_stride);
+  const ForceMisfit misfit = correction_force_misfit(motions, correction, options.frame_stride);
+  int rows = 0;
+  for (const ReconstructionMotion& motion : motions)
+    rows += motion.dofs.num_free();
   StressReconstructionResult result { std::move(correction), std::move(x), misfit, rows };
   result.assembly_seconds = assembly_seconds;
   result.solve_seconds = solve_seconds;
   result.misfit_seconds = seconds_since(misfit_start);
   return result;
+}
+
+ForceMisfit correction_force_misfit(std::span<const ReconstructionMotion> motions,
+    const material::Correction& correction, int frame_stride) {
+  ForceMisfit out;
+  double count = 0; // frames × free vertices so far
+  double residual = 0, target = 0; // their sums of squares
+  for (const ReconstructionMotion& motion : motions) {
+    const ForceMisfit part = correction_force_misfit(motion.mesh, motion.dofs, correction,
+        motion.positions, motion.velocities, motion.target_forces, frame_stride);
+    const double part_count = double(part.frames) * (motion.dofs.num_free() / 3.0);
+    if (count == 0) {
+      out = part;
+    } else {
+      out.rms_residual = std::sqrt(
+          (residual + part_count * part.rms_residual * part.rms_residual) / (count + part_count));
+      out.rms_target = std::sqrt(
+          (target + part_count * part.rms_target * part.rms_target) / (count + part_count));
+      out.frames += part.frames;
+    }
+    count += part_count;
+    residual += part_count * part.rms_residual * part.rms_residual;
+    target += part_count * part.rms_target * part.rms_target;
+  }
+  return out;
 }
 
 } // namespace elastolearn::learn

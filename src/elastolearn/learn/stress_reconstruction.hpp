@@ -10,6 +10,7 @@
 #include <elastolearn/learn/correction_force.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -48,7 +49,7 @@ struct StressReconstructionResult {
   material::RbfCorrection correction; ///< design.correction(unknowns)
   VecX unknowns; ///< x in RbfDesign's layout
   ForceMisfit misfit; ///< of `correction` over the frames used
-  int rows_per_frame = 0; ///< free dofs
+  int rows_per_frame = 0; ///< free dofs (summed over the motions)
   // lsqr method only:
   int lsqr_max_iterations = 0; ///< most CGLS iterations of any frame
   double lsqr_max_relative_error = 0; ///< largest ‖Bᵀr‖/‖Bᵀf‖ of any frame at exit
@@ -57,6 +58,17 @@ struct StressReconstructionResult {
   double assembly_seconds = 0; ///< element pass + normal equations (or CGLS + samples)
   double solve_seconds = 0; ///< the regularised dense solve (or fit_rbf_correction)
   double misfit_seconds = 0; ///< correction_force_misfit
+};
+
+/// One motion's part of a joint reconstruction, viewed (not owned): the arguments of the
+/// single-motion reconstruct_rbf_correction below. Motions may have different meshes.
+struct ReconstructionMotion {
+  const ReconstructionMesh& mesh;
+  const fem::DofMap& dofs; ///< 3n dofs of `mesh`
+  const std::vector<VecX>& positions; ///< flat 3n per frame [m]
+  const std::vector<VecX>& velocities; ///< flat 3n per frame [m/s]
+  const std::vector<VecX>& target_forces; ///< flat 3n per frame [N]
+  Eigen::Ref<const MatX> projection; ///< free dofs × r, orthonormal columns; empty = none
 };
 
 /// Find the unknowns x of `design` minimising (paper Eqs. 12–13)
@@ -85,5 +97,21 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
     const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
     const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
     const StressReconstructionOptions& options = {}, ConstRef<MatX> projection = MatX());
+
+/// The same fit over several motions' frames at once (a training set): the sum over motions of
+/// each motion's misfit (with its own projection and μ-weighted rest), one Tikhonov term, so
+/// that one correction explains every motion. The equations of each motion are accumulated as
+/// above (its own blocks of frames) and the motions' sums added in order, so that one motion
+/// gives exactly the single-motion result. `misfit` is over all motions' frames together.
+/// options.frame_stride applies to every motion. The lsqr method fits one RBF to every motion's
+/// element-stress samples. Throws InputError as above, and for no motion.
+StressReconstructionResult reconstruct_rbf_correction(std::span<const ReconstructionMotion> motions,
+    const RbfDesign& design, const StressReconstructionOptions& options = {});
+
+/// The misfit of `correction` over every motion's frames 0, stride, 2·stride, …: the RMS over
+/// all of them (each motion's correction_force_misfit weighted by its frames × free vertices;
+/// one motion's is returned as it is). Same checks as correction_force_misfit.
+ForceMisfit correction_force_misfit(std::span<const ReconstructionMotion> motions,
+    const material::Correction& correction, int frame_stride = 1);
 
 } // namespace elastolearn::learn

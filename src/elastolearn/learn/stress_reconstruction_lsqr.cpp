@@ -72,41 +72,67 @@ StressReconstructionResult reconstruct_rbf_correction_via_lsqr(const Reconstruct
     const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
     const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
     const StressReconstructionOptions& options) {
+  const MatX none;
+  const ReconstructionMotion motion { mesh, dofs, positions, velocities, target_forces, none };
+  return reconstruct_rbf_correction_via_lsqr(std::span(&motion, 1), design, options);
+}
+
+StressReconstructionResult reconstruct_rbf_correction_via_lsqr(
+    std::span<const ReconstructionMotion> motions, const RbfDesign& design,
+    const StressReconstructionOptions& options) {
   options.validate();
-  detail::check_frames(mesh, &dofs, positions, &velocities, &target_forces);
-  if (dofs.num_free() == 0)
-    throw InputError("stress_reconstruction.dofs", "no free degree of freedom");
+  if (motions.empty())
+    throw InputError("stress_reconstruction.motions", "no motion to reconstruct from");
+  // Each motion's samples start at its offset: (frames used) × (its elements) rows.
+  std::vector<std::vector<int>> frames;
+  std::vector<Eigen::Index> offsets { 0 };
+  for (const ReconstructionMotion& motion : motions) {
+    detail::check_frames(
+        motion.mesh, &motion.dofs, motion.positions, &motion.velocities, &motion.target_forces);
+    if (motion.dofs.num_free() == 0)
+      throw InputError("stress_reconstruction.dofs", "no free degree of freedom");
+    frames.push_back(detail::selected_frames(int(motion.positions.size()), options.frame_stride));
+    offsets.push_back(offsets.back() + Eigen::Index(frames.back().size()) * motion.mesh.num_tets());
+  }
   const auto start = Clock::now();
-  const std::vector<int> frames
-      = detail::selected_frames(int(positions.size()), options.frame_stride);
-  const Eigen::Index m = mesh.num_tets();
-  const Eigen::Index n = Eigen::Index(frames.size()) * m;
+  const Eigen::Index n = offsets.back();
   StressSamples samples;
   samples.stretches.resize(n, 3);
   samples.stretch_rates.resize(n, 3);
   samples.targets.resize(n, 3);
-  std::vector<int> iterations(frames.size());
-  std::vector<double> errors(frames.size());
-  // One task per frame (its element pass is a nested parallel loop; `states` is task-local).
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, frames.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-        std::vector<ElementState> states;
-        for (size_t i = r.begin(); i < r.end(); ++i) {
-          const int t = frames[i];
-          states.resize(m);
-          compute_element_states(mesh, positions[t], velocities[t], states);
-          const ElementStressResult p = solve_min_norm(assemble_stress_operator(mesh, dofs, states),
-              dofs.restrict(target_forces[t]), options);
-          iterations[i] = p.iterations;
-          errors[i] = p.relative_error;
-          for (Eigen::Index e = 0; e < m; ++e) {
-            const Eigen::Index row = Eigen::Index(i) * m + e;
-            samples.stretches.row(row) = states[e].frame.stretches.transpose();
-            samples.stretch_rates.row(row) = states[e].stretch_rates.transpose();
-            samples.targets.row(row) = p.stresses.segment<3>(3 * e).transpose();
+  int max_iterations = 0;
+  double max_error = 0;
+  for (size_t k = 0; k < motions.size(); ++k) {
+    const ReconstructionMotion& motion = motions[k];
+    const std::vector<int>& used = frames[k];
+    const Eigen::Index m = motion.mesh.num_tets();
+    std::vector<int> iterations(used.size());
+    std::vector<double> errors(used.size());
+    // One task per frame (its element pass is a nested parallel loop; `states` is task-local).
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, used.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+          std::vector<ElementState> states;
+          for (size_t i = r.begin(); i < r.end(); ++i) {
+            const int t = used[i];
+            states.resize(m);
+            compute_element_states(motion.mesh, motion.positions[t], motion.velocities[t], states);
+            const ElementStressResult p
+                = solve_min_norm(assemble_stress_operator(motion.mesh, motion.dofs, states),
+                    motion.dofs.restrict(motion.target_forces[t]), options);
+            iterations[i] = p.iterations;
+            errors[i] = p.relative_error;
+            for (Eigen::Index e = 0; e < m; ++e) {
+              const Eigen::Index row = offsets[k] + Eigen::Index(i) * m + e;
+              samples.stretches.row(row) = states[e].frame.stretches.transpose();
+              samples.stretch_rates.row(row) = states[e].stretch_rates.transpose();
+              samples.targets.row(row) = p.stresses.segment<3>(3 * e).transpose();
+            }
           }
-        }
-      });
+        });
+    max_iterations
+        = std::max(max_iterations, *std::max_element(iterations.begin(), iterations.end()));
+    max_error = std::max(max_error, *std::max_element(errors.begin(), errors.end()));
+  }
   const double assembly_seconds = seconds_since(start);
 
   const auto solve_start = Clock::now();
@@ -114,12 +140,14 @@ StressReconstructionResult reconstruct_rbf_correction_via_lsqr(const Reconstruct
   const double solve_seconds = seconds_since(solve_start);
 
   const auto misfit_start = Clock::now();
-  const ForceMisfit misfit = correction_force_misfit(
-      mesh, dofs, fit.correction, positions, velocities, target_forces, options.frame_stride);
+  const ForceMisfit misfit = correction_force_misfit(motions, fit.correction, options.frame_stride);
+  int rows = 0;
+  for (const ReconstructionMotion& motion : motions)
+    rows += motion.dofs.num_free();
   StressReconstructionResult result { std::move(fit.correction), std::move(fit.unknowns), misfit,
-    dofs.num_free() };
-  result.lsqr_max_iterations = *std::max_element(iterations.begin(), iterations.end());
-  result.lsqr_max_relative_error = *std::max_element(errors.begin(), errors.end());
+    rows };
+  result.lsqr_max_iterations = max_iterations;
+  result.lsqr_max_relative_error = max_error;
   result.stress_rms_residual = fit.rms_residual;
   result.assembly_seconds = assembly_seconds;
   result.solve_seconds = solve_seconds;

@@ -9,6 +9,8 @@
 
 #include <Eigen/SparseCore>
 
+#include <span>
+
 namespace elastolearn::learn {
 
 /// The paper's B of one frame (§4.1, "B p̂ = f"), restricted to the free dofs: a sparse
@@ -47,6 +49,13 @@ ElementStressResult reconstruct_element_stresses(const ReconstructionMesh& mesh,
 StressReconstructionResult reconstruct_rbf_correction_via_lsqr(const ReconstructionMesh& mesh,
     const fem::DofMap& dofs, const RbfDesign& design, const std::vector<VecX>& positions,
     const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces,
+    const StressReconstructionOptions& options = {});
+
+/// The same over several motions: every motion's samples (motion by motion, each in frame
+/// order) in one RBF fit; `misfit` over all their frames. Projections are ignored (the caller
+/// refuses them). Throws InputError as above, and for no motion.
+StressReconstructionResult reconstruct_rbf_correction_via_lsqr(
+    std::span<const ReconstructionMotion> motions, const RbfDesign& design,
     const StressReconstructionOptions& options = {});
 
 } // namespace elastolearn::learn

@@ -114,6 +114,26 @@ ErrorSummary observation_error(const std::vector<VecX>& frames, const observe::O
   return acc.summary();
 }
 
+ErrorSummary combined_error(std::span<const ErrorSummary> parts) {
+  if (parts.empty())
+    return {};
+  ErrorSummary out = parts.front();
+  for (const ErrorSummary& part : parts.subspan(1)) {
+    if (part.samples == 0)
+      continue;
+    if (part.max > out.max || out.worst_frame < 0) {
+      out.max = part.max;
+      out.worst_frame = part.worst_frame;
+      out.worst_vertex = part.worst_vertex;
+    }
+    const double a = double(out.samples), b = double(part.samples);
+    out.mean = (a * out.mean + b * part.mean) / (a + b);
+    out.rms = std::sqrt((a * out.rms * out.rms + b * part.rms * part.rms) / (a + b));
+    out.samples += part.samples;
+  }
+  return out;
+}
+
 ErrorSummary as_percent_of(const ErrorSummary& error, double length) {
   if (!(std::isfinite(length) && length > 0)) {
     throw InputError(

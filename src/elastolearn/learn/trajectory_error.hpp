@@ -5,6 +5,7 @@
 #include <elastolearn/core/types.hpp>
 #include <elastolearn/observe/observation.hpp>
 
+#include <span>
 #include <vector>
 
 namespace elastolearn::learn {
@@ -34,6 +35,11 @@ ErrorSummary position_error(
 /// Throws InputError if either is empty, frames differ in size, or an observed vertex id is
 /// out of range of the frames.
 ErrorSummary observation_error(const std::vector<VecX>& frames, const observe::Observation& obs);
+
+/// The statistics of the union of the (frame, vertex) pairs of `parts` (e.g. one per motion):
+/// the max with the worst frame and vertex of the part that holds it, mean and rms weighted by
+/// each part's samples. One part is returned unchanged; no part gives the empty summary.
+ErrorSummary combined_error(std::span<const ErrorSummary> parts);
 
 /// The same errors as percentages of `length` [m] (paper 000 Table 1 uses the rest
 /// bounding-box diagonal): max, mean and rms scaled by 100 / length. Throws InputError if

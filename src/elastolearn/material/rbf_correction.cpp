@@ -63,6 +63,47 @@ Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3
   return g;
 }
 
+namespace {
+
+/// The six permutations of three indices: P_π σ = (σ[π₀], σ[π₁], σ[π₂]).
+constexpr std::array<std::array<int, 3>, 6> k_permutations
+    = { { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } } };
+
+} // namespace
+
+Vec3 energy_kernel_gradient(
+    const Vec3& stretches, const Vec3& centre, double epsilon, Mat3* hessian) {
+  // ∂φ(‖u − c‖)/∂u = (u − c)/φ with u = P_π σ, so ∂/∂σ[π_j] receives (u_j − c_j)/φ, and
+  // ∂²/∂σ[π_j]∂σ[π_l] receives δ_jl/φ − (u_j − c_j)(u_l − c_l)/φ³.
+  const double eps2 = epsilon * epsilon;
+  Vec3 gradient = Vec3::Zero();
+  if (hessian)
+    hessian->setZero();
+  for (const auto& pi : k_permutations) {
+    const Vec3 d(
+        stretches[pi[0]] - centre[0], stretches[pi[1]] - centre[1], stretches[pi[2]] - centre[2]);
+    const double phi = std::sqrt(d.squaredNorm() + eps2);
+    if (phi == 0)
+      continue; // ε = 0 at a centre: the subgradient 0
+    for (int j = 0; j < 3; ++j)
+      gradient[pi[j]] += d[j] / phi;
+    if (hessian)
+      for (int j = 0; j < 3; ++j)
+        for (int l = 0; l < 3; ++l)
+          (*hessian)(pi[j], pi[l]) += ((j == l ? 1.0 : 0.0) - d[j] * d[l] / (phi * phi)) / phi;
+  }
+  return gradient;
+}
+
+double energy_kernel(const Vec3& stretches, const Vec3& centre, double epsilon) {
+  double sum = 0;
+  for (const auto& pi : k_permutations)
+    sum += rbf_kernel(
+        (Vec3(stretches[pi[0]], stretches[pi[1]], stretches[pi[2]]) - centre).squaredNorm(),
+        epsilon);
+  return sum;
+}
+
 RbfCorrection::RbfCorrection(Parameters p)
     : m_p(std::move(p)) {
   const Eigen::Index m = m_p.centres.rows();
@@ -94,6 +135,95 @@ RbfCorrection::RbfCorrection(Parameters p)
   if (!std::isfinite(m_p.epsilon) || m_p.epsilon < 0) {
     fail("epsilon", "must be finite and ≥ 0, got " + to_text(m_p.epsilon));
   }
+  if (m_p.energy_kernels && !is_energy_quadratic_tail(m_p.quadratic))
+    fail("quadratic",
+        "is not the gradient of an energy (energy kernels need quadratic[1] = 2 quadratic[2])");
+  if (m_p.energy_kernels) {
+    const Eigen::Index n = 6 * m, padded = (n + 3) / 4 * 4;
+    for (auto* a : { &m_energy_x, &m_energy_y, &m_energy_z, &m_energy_w })
+      a->setZero(padded);
+    Eigen::Index j = 0;
+    for (Eigen::Index i = 0; i < m; ++i)
+      for (const auto& pi : k_permutations) {
+        // ‖P_π σ − c‖ = ‖σ − P_π⁻¹ c‖: component π_l of the copy is c_l.
+        Vec3 copy;
+        for (int l = 0; l < 3; ++l)
+          copy[pi[l]] = m_p.centres(i, l);
+        m_energy_x[j] = copy[0];
+        m_energy_y[j] = copy[1];
+        m_energy_z[j] = copy[2];
+        m_energy_w[j++] = m_p.weights[i];
+      }
+    // Padding: far-away copies with zero weight (a finite distance keeps 1/φ finite).
+    for (; j < padded; ++j)
+      m_energy_x[j] = m_energy_y[j] = m_energy_z[j] = 1e3;
+  }
+}
+
+Vec3 RbfCorrection::energy_kernels_sum(const Vec3& stretches, Mat3* hessian) const {
+  // Σ_j w_j ∇φ_j = Σ_j w_j d_j/φ_j and Σ_j w_j ∇²φ_j = (Σ_j w_j/φ_j) I − Σ_j (w_j/φ_j³) d_j d_jᵀ
+  // over the permuted copies j (d_j = σ − copy_j), four copies per packed step.
+  using Lanes = Eigen::Array4d;
+  const double eps2 = m_p.epsilon * m_p.epsilon;
+  Lanes gx = Lanes::Zero(), gy = Lanes::Zero(), gz = Lanes::Zero(), diag = Lanes::Zero(),
+        hxx = Lanes::Zero(), hyy = Lanes::Zero(), hzz = Lanes::Zero(), hxy = Lanes::Zero(),
+        hxz = Lanes::Zero(), hyz = Lanes::Zero();
+  for (Eigen::Index j = 0; j < m_energy_w.size(); j += 4) {
+    const Lanes dx = stretches[0] - m_energy_x.segment<4>(j),
+                dy = stretches[1] - m_energy_y.segment<4>(j),
+                dz = stretches[2] - m_energy_z.segment<4>(j);
+    const Lanes r2 = dx * dx + dy * dy + dz * dz + eps2;
+    // ε = 0 at a copy: the subgradient 0 (Eigen's select would not run packed).
+    const Lanes inv = (r2 > 0).select(m_energy_w.segment<4>(j) / r2.sqrt(), 0.0);
+    gx += inv * dx;
+    gy += inv * dy;
+    gz += inv * dz;
+    if (hessian) {
+      const Lanes inv3 = (r2 > 0).select(inv / r2, 0.0);
+      diag += inv;
+      hxx += inv3 * dx * dx;
+      hyy += inv3 * dy * dy;
+      hzz += inv3 * dz * dz;
+      hxy += inv3 * dx * dy;
+      hxz += inv3 * dx * dz;
+      hyz += inv3 * dy * dz;
+    }
+  }
+  if (hessian) {
+    const double d = diag.sum(), xy = hxy.sum(), xz = hxz.sum(), yz = hyz.sum();
+    *hessian
+        += (Mat3() << d - hxx.sum(), -xy, -xz, -xy, d - hyy.sum(), -yz, -xz, -yz, d - hzz.sum())
+               .finished();
+  }
+  return { gx.sum(), gy.sum(), gz.sum() };
+}
+
+double RbfCorrection::elastic_energy(const Vec3& stretches) const {
+  if (!m_p.energy_kernels)
+    fail("energy_kernels", "the correction is not an energy (stress kernels)");
+  const Vec3 e = stretches - Vec3::Ones();
+  const double p1 = e.sum(), p2 = e.squaredNorm(), p3 = e.array().cube().sum();
+  double psi = 0;
+  for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i)
+    psi += m_p.weights[i] * energy_kernel(stretches, m_p.centres.row(i).transpose(), m_p.epsilon);
+  // N_k = a e_k + b (p₁ − e_k) + c is the gradient of ½(a − b) p₂ + ½ b p₁² + c p₁.
+  const double a = m_p.own_slope, b = m_p.other_slope;
+  psi += 0.5 * (a - b) * p2 + 0.5 * b * p1 * p1 + m_p.constant * p1;
+  // q = α(3, 6, 3, 0) + β(3, 2, 1, −2) + γ(3, 0, 0, 0) ↔ α p₁³ + β p₁ p₂ + γ p₃.
+  const Eigen::Vector4d& q = m_p.quadratic;
+  const double beta = -0.5 * q[3], alpha = (q[2] - beta) / 3,
+               gamma = (q[0] - 3 * alpha - 3 * beta) / 3;
+  psi += alpha * p1 * p1 * p1 + beta * p1 * p2 + gamma * p3;
+  if (!m_p.neo_hookean.isZero(0)) {
+    // g₁ = −∇E_μ, g₂ = ∇E_λ with E_μ = ½(p₂' − 3) − ln J − Σ(σ − 1)² (p₂' = Σσ²) and
+    // E_λ = ½ ln²J − ½ p₁² (neo-Hookean minus corotated, per Lamé parameter).
+    const Vec3 z = stretches.cwiseMax(1e-3);
+    const double log_j = std::log(z.prod());
+    const double e_mu = 0.5 * (z.squaredNorm() - 3) - log_j - (z - Vec3::Ones()).squaredNorm();
+    const double e_lambda = 0.5 * log_j * log_j - 0.5 * std::pow((z - Vec3::Ones()).sum(), 2);
+    psi += -m_p.neo_hookean[0] * e_mu + m_p.neo_hookean[1] * e_lambda;
+  }
+  return psi;
 }
 
 double RbfCorrection::elastic_tail(const Vec3& y, Vec3* d_y) const {
@@ -135,7 +265,8 @@ Vec3 RbfCorrection::elastic_views(const Mat3& y, Mat3* d_y) const {
   const Lanes y0(y(0, 0), y(0, 1), y(0, 2), 1), y1(y(1, 0), y(1, 1), y(1, 2), 1),
       y2(y(2, 0), y(2, 1), y(2, 2), 1);
   const double eps2 = m_p.epsilon * m_p.epsilon;
-  for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i) {
+  const Eigen::Index kernels = m_p.energy_kernels ? 0 : m_p.centres.rows();
+  for (Eigen::Index i = 0; i < kernels; ++i) {
     const double w = m_p.weights[i];
     const Lanes d0 = y0 - m_p.centres(i, 0), d1 = y1 - m_p.centres(i, 1),
                 d2 = y2 - m_p.centres(i, 2);
@@ -186,11 +317,13 @@ Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& 
     views[k] = stretch_view_indices(stretches, k);
     y.col(k) = Vec3(stretches[views[k][0]], stretches[views[k][1]], stretches[views[k][2]]);
   }
-  const Vec3 n = elastic_views(y, &d_y);
+  Vec3 n = elastic_views(y, &d_y);
   d_stretches.setZero();
   for (int k = 0; k < 3; ++k)
     for (int c = 0; c < 3; ++c)
       d_stretches(k, views[k][c]) += d_y(c, k);
+  if (m_p.energy_kernels)
+    n += energy_kernels_sum(stretches, &d_stretches);
   d_stretch_rates.setZero();
   return n;
 }
@@ -208,7 +341,8 @@ Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
   Mat3 y;
   for (int k = 0; k < 3; ++k)
     y.col(k) = stretch_view(stretches, k);
-  return elastic_views(y, nullptr);
+  const Vec3 n = elastic_views(y, nullptr);
+  return m_p.energy_kernels ? Vec3(n + energy_kernels_sum(stretches, nullptr)) : n;
 }
 
 bool RbfCorrection::has_damping() const {
@@ -228,6 +362,8 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   const RbfCorrection::Parameters& q = b ? b->parameters() : zero;
   if (b && q.epsilon != p.epsilon)
     fail("epsilon", "cannot blend corrections with different kernel smoothing");
+  if (b && q.energy_kernels != p.energy_kernels)
+    fail("energy_kernels", "cannot blend energy kernels with stress kernels");
   const auto damping_weights = [](const RbfCorrection::Parameters& x) {
     return x.damping_weights.size() > 0 ? x.damping_weights : VecX(VecX::Zero(x.centres.rows()));
   };

@@ -38,6 +38,23 @@ Eigen::Vector4d quadratic_tail_basis(const Vec3& y);
 /// `d_y`, if not null, receives ∂g_i/∂y as its rows.
 Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3>* d_y = nullptr);
 
+/// The energy kernel of centre c: S(σ) = Σ_π φ(‖P_π σ − c‖) over the six permutations P_π of
+/// the stretches, φ = rbf_kernel. S is a smooth symmetric function of σ (for ε > 0), so its
+/// gradient is a principal stress that is continuous in F (equal components at equal stretches)
+/// and its Hessian is symmetric. Returns ∇S(σ); `hessian`, if not null, receives ∇²S(σ).
+/// Allocation-free.
+Vec3 energy_kernel_gradient(
+    const Vec3& stretches, const Vec3& centre, double epsilon, Mat3* hessian = nullptr);
+/// S(σ) itself (for checks: its gradient is energy_kernel_gradient).
+double energy_kernel(const Vec3& stretches, const Vec3& centre, double epsilon);
+
+/// The quadratic tails qᵀ t(y_k) that are the gradient of an isotropic cubic energy in
+/// e = σ − 1: exactly those with q₁ = 2 q₂ (0-based), spanned by ∇(Σe)³ ↔ (3, 6, 3, 0),
+/// ∇(Σe)(Σe²) ↔ (3, 2, 1, −2) and ∇Σe³ ↔ (3, 0, 0, 0).
+inline bool is_energy_quadratic_tail(const Eigen::Vector4d& q) {
+  return std::abs(q[1] - 2 * q[2]) <= 1e-9 * (std::abs(q[1]) + 2 * std::abs(q[2]));
+}
+
 /// The learned correction, for centres c_i (i = 1..m) in the space of stretch views and
 /// φ_i(y) = φ(‖y − c_i‖):
 ///   N_k(σ)  = h(y_k)                                                                   [Pa]
@@ -90,6 +107,13 @@ class RbfCorrection final : public Correction {
     /// model so that the total stiffness damping never turns negative (energy would grow).
     double damping_floor = -std::numeric_limits<double>::infinity();
     double epsilon = 1e-3; ///< kernel smoothing ε [-] (≥ 0)
+    /// The kernels as an energy (energy_kernel_gradient): N = ∇_σ ΔΨ with
+    /// ΔΨ = Σ_i w_i S_i(σ) + the tails' energies, instead of N_k = Σ_i w_i φ_i(y_k). Then ∂N/∂σ is
+    /// symmetric, the corrected material is hyperelastic (elastic_energy) and its tangent can be
+    /// projected like the nominal's: Newton minimises an incremental potential again. Requires
+    /// the quadratic tail in the energy subspace (is_energy_quadratic_tail); the linear and
+    /// neo-Hookean tails are gradients already.
+    bool energy_kernels = false;
   };
 
   /// Throws InputError("rbf_correction.<field>", ...) if sizes disagree (weights ≠ m entries,
@@ -108,8 +132,11 @@ class RbfCorrection final : public Correction {
   double stiffness_damping(const Vec3& stretches) const override;
   bool depends_on_rates() const override { return false; }
 
-  /// (h(y_1), h(y_2), h(y_3)) [Pa], the same as correction(stretches, ·).
+  /// N(σ) [Pa], the same as correction(stretches, ·).
   Vec3 elastic_correction(const Vec3& stretches) const;
+  /// ΔΨ(σ) [J/m³] up to a constant, whose gradient is N; only for energy_kernels (throws
+  /// InputError otherwise).
+  double elastic_energy(const Vec3& stretches) const;
   /// True if Δα₁ is not identically zero.
   bool has_damping() const;
   /// True if N is not identically zero (a weight, slope, constant, quadratic or neo-Hookean term ≠
@@ -122,9 +149,15 @@ class RbfCorrection final : public Correction {
   /// The tails' part of h(y) (all but the kernels) and, if d_y is non-null, its ∂/∂y.
   double elastic_tail(const Vec3& y, Vec3* d_y) const;
   /// h(y_k) of the three views y_k = column k of `y` and, if d_y is non-null, column k of *d_y =
-  /// ∂h/∂y at y_k.
+  /// ∂h/∂y at y_k; with energy_kernels the kernels are left out (energy_kernels_sum adds them).
   Vec3 elastic_views(const Mat3& y, Mat3* d_y) const;
+  /// Σ_i w_i ∇S_i(σ) and, if not null, Σ_i w_i ∇²S_i(σ) added to *hessian.
+  Vec3 energy_kernels_sum(const Vec3& stretches, Mat3* hessian) const;
   Parameters m_p;
+  /// Energy kernels as plain kernels in σ-space: S_i(σ) = Σ_π φ(‖σ − P_π⁻¹ c_i‖), so the six
+  /// permuted copies of every centre, with its weight, in structure-of-arrays form padded to a
+  /// multiple of 4 (zero weight) for packed evaluation. Empty for stress kernels.
+  Eigen::ArrayXd m_energy_x, m_energy_y, m_energy_z, m_energy_w;
 };
 
 /// (1 − t) a + t b: one correction whose N and Δα₁ (above its floor) are that blend of a's and

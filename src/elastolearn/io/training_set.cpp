@@ -1,0 +1,129 @@
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/io/observation_file.hpp>
+#include <elastolearn/io/training_set.hpp>
+
+#include <string>
+
+namespace elastolearn::io {
+
+namespace {
+
+constexpr const char* k_format_kind = "elastolearn-training";
+constexpr int k_format_version = 1;
+
+/// Adds one motion (its files already resolved) to `set`, checking it for learning. `scene_where`
+/// and `observations_where` name the motion's fields in messages.
+void add_motion(TrainingSet& set, const TrainingSetEntry& paths, const std::string& scene_where,
+    const std::string& observations_where) {
+  SceneFile scene_file = read_scene_file(paths.scene);
+  const sim::Scene& scene = scene_file.scene;
+  if (scene.material.correction)
+    throw InputError(scene_where,
+        "material: the scene's material already carries a correction; learn from a nominal one");
+  if (scene.mass != fem::MassType::Lumped)
+    throw InputError(scene_where,
+        "mass: learning needs \"lumped\" mass (the paper's); learn with lumped mass and simulate "
+        "the learned material with either (docs/learning_loop.md, \"Lumped mass only\")");
+  if (set.motions.empty()) {
+    set.nominal_material = scene_file.nominal_material;
+  } else if (scene_file.nominal_material != set.nominal_material) {
+    throw InputError(scene_where,
+        "material: the nominal material differs from the first motion's ("
+            + set.files.front().paths.scene.string()
+            + "); a training set holds motions of one material");
+  }
+  observe::Observation observed = read_observation_h5(paths.observations);
+  observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, observations_where);
+
+  set.inputs.insert(set.inputs.end(), scene_file.inputs.begin(), scene_file.inputs.end());
+  set.inputs.push_back({ paths.observations, "observations" });
+  set.motions.push_back({ paths.observations.string(), scene, std::move(observed) });
+  set.files.push_back({ paths, std::move(scene_file) });
+}
+
+/// `p` resolved against `folder` (absolute paths stay).
+std::filesystem::path resolved(const std::filesystem::path& folder, const std::string& p) {
+  const std::filesystem::path path(p);
+  return path.is_absolute() ? path : folder / path;
+}
+
+/// `p` (relative to the current folder or absolute) written relative to `folder` when possible.
+std::string relative_to(const std::filesystem::path& folder, const std::filesystem::path& p) {
+  const std::filesystem::path absolute = std::filesystem::absolute(p).lexically_normal();
+  const std::filesystem::path relative = absolute.lexically_relative(folder);
+  return (relative.empty() ? absolute : relative).generic_string();
+}
+
+} // namespace
+
+TrainingSet read_training_set(const std::filesystem::path& path) {
+  const nlohmann::json json = read_json_file(path);
+  const std::string file = path.string();
+  const JsonObject root(json, file);
+  check_format(root, k_format_kind, k_format_version);
+  root.reject_unknown_keys({ "format", "motions" });
+  const std::vector<JsonObject> entries = root.objects("motions");
+  if (entries.empty())
+    root.fail("motions",
+        "needs at least one motion (an object with \"scene\" and "
+        "\"observations\")");
+  TrainingSet set;
+  set.path = path;
+  set.inputs.push_back({ path, "training set" });
+  const std::filesystem::path folder = path.parent_path();
+  for (const JsonObject& entry : entries) {
+    entry.reject_unknown_keys({ "scene", "observations" });
+    for (const char* key : { "scene", "observations" })
+      if (entry.string(key).empty())
+        entry.fail(key, "expected a path, got an empty string");
+    const TrainingSetEntry paths { resolved(folder, entry.string("scene")),
+      resolved(folder, entry.string("observations")) };
+    add_motion(set, paths, file + ": " + entry.field("scene") + " (" + paths.scene.string() + ")",
+        file + ": " + entry.field("observations") + " (" + paths.observations.string() + ")");
+  }
+  return set;
+}
+
+TrainingSet read_training_motion(
+    const std::filesystem::path& scene, const std::filesystem::path& observations) {
+  TrainingSet set;
+  add_motion(set, { scene, observations }, scene.string(), observations.string());
+  return set;
+}
+
+bool is_training_set_file(const std::filesystem::path& path) {
+  try {
+    const nlohmann::json json = read_json_file(path);
+    const auto format = json.is_object() ? json.find("format") : json.end();
+    return format != json.end() && format->is_string()
+        && format->get<std::string>().rfind(std::string(k_format_kind) + "/", 0) == 0;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+nlohmann::json training_set_to_json(
+    const std::filesystem::path& path, const std::vector<TrainingSetEntry>& motions) {
+  const std::filesystem::path folder
+      = std::filesystem::absolute(path).lexically_normal().parent_path();
+  nlohmann::json entries = nlohmann::json::array();
+  for (const TrainingSetEntry& motion : motions)
+    entries.push_back({ { "scene", relative_to(folder, motion.scene) },
+        { "observations", relative_to(folder, motion.observations) } });
+  return { { "format", std::string(k_format_kind) + "/" + std::to_string(k_format_version) },
+    { "motions", entries } };
+}
+
+void write_training_set(
+    const std::filesystem::path& path, const std::vector<TrainingSetEntry>& motions) {
+  if (motions.empty())
+    throw InputError(path.string(), "motions: a training set needs at least one motion");
+  for (size_t i = 0; i < motions.size(); ++i)
+    if (motions[i].scene.empty() || motions[i].observations.empty())
+      throw InputError(path.string(),
+          "motions[" + std::to_string(i) + "]: the scene and observation paths must not be empty");
+  write_json_file(path, training_set_to_json(path, motions));
+}
+
+} // namespace elastolearn::io

@@ -1,0 +1,76 @@
+#include <elastolearn/learn/material_stability.hpp>
+#include <elastolearn/material/principal_stress.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <limits>
+
+namespace elastolearn::learn {
+
+namespace {
+
+/// The smallest eigenvalue of the stretch block's symmetric part and of the twist eigenvalues.
+double smallest_eigenvalue(const material::PrincipalTangent& t) {
+  const Mat3 block = 0.5 * (t.block + t.block.transpose());
+  const double block_min
+      = Eigen::SelfAdjointEigenSolver<Mat3>(block, Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
+  return std::min(block_min, t.twist.minCoeff());
+}
+
+/// A principal frame with the given stretches (U = V = I): the tangent's eigen-form depends on
+/// the stretches only.
+material::PrincipalFrame frame_of(const Vec3& stretches) {
+  return { Mat3::Identity(), stretches, Mat3::Identity() };
+}
+
+} // namespace
+
+StabilityReport material_stability(const material::ElasticModel& nominal,
+    const material::Correction* correction, ConstRef<MatX> stretches) {
+  struct Partial {
+    double worst = std::numeric_limits<double>::infinity();
+    Vec3 at = Vec3::Ones();
+    long unstable = 0;
+  };
+  const Partial total = tbb::parallel_reduce(
+      tbb::blocked_range<Eigen::Index>(0, stretches.rows(), 256), Partial {},
+      [&](const tbb::blocked_range<Eigen::Index>& range, Partial p) {
+        for (Eigen::Index i = range.begin(); i < range.end(); ++i) {
+          const Vec3 s = stretches.row(i).transpose();
+          const material::PrincipalFrame frame = frame_of(s);
+          const double reference
+              = std::max(smallest_eigenvalue(material::principal_tangent(nominal, frame, false)),
+                  std::numeric_limits<double>::min());
+          const material::CorrectedStress c
+              = material::corrected_principal_stress(nominal, correction, s, Vec3::Zero());
+          const double lowest = smallest_eigenvalue(
+              material::principal_tangent(frame, c.stress, c.d_stretches, false));
+          if (lowest < 0)
+            ++p.unstable;
+          if (lowest / reference < p.worst) {
+            p.worst = lowest / reference;
+            p.at = s;
+          }
+        }
+        return p;
+      },
+      [](Partial a, const Partial& b) {
+        a.unstable += b.unstable;
+        if (b.worst < a.worst) {
+          a.worst = b.worst;
+          a.at = b.at;
+        }
+        return a;
+      });
+  StabilityReport r;
+  r.samples = stretches.rows();
+  r.unstable_samples = total.unstable;
+  r.min_relative_eigenvalue = r.samples > 0 ? total.worst : 0;
+  r.worst_stretches = total.at;
+  return r;
+}
+
+} // namespace elastolearn::learn

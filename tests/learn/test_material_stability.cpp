@@ -1,0 +1,82 @@
+// material_stability (issue 19, "stable corrections"): the nominal models are stable, a
+// correction that removes more stiffness than the nominal has is found at the stretches where
+// it does, and only there.
+#include <elastolearn/learn/material_stability.hpp>
+#include <elastolearn/material/corotated.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
+
+#include <gtest/gtest.h>
+
+namespace elastolearn::learn {
+namespace {
+
+const material::CorotatedModel k_nominal(material::Lame::from_young_poisson(1e5, 0.4));
+
+MatX stretch_grid() {
+  MatX s(0, 3);
+  for (double a = 0.7; a <= 1.31; a += 0.1)
+    for (double b = 0.7; b <= a + 1e-9; b += 0.1)
+      for (double c = 0.7; c <= b + 1e-9; c += 0.1) {
+        s.conservativeResize(s.rows() + 1, 3);
+        s.row(s.rows() - 1) << a, b, c;
+      }
+  return s;
+}
+
+/// The linear tail N_k = a e_k + b(Σe − e_k): a Lamé change Δμ = (a − b)/2, Δλ = b.
+material::RbfCorrection lame_change(double d_mu, double d_lambda) {
+  material::RbfCorrection::Parameters p;
+  p.centres.resize(0, 3);
+  p.energy_kernels = true;
+  p.own_slope = 2 * d_mu + d_lambda;
+  p.other_slope = d_lambda;
+  return material::RbfCorrection(std::move(p));
+}
+
+TEST(MaterialStability, NominalAndMildCorrectionsAreStable) {
+  const MatX grid = stretch_grid();
+  const StabilityReport nominal = material_stability(k_nominal, nullptr, grid);
+  EXPECT_TRUE(nominal.stable());
+  EXPECT_EQ(nominal.samples, grid.rows());
+  EXPECT_NEAR(nominal.min_relative_eigenvalue, 1.0, 1e-12); // relative to itself
+  const double mu = material::Lame::from_young_poisson(1e5, 0.4).mu;
+  const material::RbfCorrection softer = lame_change(-0.5 * mu, 0);
+  const StabilityReport r = material_stability(k_nominal, &softer, grid);
+  EXPECT_TRUE(r.stable());
+  // Twist 2μ → μ: half the nominal's smallest eigenvalue (2μ, the twist and the block's).
+  EXPECT_NEAR(r.min_relative_eigenvalue, 0.5, 1e-9);
+}
+
+TEST(MaterialStability, FindsAShearInstability) {
+  const double mu = material::Lame::from_young_poisson(1e5, 0.4).mu;
+  const material::RbfCorrection too_soft = lame_change(-1.5 * mu, 0);
+  const MatX grid = stretch_grid();
+  const StabilityReport r = material_stability(k_nominal, &too_soft, grid);
+  EXPECT_FALSE(r.stable());
+  EXPECT_EQ(r.unstable_samples, grid.rows()); // a Lamé change acts everywhere alike
+  EXPECT_NEAR(r.min_relative_eigenvalue, -0.5, 1e-9);
+}
+
+TEST(MaterialStability, FindsALocalSofteningWhereItActs) {
+  // One energy kernel at stretch (1.2, 1.2, 1.2): a softening there, none near rest.
+  material::RbfCorrection::Parameters p;
+  p.energy_kernels = true;
+  p.epsilon = 0.03;
+  p.centres.resize(1, 3);
+  p.centres << 1.2, 1.2, 1.2;
+  p.weights.resize(1);
+  // Curvature 6 w/ε = −4e5 Pa at the centre (the nominal's smallest is 2μ = 7.1e4 Pa) and of
+  // order 6 w/r = −3.5e4 Pa at rest, r = 0.35 away: the multiquadric's curvature decays as 1/r.
+  p.weights << -2e3;
+  const material::RbfCorrection local(std::move(p));
+  MatX near_rest(1, 3), near_centre(1, 3);
+  near_rest << 1.0, 1.0, 1.0;
+  near_centre << 1.2, 1.2, 1.2;
+  EXPECT_TRUE(material_stability(k_nominal, &local, near_rest).stable());
+  const StabilityReport r = material_stability(k_nominal, &local, near_centre);
+  EXPECT_FALSE(r.stable());
+  EXPECT_EQ(r.worst_stretches, Vec3(1.2, 1.2, 1.2));
+}
+
+} // namespace
+} // namespace elastolearn::learn
