@@ -80,10 +80,12 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   ASSERT_GE(candidates.size(), 3u) << recipe.dump(); // nominal, fitted nominal, corrections
   EXPECT_EQ(candidates.at(1).at("kind"), "fitted nominal");
   const auto chosen = recipe.at("chosen").get<size_t>();
-  for (const auto& c : candidates)
-    if (c.at("completed").get<bool>())
+  for (const auto& c : candidates) {
+    if (c.at("completed").get<bool>()) {
       EXPECT_LE(candidates.at(chosen).at("validation_rms_error_m").get<double>(),
           c.at("validation_rms_error_m").get<double>());
+    }
+  }
   EXPECT_NE(learned.output.find("<- chosen"), std::string::npos) << learned.output;
   ASSERT_TRUE(file.training_stretches.has_value())
       << "learn records the training motion's stretches";

@@ -83,9 +83,11 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
   EXPECT_EQ(r.candidates[0].kind, CandidateKind::Nominal);
   EXPECT_EQ(r.candidates[1].kind, CandidateKind::FittedNominal);
   ASSERT_TRUE(r.candidates[1].completed);
-  for (const Candidate& k : r.candidates)
-    if (k.completed)
+  for (const Candidate& k : r.candidates) {
+    if (k.completed) {
       EXPECT_LE(r.choice().validation.rms, k.validation.rms);
+    }
+  }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);
   // 60 frames: the last 12 held out, 48 trained on.
   EXPECT_EQ(r.training_frames, 48);
