@@ -150,11 +150,10 @@ double merged_rms(double a, double wa, double b, double wb) {
   return std::sqrt((wa * a * a + wb * b * b) / (wa + wb));
 }
 
-/// RBF centres: k-means over the stretch views of every motion's trajectory (at most
-/// options.centres; options.stretch_samples caps each motion's samples).
-MatX rbf_centres(std::span<const ReconstructionMesh> meshes,
-    const std::vector<const std::vector<VecX>*>& trajectories, const LearningOptions& options,
-    std::uint64_t seed) {
+/// The principal stretches of every motion's trajectory, stacked (options.stretch_samples caps
+/// each motion's samples): where the RBF centres go and where a correction must be stable.
+MatX trajectory_stretches(std::span<const ReconstructionMesh> meshes,
+    const std::vector<const std::vector<VecX>*>& trajectories, const LearningOptions& options) {
   std::vector<MatX> parts;
   parts.reserve(trajectories.size());
   Eigen::Index rows = 0;
@@ -168,11 +167,16 @@ MatX rbf_centres(std::span<const ReconstructionMesh> meshes,
     stacked.middleRows(rows, part.rows()) = part;
     rows += part.rows();
   }
-  const MatX stretches = stretch_views(stacked);
+  return stacked;
+}
+
+/// RBF centres: k-means over the stretch views of `stretches` (at most options.centres).
+MatX rbf_centres(const MatX& stretches, const LearningOptions& options, std::uint64_t seed) {
+  const MatX views = stretch_views(stretches);
   KMeansOptions kmeans_options;
-  kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(stretches.rows()));
+  kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(views.rows()));
   kmeans_options.seed = seed;
-  return kmeans(stretches, kmeans_options).centres;
+  return kmeans(views, kmeans_options).centres;
 }
 
 /// Where a correction must be stable: the trajectory's stretches σ and the same deformations
@@ -238,20 +242,15 @@ bool run_forward_fit(std::span<const Motion> motions, std::span<const Reconstruc
   std::vector<std::vector<VecX>> best_runs;
   std::vector<const std::vector<VecX>*> trajectories;
   best_runs.reserve(motions.size());
-  MatX stretches(0, 3);
-  for (size_t i = 0; i < motions.size(); ++i) {
-    best_runs.push_back(sim::simulate_positions(
-        sim::with_correction(motions[i].scene, state.best), callbacks.progress)
-                            .positions);
+  for (const Motion& motion : motions) {
+    best_runs.push_back(
+        sim::simulate_positions(sim::with_correction(motion.scene, state.best), callbacks.progress)
+            .positions); // the best correction's runs completed before: never empty
     trajectories.push_back(&best_runs.back());
-    if (best_runs.back().empty())
-      continue; // cannot happen for the best correction; no samples from it if it does
-    const MatX samples = collect_stretches(meshes[i], best_runs.back(), options.stretch_samples);
-    stretches.conservativeResize(stretches.rows() + samples.rows(), 3);
-    stretches.bottomRows(samples.rows()) = samples;
   }
+  const MatX stretches = trajectory_stretches(meshes, trajectories, options);
   const MatX centres = state.best ? MatX(state.best->parameters().centres)
-                                  : rbf_centres(meshes, trajectories, options, options.seed);
+                                  : rbf_centres(stretches, options, options.seed);
   const RbfDesign design(centres, options.rbf);
   const VecX start
       = state.best ? design.unknowns(*state.best) : VecX(VecX::Zero(design.num_unknowns()));
@@ -502,7 +501,8 @@ bool run_learning(std::span<const Motion> motions, const LearningOptions& option
         blocks.push_back(
             { meshes[i], m.physics.dofs(), m.positions, m.velocities, m.targets, m.projection });
       }
-      const RbfDesign design(rbf_centres(meshes, trajectories, options,
+      const MatX stretches = trajectory_stretches(meshes, trajectories, options);
+      const RbfDesign design(rbf_centres(stretches, options,
                                  options.seed + static_cast<std::uint64_t>(record.iteration)),
           rbf);
       const StressReconstructionResult reconstructed
@@ -510,13 +510,6 @@ bool run_learning(std::span<const Motion> motions, const LearningOptions& option
       record.centres = design.num_centres();
       record.correction_misfit = reconstructed.misfit.rms_residual;
       record.correction_target = reconstructed.misfit.rms_target;
-      MatX stretches(0, 3);
-      for (size_t i = 0; i < motions.size(); ++i) {
-        const MatX samples = collect_stretches(
-            meshes[i], optimized_motions[i].trajectory, options.stretch_samples);
-        stretches.conservativeResize(stretches.rows() + samples.rows(), 3);
-        stretches.bottomRows(samples.rows()) = samples;
-      }
       next.correction = stable_fraction(reconstructed.correction, motions.front().scene.material,
           stability_samples(stretches, 30000), record);
       record.seconds_reconstruction += seconds_since(t0);

@@ -85,12 +85,17 @@ const Eigen::Matrix<double, 4, 3>& energy_tail_map() {
 } // namespace
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
+  if (m_options.energy_kernels)
+    for (Eigen::Index i = 0; i < m_centres.rows(); ++i)
+      out.col(i) = material::energy_kernel_gradient(
+                       stretches, m_centres.row(i).transpose(), m_options.epsilon)
+          - Vec3::Constant(m_rest_kernels[i]);
+  view_columns(stretches, out);
+}
+
+void RbfDesign::view_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
   const Eigen::Index m = m_centres.rows();
   const double eps = m_options.epsilon;
-  if (m_options.energy_kernels)
-    for (Eigen::Index i = 0; i < m; ++i)
-      out.col(i) = material::energy_kernel_gradient(stretches, m_centres.row(i).transpose(), eps)
-          - Vec3::Constant(m_rest_kernels[i]);
   for (int k = 0; k < 3; ++k) {
     const Vec3 y = material::stretch_view(stretches, k);
     if (!m_options.energy_kernels)
@@ -117,7 +122,7 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
     Eigen::Ref<OutputGradient> gradient) const {
-  output_matrix(stretches, out);
+  view_columns(stretches, out);
   gradient.setZero();
   const Eigen::Index m = m_centres.rows();
   for (int k = 0; k < 3; ++k) {
@@ -161,8 +166,9 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
   if (m_options.energy_kernels) {
     Mat3 hessian; // ∂N_k/∂σ_j of kernel i alone: row 3j + k
     for (Eigen::Index i = 0; i < m; ++i) {
-      material::energy_kernel_gradient(
-          stretches, m_centres.row(i).transpose(), m_options.epsilon, &hessian);
+      out.col(i) = material::energy_kernel_gradient(
+                       stretches, m_centres.row(i).transpose(), m_options.epsilon, &hessian)
+          - Vec3::Constant(m_rest_kernels[i]);
       gradient.col(i) = hessian.reshaped();
     }
   }

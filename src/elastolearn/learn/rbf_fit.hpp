@@ -92,6 +92,9 @@ class RbfDesign {
   VecX unknowns(const material::RbfCorrection& correction) const;
 
   private:
+  /// The columns that come from the stretch views: the stress kernels (not energy kernels, which
+  /// each overload of output_matrix fills itself) and the tails.
+  void view_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const;
   material::RbfCorrection::Centres m_centres;
   RbfFitOptions m_options;
   VecX m_rest_kernels; ///< r_i = φ_i(1, 1, 1) under stress_free_rest, else 0
