@@ -109,7 +109,9 @@ observe::Observation frame_range(const observe::Observation& o, int first, int l
 /// The training and validation data of stage 1.
 struct Split {
   std::vector<Motion> training; ///< observations smoothed to the noise level
-  std::vector<Motion> raw_training; ///< the same with the observations as recorded
+  /// The first training motion's observations as recorded (the parameter fit's data: it does
+  /// not differentiate positions).
+  observe::Observation fit_observed;
   Motion validation; ///< scene simulated in full; observed = its frames compared
   int first_validation_frame = 0; ///< frame of the validation scene's run that observed[0] is
   std::string description;
@@ -120,8 +122,8 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
     std::vector<observe::Observation> smoothed) {
   Split split;
   if (motions.size() >= 2) {
+    split.fit_observed = motions.front().observed;
     for (size_t i = 0; i + 1 < motions.size(); ++i) {
-      split.raw_training.push_back(motions[i]);
       Motion m = motions[i];
       m.observed = std::move(smoothed[i]);
       split.training.push_back(std::move(m));
@@ -142,13 +144,11 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
     throw InputError(only.name,
         "too few frames (" + std::to_string(frames) + ") to hold out the last "
             + std::to_string(held_out) + " for validation");
-  Motion raw = only;
-  raw.scene.frames = train_frames;
-  raw.observed = frame_range(only.observed, 0, train_frames);
-  Motion train = raw;
+  Motion train = only;
+  train.scene.frames = train_frames;
   train.observed = frame_range(smoothed.front(), 0, train_frames);
-  split.raw_training.push_back(std::move(raw));
   split.training.push_back(std::move(train));
+  split.fit_observed = frame_range(only.observed, 0, train_frames);
   split.validation = only;
   split.validation.observed = frame_range(only.observed, train_frames + 1, frames);
   split.first_validation_frame = train_frames + 1;
@@ -233,7 +233,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
           + format("%.3g m RMS", change));
 
   // Stage 1: training and validation data.
-  const Split split = split_motions(motions, options.validation_fraction, std::move(smoothed));
+  Split split = split_motions(motions, options.validation_fraction, std::move(smoothed));
   result.training_frames = split.training.front().scene.frames;
   result.validation_frames = split.validation.observed.num_frames();
   result.validation_data = split.description;
@@ -241,13 +241,13 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
 
   // Stage 2: the nominal model's parameters, fitted to the first training motion (the
   // parameter fit takes one motion).
-  const Motion& train = split.raw_training.front();
+  const sim::Scene& train = split.training.front().scene;
   if (resume) {
     result.parameter_fit = resume->parameter_fit;
     result.loop = resume->loop;
   } else if (options.fit_parameters) {
-    result.parameter_fit = fit_parameters(train.scene, result.nominal_type, given_parameters,
-        train.observed, options.parameter_fit, {});
+    result.parameter_fit = fit_parameters(train, result.nominal_type, given_parameters,
+        split.fit_observed, options.parameter_fit, {});
     const auto& f = result.parameter_fit;
     say(callbacks,
         format("parameter fit: E %.4g Pa, ν %.3f, α₀ %.3g 1/s, ", f.fitted.young, f.fitted.poisson,
@@ -260,13 +260,11 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   if (!resume && callbacks.parameters_fitted)
     callbacks.parameters_fitted(result.parameter_fit);
   result.fitted_nominal
-      = scene_with_parameters(train.scene, result.nominal_type, result.parameter_fit.fitted)
-            .material;
+      = scene_with_parameters(train, result.nominal_type, result.parameter_fit.fitted).material;
 
   // Stage 3: the loop (and its forward fit) on the fitted nominal, following smoothed positions,
   // over every training motion.
-  std::vector<Motion> loop_motions = split.training;
-  for (Motion& m : loop_motions)
+  for (Motion& m : split.training)
     m.scene.material = result.fitted_nominal;
   std::map<int, std::shared_ptr<const material::RbfCorrection>> tried; // C_k per iteration
   std::shared_ptr<const material::RbfCorrection> current = result.loop.correction; // next C_k
@@ -284,7 +282,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     if (callbacks.loop.checkpoint)
       callbacks.loop.checkpoint(s);
   };
-  if (!run_learning(loop_motions, options.loop, result.loop, loop_callbacks)) {
+  if (!run_learning(split.training, options.loop, result.loop, loop_callbacks)) {
     result.interrupted = true;
     return result;
   }
