@@ -139,6 +139,41 @@ void apply_overrides(learn::LearningOptions& o) {
     o.reconstruction.full_space_weight = g_full_space_weight;
 }
 
+/// One line per loop or forward-fit iteration (errors as % of `size`), indented by `indent`.
+void print_iteration(const learn::IterationRecord& r, double size, const char* indent) {
+  if (r.forward_completed)
+    std::printf("%siteration %d: forward rms %.4f %%, max %.4f %%", indent, r.iteration,
+        100 * r.forward_error.rms / size, 100 * r.forward_error.max / size);
+  else
+    std::printf("%siteration %d:", indent, r.iteration);
+  if (r.forward_fit)
+    std::printf(" (forward fit: %s, %d kernels, %.1f s)\n",
+        r.forward_unstable           ? "trial unstable, rejected unsimulated"
+            : !r.forward_completed   ? "trial DIVERGED, rejected"
+            : r.forward_fit_accepted ? "accepted"
+                                     : "rejected",
+        r.centres, r.seconds_forward);
+  else if (r.modes > 0)
+    std::printf(
+        "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N, step kept %.3g; "
+        "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
+        r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target,
+        r.step_kept, r.seconds_forward, r.seconds_constrained, r.seconds_space_time,
+        r.space_time_iterations, r.seconds_reconstruction);
+  else if (!r.forward_completed)
+    std::printf(" -> this correction's forward simulation DIVERGED (%.1f s: %s); %s\n",
+        r.seconds_forward, r.forward_message.c_str(),
+        r.damped_update ? "trying half its step" : "the loop stops");
+  else
+    std::printf(" (final forward check, %.1f s)\n", r.seconds_forward);
+  std::fflush(stdout);
+}
+
+/// A forward simulation that failed (a correction rejected as unstable was never simulated).
+bool diverged(const learn::IterationRecord& r) {
+  return !r.forward_completed && !r.forward_unstable;
+}
+
 Row run_case(const LearningCase& c) {
   Row row;
   row.name = c.name;
@@ -191,34 +226,8 @@ Row run_case(const LearningCase& c) {
     std::printf("   %s\n", line.c_str());
     std::fflush(stdout);
   };
-  callbacks.loop.iteration = [&](const learn::IterationRecord& r) {
-    if (r.forward_completed)
-      std::printf("   iteration %d: forward rms %.4f %%, max %.4f %%", r.iteration,
-          100 * r.forward_error.rms / size, 100 * r.forward_error.max / size);
-    else
-      std::printf("   iteration %d:", r.iteration);
-    if (r.forward_fit)
-      std::printf(" (forward fit: %s, %d kernels, %.1f s)\n",
-          r.forward_unstable           ? "trial unstable, rejected unsimulated"
-              : !r.forward_completed   ? "trial DIVERGED, rejected"
-              : r.forward_fit_accepted ? "accepted"
-                                       : "rejected",
-          r.centres, r.seconds_forward);
-    else if (r.modes > 0)
-      std::printf(
-          "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N, step kept %.3g; "
-          "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
-          r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target,
-          r.step_kept, r.seconds_forward, r.seconds_constrained, r.seconds_space_time,
-          r.space_time_iterations, r.seconds_reconstruction);
-    else if (!r.forward_completed)
-      std::printf(" -> this correction's forward simulation DIVERGED (%.1f s: %s); %s\n",
-          r.seconds_forward, r.forward_message.c_str(),
-          r.damped_update ? "trying half its step" : "the loop stops");
-    else
-      std::printf(" (final forward check, %.1f s)\n", r.seconds_forward);
-    std::fflush(stdout);
-  };
+  callbacks.loop.iteration
+      = [&](const learn::IterationRecord& r) { print_iteration(r, size, "   "); };
   t0 = Clock::now();
   const std::vector<learn::Motion> motions { { c.name + " training", c.train, observed } };
   const learn::RecipeResult learned = learn::learn_material(motions, g_recipe, callbacks);
@@ -231,7 +240,7 @@ Row run_case(const LearningCase& c) {
     row.reconstruction += r.seconds_reconstruction;
     if (r.modes > 0)
       ++row.iterations;
-    if (!r.forward_completed && !r.forward_unstable)
+    if (diverged(r))
       ++row.divergences;
     row.modes = std::max(row.modes, r.modes);
     row.kernels = std::max(row.kernels, r.centres);
@@ -436,6 +445,8 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
     std::printf("   recipe: %s\n", line.c_str());
     std::fflush(stdout);
   };
+  callbacks.loop.iteration
+      = [&](const learn::IterationRecord& r) { print_iteration(r, o.diagonal, "   recipe: "); };
   t0 = Clock::now();
   const auto result
       = learn::learn_material(std::span<const learn::Motion>(&motion, 1), {}, callbacks);
@@ -443,7 +454,7 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
   row.fit_seconds = result.parameter_fit.seconds;
   row.fit_diverged = result.parameter_fit.diverged;
   for (const auto& r : result.loop.history)
-    row.loop_diverged += r.forward_completed ? 0 : 1;
+    row.loop_diverged += diverged(r) ? 1 : 0;
   for (const auto& c : result.candidates)
     row.validation_diverged += c.completed ? 0 : 1;
   row.chosen = learn::to_string(result.choice().kind);

@@ -122,7 +122,9 @@ nlohmann::json recipe_json(const elastolearn::learn::RecipeResult& r) {
     candidates.push_back({ { "kind", learn::to_string(c.kind) }, { "iteration", c.iteration },
         { "completed", c.completed }, { "training_rms_error_m", c.training.rms },
         { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
-        { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr } });
+        { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr },
+        { "extrapolation_unstable_samples", c.extrapolation.unstable_samples },
+        { "extrapolation_samples", c.extrapolation.samples }, { "eligible", c.eligible() } });
   return { { "noise_sigma_m", r.noise.sigma }, { "noise_estimated", r.noise.estimated },
     { "smoothing_rms_change_m", r.noise.smoothing_residual },
     { "training_frames", r.training_frames }, { "validation_frames", r.validation_frames },
@@ -272,7 +274,9 @@ void run_learn(const LearnOptions& o) {
         + (c.iteration >= 0 ? " (iteration " + std::to_string(c.iteration) + ")" : "");
     if (c.completed)
       std::printf("  %-28s %10.4f %%%s\n", name.c_str(), 100 * c.validation.rms / diagonal,
-          static_cast<int>(i) == result.chosen ? "   <- chosen" : "");
+          static_cast<int>(i) == result.chosen ? "   <- chosen"
+              : c.eligible()                   ? ""
+                                               : "   (unstable in a larger motion: not eligible)");
     else
       std::printf("  %-28s   diverged\n", name.c_str());
   }

@@ -5,6 +5,9 @@
 #include <elastolearn/material/corotated.hpp>
 #include <elastolearn/material/rbf_correction.hpp>
 
+#include <array>
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 namespace elastolearn::learn {
@@ -76,6 +79,41 @@ TEST(MaterialStability, FindsALocalSofteningWhereItActs) {
   const StabilityReport r = material_stability(k_nominal, &local, near_centre);
   EXPECT_FALSE(r.stable());
   EXPECT_EQ(r.worst_stretches, Vec3(1.2, 1.2, 1.2));
+}
+
+TEST(MaterialStability, AmplifiedStretchesReachALargerMotionsInstability) {
+  // Samples of an isochoric stretch (s, s^-1/2, s^-1/2), s ≤ 1.1, raised to the powers 1 and 2:
+  // each row is exactly σᵃ (J stays 1), and the kernel softening at s = 1.2 of the test above is
+  // reached only by the amplified samples (1.1² = 1.21).
+  MatX motion(11, 3);
+  for (int i = 0; i <= 10; ++i) {
+    const double s = 1 + 0.01 * i;
+    motion.row(i) << s, 1 / std::sqrt(s), 1 / std::sqrt(s);
+  }
+  const std::array<double, 2> powers { 1.0, 2.0 };
+  const MatX amplified = amplified_stretches(motion, powers, 1000);
+  ASSERT_EQ(amplified.rows(), 22);
+  for (int i = 0; i <= 10; ++i) {
+    EXPECT_EQ(amplified.row(i), motion.row(i));
+    for (int c = 0; c < 3; ++c)
+      EXPECT_DOUBLE_EQ(amplified(11 + i, c), motion(i, c) * motion(i, c));
+    EXPECT_NEAR(amplified.row(11 + i).prod(), 1.0, 1e-14);
+  }
+  // The row cap keeps every ⌈2 · 11 / 10⌉ = 3rd sample of each power.
+  EXPECT_EQ(amplified_stretches(motion, powers, 10).rows(), 8);
+
+  material::RbfCorrection::Parameters p;
+  p.energy_kernels = true;
+  p.epsilon = 0.03;
+  p.centres.resize(1, 3);
+  p.centres << 1.2, 1 / std::sqrt(1.2), 1 / std::sqrt(1.2);
+  p.weights.resize(1);
+  p.weights << -2e3;
+  const material::RbfCorrection local(std::move(p));
+  EXPECT_TRUE(material_stability(k_nominal, &local, motion).stable());
+  const StabilityReport r = material_stability(k_nominal, &local, amplified);
+  EXPECT_FALSE(r.stable());
+  EXPECT_GT(r.worst_stretches[0], 1.1);
 }
 
 } // namespace

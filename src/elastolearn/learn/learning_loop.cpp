@@ -150,6 +150,13 @@ double merged_rms(double a, double wa, double b, double wb) {
   return std::sqrt((wa * a * a + wb * b * b) / (wa + wb));
 }
 
+/// Where the loop's corrections must be stable: the trajectory's stretches and σ^1.25 (a forward
+/// simulation with a softening correction strains more than the trajectory it was fitted to, and
+/// there the correction's tails extrapolate). Larger amplifications there made the turtle's first
+/// correction unstable at a few samples beyond the training's extremes and halved every step;
+/// the recipe's validation checks its candidates further out (learning_recipe.cpp).
+constexpr std::array<double, 2> kLoopAmplifications { 1.0, 1.25 };
+
 /// The principal stretches of every motion's trajectory, stacked (options.stretch_samples caps
 /// each motion's samples): where the RBF centres go and where a correction must be stable.
 MatX trajectory_stretches(std::span<const ReconstructionMesh> meshes,
@@ -177,27 +184,6 @@ MatX rbf_centres(const MatX& stretches, const LearningOptions& options, std::uin
   kmeans_options.clusters = std::min<int>(options.centres, static_cast<int>(views.rows()));
   kmeans_options.seed = seed;
   return kmeans(views, kmeans_options).centres;
-}
-
-/// Where a correction must be stable: the trajectory's stretches σ and the same deformations
-/// amplified in log-stretch, σᵃ for a = 1.25 (a forward simulation with a softening correction
-/// strains more than the trajectory it was fitted to, and there the correction's tails
-/// extrapolate). Log-stretches keep J = 1 states at J = 1: amplifying σ − 1 instead would turn a
-/// nearly incompressible motion into large volume changes, where even the truth may be unstable.
-/// Inverted samples (σ₃ ≤ 0) are kept as they are. At most `max_rows` rows in all.
-MatX stability_samples(const MatX& stretches, Eigen::Index max_rows) {
-  constexpr std::array<double, 2> amplification { 1.0, 1.25 };
-  const Eigen::Index step = std::max<Eigen::Index>(1,
-      (static_cast<Eigen::Index>(amplification.size()) * stretches.rows() + max_rows - 1)
-          / std::max<Eigen::Index>(max_rows, 1));
-  const Eigen::Index kept = (stretches.rows() + step - 1) / step;
-  MatX out(static_cast<Eigen::Index>(amplification.size()) * kept, 3);
-  Eigen::Index row = 0;
-  for (const double a : amplification)
-    for (Eigen::Index i = 0; i < stretches.rows(); i += step, ++row)
-      for (int c = 0; c < 3; ++c)
-        out(row, c) = stretches(i, c) > 0 ? std::pow(stretches(i, c), a) : stretches(i, c);
-  return out;
 }
 
 /// The reconstructed correction, or the largest fraction ½ᵏ (k ≤ 4) of it whose material is
@@ -259,7 +245,7 @@ bool run_forward_fit(std::span<const Motion> motions, std::span<const Reconstruc
   if (state.forward_fit_damping > 0)
     fit_options.damping = state.forward_fit_damping;
   if (stretches.rows() > 0)
-    fit_options.stability_stretches = stability_samples(stretches, 30000);
+    fit_options.stability_stretches = amplified_stretches(stretches, kLoopAmplifications, 30000);
   bool stopped = false;
   fit_to_observations(motions, meshes, design, start, fit_options, callbacks.progress,
       [&](const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping) {
@@ -511,7 +497,7 @@ bool run_learning(std::span<const Motion> motions, const LearningOptions& option
       record.correction_misfit = reconstructed.misfit.rms_residual;
       record.correction_target = reconstructed.misfit.rms_target;
       next.correction = stable_fraction(reconstructed.correction, motions.front().scene.material,
-          stability_samples(stretches, 30000), record);
+          amplified_stretches(stretches, kLoopAmplifications, 30000), record);
       record.seconds_reconstruction += seconds_since(t0);
     }
     next.next_iteration = record.iteration + 1;

@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
+#include <elastolearn/learn/element_state.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/material/corotated.hpp>
 #include <elastolearn/material/neohookean.hpp>
@@ -10,6 +11,7 @@
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -109,9 +111,9 @@ observe::Observation frame_range(const observe::Observation& o, int first, int l
 /// The training and validation data of stage 1.
 struct Split {
   std::vector<Motion> training; ///< observations smoothed to the noise level
-  /// The first training motion's observations as recorded (the parameter fit's data: it does
-  /// not differentiate positions).
-  observe::Observation fit_observed;
+  /// The training motions' observations as recorded, in order (the parameter fit's data: it
+  /// does not differentiate positions).
+  std::vector<observe::Observation> fit_observed;
   Motion validation; ///< scene simulated in full; observed = its frames compared
   int first_validation_frame = 0; ///< frame of the validation scene's run that observed[0] is
   std::string description;
@@ -122,8 +124,8 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
     std::vector<observe::Observation> smoothed) {
   Split split;
   if (motions.size() >= 2) {
-    split.fit_observed = motions.front().observed;
     for (size_t i = 0; i + 1 < motions.size(); ++i) {
+      split.fit_observed.push_back(motions[i].observed);
       Motion m = motions[i];
       m.observed = std::move(smoothed[i]);
       split.training.push_back(std::move(m));
@@ -148,7 +150,7 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
   train.scene.frames = train_frames;
   train.observed = frame_range(smoothed.front(), 0, train_frames);
   split.training.push_back(std::move(train));
-  split.fit_observed = frame_range(only.observed, 0, train_frames);
+  split.fit_observed.push_back(frame_range(only.observed, 0, train_frames));
   split.validation = only;
   split.validation.observed = frame_range(only.observed, train_frames + 1, frames);
   split.first_validation_frame = train_frames + 1;
@@ -159,7 +161,14 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
   return split;
 }
 
-/// The candidate's error on the held-out data (completed false if its simulation diverged).
+/// Where a candidate's material must stay stable: its validation run's stretches amplified in
+/// log-stretch to σ^1.5 and σ², the strains of a motion 1.5–2× as large (a user's next motion is
+/// rarely the one recorded). The loop's own check stops at σ^1.25 (learning_loop.cpp): it shrinks
+/// every correction that fails, while here a failing candidate only loses the choice.
+constexpr std::array<double, 2> kExtrapolation { 1.5, 2.0 };
+
+/// The candidate's error on the held-out data (completed false if its simulation diverged) and
+/// its material's stability where a larger motion goes.
 void validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
   sim::Scene scene = split.validation.scene;
   scene.material = nominal;
@@ -171,6 +180,11 @@ void validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
   const std::vector<VecX> compared(
       run.positions.begin() + split.first_validation_frame, run.positions.end());
   c.validation = observation_error(compared, split.validation.observed);
+  if (c.correction) {
+    const MatX stretches = collect_stretches(ReconstructionMesh(scene.mesh), run.positions);
+    c.extrapolation = material_stability(*nominal.elastic, c.correction.get(),
+        amplified_stretches(stretches, kExtrapolation, 40000));
+  }
 }
 
 void say(const RecipeCallbacks& callbacks, const std::string& line) {
@@ -239,15 +253,21 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   result.validation_data = split.description;
   say(callbacks, "validation: " + split.description);
 
-  // Stage 2: the nominal model's parameters, fitted to the first training motion (the
-  // parameter fit takes one motion).
+  // Stage 2: the nominal model's parameters, fitted to every training motion as recorded (the
+  // training motions lend their scenes, their observations swapped for the raw ones meanwhile).
   const sim::Scene& train = split.training.front().scene;
   if (resume) {
     result.parameter_fit = resume->parameter_fit;
     result.loop = resume->loop;
   } else if (options.fit_parameters) {
-    result.parameter_fit = fit_parameters(train, result.nominal_type, given_parameters,
-        split.fit_observed, options.parameter_fit, {});
+    const auto swap_observations = [&] {
+      for (size_t i = 0; i < split.training.size(); ++i)
+        std::swap(split.training[i].observed, split.fit_observed[i]);
+    };
+    swap_observations();
+    result.parameter_fit = fit_parameters(
+        split.training, result.nominal_type, given_parameters, options.parameter_fit, {});
+    swap_observations();
     const auto& f = result.parameter_fit;
     say(callbacks,
         format("parameter fit: E %.4g Pa, ν %.3f, α₀ %.3g 1/s, ", f.fitted.young, f.fitted.poisson,
@@ -300,7 +320,12 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
         "candidate " + to_string(kind) + (iteration >= 0 ? " " + std::to_string(iteration) : "")
             + (c.completed ? format(": validation error rms %.4f %%, max %.4f %%",
                    100 * c.validation.rms / size, 100 * c.validation.max / size)
-                           : ": its simulation of the held-out data diverged"));
+                           : ": its simulation of the held-out data diverged")
+            + (c.completed && !c.extrapolation.stable()
+                    ? format("; unstable at %.0f of %.0f samples of σ^1.5, σ² (not eligible)",
+                        static_cast<double>(c.extrapolation.unstable_samples),
+                        static_cast<double>(c.extrapolation.samples))
+                    : ""));
     result.candidates.push_back(std::move(c));
   };
   add(CandidateKind::Nominal, -1, nullptr, result.parameter_fit.initial_rms);
@@ -334,7 +359,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best, result.loop.best_error);
   for (size_t i = 0; i < result.candidates.size(); ++i) {
     const Candidate& c = result.candidates[i];
-    if (c.completed && (result.chosen < 0 || c.validation.rms < result.choice().validation.rms))
+    if (c.eligible() && (result.chosen < 0 || c.validation.rms < result.choice().validation.rms))
       result.chosen = static_cast<int>(i);
   }
   if (result.chosen < 0)

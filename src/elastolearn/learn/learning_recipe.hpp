@@ -9,11 +9,13 @@
 ///   2. parameter fit: E, ν, α₀, α₁ of the nominal model fitted to the training data;
 ///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit;
 ///   4. validation: every candidate (the given nominal, the fitted nominal, each completed
-///      correction of the loop and of the forward fit) simulates the held-out data; the one with
-///      the smallest RMS error there is the result.
+///      correction of the loop and of the forward fit) simulates the held-out data; among those
+///      whose material stays stable where a larger motion goes, the one with the smallest RMS
+///      error there is the result.
 /// The validation choice is what makes the result never worse than fitting parameters on data
 /// nobody tuned the recipe for: the fitted nominal is always a candidate.
 #include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
@@ -63,7 +65,13 @@ struct Candidate {
   std::shared_ptr<const material::RbfCorrection> correction;
   bool completed = false; ///< the validation simulation completed
   ErrorSummary validation; ///< at the held-out observations [m]
+  /// Its material's stability (material_stability) at the stretches of its validation run
+  /// amplified to σ^1.5 and σ² (amplified_stretches): where a larger motion of the same kind
+  /// goes. Not checked (all stable) for the nominals.
+  StabilityReport extrapolation;
   ErrorSummary training; ///< at the training observations [m] (the loop's own signal)
+  /// Eligible for the choice: its validation completed and its material extrapolates stably.
+  bool eligible() const { return completed && extrapolation.stable(); }
 };
 
 /// Everything the recipe decided and measured.

@@ -6,6 +6,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace elastolearn::learn {
@@ -71,6 +72,21 @@ StabilityReport material_stability(const material::ElasticModel& nominal,
   r.min_relative_eigenvalue = r.samples > 0 ? total.worst : 0;
   r.worst_stretches = total.at;
   return r;
+}
+
+MatX amplified_stretches(
+    ConstRef<MatX> stretches, std::span<const double> amplifications, Eigen::Index max_rows) {
+  const auto powers = static_cast<Eigen::Index>(amplifications.size());
+  const Eigen::Index step = std::max<Eigen::Index>(
+      1, (powers * stretches.rows() + max_rows - 1) / std::max<Eigen::Index>(max_rows, 1));
+  const Eigen::Index kept = (stretches.rows() + step - 1) / step;
+  MatX out(powers * kept, 3);
+  Eigen::Index row = 0;
+  for (const double a : amplifications)
+    for (Eigen::Index i = 0; i < stretches.rows(); i += step, ++row)
+      for (int c = 0; c < 3; ++c)
+        out(row, c) = stretches(i, c) > 0 ? std::pow(stretches(i, c), a) : stretches(i, c);
+  return out;
 }
 
 } // namespace elastolearn::learn

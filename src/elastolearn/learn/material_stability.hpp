@@ -11,6 +11,8 @@
 #include <elastolearn/material/correction.hpp>
 #include <elastolearn/material/elastic_model.hpp>
 
+#include <span>
+
 namespace elastolearn::learn {
 
 struct StabilityReport {
@@ -28,5 +30,14 @@ struct StabilityReport {
 /// (N × 3 principal stretches, e.g. collect_stretches of a trajectory). Parallel over samples.
 StabilityReport material_stability(const material::ElasticModel& nominal,
     const material::Correction* correction, ConstRef<MatX> stretches);
+
+/// Sample stretches for the check: every row of `stretches` (sorted principal stretches of a
+/// motion) raised to each power a in `amplifications`, σᵃ: the same deformations amplified in
+/// log-stretch, as a larger motion of the same kind reaches them. Log-stretches keep J = 1 states
+/// at J = 1 (amplifying σ − 1 instead would turn a nearly incompressible motion into large volume
+/// changes, where even the truth may be unstable). Inverted samples (σ₃ ≤ 0) are kept as they
+/// are. At most `max_rows` rows in all: every ⌈·⌉-th row of `stretches` is used.
+MatX amplified_stretches(
+    ConstRef<MatX> stretches, std::span<const double> amplifications, Eigen::Index max_rows);
 
 } // namespace elastolearn::learn

@@ -60,38 +60,62 @@ struct ParameterTransform {
   }
 };
 
-/// One forward simulation compared with the observation.
+/// Forward simulations of every motion compared with its observation.
 struct Evaluation {
   bool completed = false;
   std::string message; ///< the simulation's reason when not completed
-  VecX residual; ///< x_sim − x_obs at the observed vertices, frame-major, (frames+1)·k·3
+  /// x_sim − x_obs at the observed vertices, motion after motion, each frame-major,
+  /// Σ (frames+1)·k·3
+  VecX residual;
   double cost = std::numeric_limits<double>::infinity(); ///< ‖residual‖²
-  double max_error = 0; ///< max over (frame, vertex) of the error norm [m]
+  double max_error = 0; ///< max over (motion, frame, vertex) of the error norm [m]
 
   double rms(int samples) const { return std::sqrt(cost / samples); }
 };
 
-Evaluation evaluate(const sim::Scene& base, material::ElasticModelType type,
-    const NominalParameters& parameters, const observe::Observation& obs, int frames) {
-  sim::Scene scene = scene_with_parameters(base, type, parameters);
-  scene.frames = frames;
-  const int k = obs.num_observed();
+/// One motion of the fit: its scene, observation and the steps simulated.
+struct FitMotion {
+  const sim::Scene* scene = nullptr;
+  const observe::Observation* observed = nullptr;
+  int frames = 0;
+  Eigen::Index samples() const {
+    return static_cast<Eigen::Index>(frames + 1) * observed->num_observed();
+  }
+};
+
+Evaluation evaluate(std::span<const FitMotion> motions, material::ElasticModelType type,
+    const NominalParameters& parameters) {
+  Eigen::Index length = 0;
+  for (const FitMotion& m : motions)
+    length += 3 * m.samples();
   Evaluation e;
-  e.residual.setZero(static_cast<Eigen::Index>(frames + 1) * k * 3);
+  e.residual.setZero(length);
   double max_sq = 0;
-  const auto sink = [&](int frame, double, const VecX& x, const VecX&) {
-    const Positions& observed = obs.positions[static_cast<size_t>(frame)];
-    for (int j = 0; j < k; ++j) {
-      const Vec3 d
-          = x.segment<3>(3 * obs.vertex_ids[static_cast<size_t>(j)]) - observed.row(j).transpose();
-      e.residual.segment<3>((static_cast<Eigen::Index>(frame) * k + j) * 3) = d;
-      max_sq = std::max(max_sq, d.squaredNorm());
+  Eigen::Index offset = 0;
+  for (const FitMotion& m : motions) {
+    sim::Scene scene = scene_with_parameters(*m.scene, type, parameters);
+    scene.frames = m.frames;
+    const observe::Observation& obs = *m.observed;
+    const int k = obs.num_observed();
+    const auto sink = [&](int frame, double, const VecX& x, const VecX&) {
+      const Positions& observed = obs.positions[static_cast<size_t>(frame)];
+      for (int j = 0; j < k; ++j) {
+        const Vec3 d = x.segment<3>(3 * obs.vertex_ids[static_cast<size_t>(j)])
+            - observed.row(j).transpose();
+        e.residual.segment<3>(offset + (static_cast<Eigen::Index>(frame) * k + j) * 3) = d;
+        max_sq = std::max(max_sq, d.squaredNorm());
+      }
+    };
+    const sim::SimulationReport report = sim::run_simulation(scene, sink);
+    if (!report.completed) {
+      e.message = report.message;
+      return e;
     }
-  };
-  const sim::SimulationReport report = sim::run_simulation(scene, sink);
-  e.completed = report.completed && e.residual.allFinite();
+    offset += 3 * m.samples();
+  }
+  e.completed = e.residual.allFinite();
   if (!e.completed) {
-    e.message = report.message.empty() ? "non-finite positions" : report.message;
+    e.message = "non-finite positions";
     return e;
   }
   e.cost = e.residual.squaredNorm();
@@ -239,6 +263,9 @@ void ParameterFitOptions::validate() const {
   if (!std::isfinite(error_tolerance))
     throw InputError(
         "fit.error_tolerance", "must be finite, got " + std::to_string(error_tolerance));
+  if (!(young_scan_range >= 0 && young_scan_range <= 1e3))
+    throw InputError("fit.young_scan_range",
+        "must be in [0, 1000] (<= 1: no scan), got " + std::to_string(young_scan_range));
   if (!std::isfinite(alpha0_floor) || !std::isfinite(alpha1_floor))
     throw InputError("fit.alpha_floor", "damping floors must be finite");
 }
@@ -246,30 +273,51 @@ void ParameterFitOptions::validate() const {
 ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticModelType type,
     const NominalParameters& start, const observe::Observation& obs,
     const ParameterFitOptions& options, const ProgressCallback& progress) {
+  const Motion motion { "observation", scene, obs };
+  return fit_parameters(std::span<const Motion>(&motion, 1), type, start, options, progress);
+}
+
+ParameterFitReport fit_parameters(std::span<const Motion> data, material::ElasticModelType type,
+    const NominalParameters& start, const ParameterFitOptions& options,
+    const ProgressCallback& progress) {
   const auto t0 = Clock::now();
   options.validate();
   check_start(start, options.parameters);
-  obs.validate(scene.mesh.num_vertices(), -1, scene.dt, "observation");
-  if (obs.num_frames() < 2)
-    throw InputError("observation: /observed/positions", "needs at least 2 frames to fit a motion");
-  const int frames = options.frames < 0 ? obs.num_frames() - 1 : options.frames;
-  if (frames > obs.num_frames() - 1)
-    throw InputError("fit.frames",
-        std::to_string(frames) + " steps requested but the observation has only "
-            + std::to_string(obs.num_frames() - 1) + " (frames 0.."
-            + std::to_string(obs.num_frames() - 1) + ")");
+  if (data.empty())
+    throw InputError("fit", "no motion to fit");
+  std::vector<FitMotion> motions;
+  int samples = 0;
+  double duration = 0;
+  for (const Motion& m : data) {
+    const observe::Observation& obs = m.observed;
+    obs.validate(m.scene.mesh.num_vertices(), -1, m.scene.dt, m.name);
+    if (obs.num_frames() < 2)
+      throw InputError(m.name + ": /observed/positions", "needs at least 2 frames to fit a motion");
+    const int frames = options.frames < 0 ? obs.num_frames() - 1 : options.frames;
+    if (frames > obs.num_frames() - 1)
+      throw InputError("fit.frames",
+          std::to_string(frames) + " steps requested but " + m.name + " has only "
+              + std::to_string(obs.num_frames() - 1) + " (frames 0.."
+              + std::to_string(obs.num_frames() - 1) + ")");
+    motions.push_back({ &m.scene, &obs, frames });
+    samples += static_cast<int>(motions.back().samples());
+    duration = std::max(duration, frames * m.scene.dt);
+  }
+  const sim::Scene& scene = data.front().scene;
+  const int frames = motions.front().frames;
 
-  const double duration = frames * scene.dt;
   const ParameterTransform transform { options.alpha0_floor > 0 ? options.alpha0_floor
                                                                 : 1e-2 / duration,
     options.alpha1_floor > 0 ? options.alpha1_floor : 1e-2 * scene.dt };
   const auto& fitted = options.parameters;
   const int p = static_cast<int>(fitted.size());
-  const int samples = (frames + 1) * obs.num_observed();
   const double error_floor = options.error_tolerance > 0
       ? options.error_tolerance
       : 1e-10 * scene.mesh.bounding_box_diagonal();
-  const bool parallel = options.parallel && 3 * scene.mesh.num_vertices() <= kParallelFitMaxDofs;
+  int largest_dofs = 0;
+  for (const Motion& m : data)
+    largest_dofs = std::max(largest_dofs, 3 * m.scene.mesh.num_vertices());
+  const bool parallel = options.parallel && largest_dofs <= kParallelFitMaxDofs;
 
   ParameterFitReport report;
   report.initial = report.fitted = start;
@@ -297,7 +345,7 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
     return report;
   };
 
-  Evaluation current = evaluate(scene, type, start, obs, frames);
+  Evaluation current = evaluate(motions, type, start);
   ++report.simulations;
   if (!current.completed) {
     report.diverged = 1;
@@ -309,6 +357,43 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
   report.initial_rms = current.rms(samples);
   report.initial_max = current.max_error;
   record(0, current, options.initial_lambda, 0);
+  if (std::find(fitted.begin(), fitted.end(), FitParameter::Young) != fitted.end()
+      && options.young_scan_range > 1) {
+    // The objective is multimodal in E: a model stiffer or softer by a factor (1 + 1/P)² drifts
+    // a whole period out of phase over P observed periods, so Levenberg–Marquardt started a
+    // factor 1.5–2 off can stop in the wrong phase. E = start × 2^(j/2) over the range puts a
+    // sample within 2^(1/4) of every E, inside the right basin for P ≲ 4.
+    std::vector<double> factors;
+    const int half = static_cast<int>(std::floor(2 * std::log2(options.young_scan_range) + 1e-9));
+    for (int j = -half; j <= half; ++j)
+      if (j != 0)
+        factors.push_back(std::exp2(0.5 * j));
+    std::vector<Evaluation> scanned(factors.size());
+    const auto scan = [&](size_t i) {
+      NominalParameters trial = start;
+      trial.young *= factors[i];
+      scanned[i] = evaluate(motions, type, trial);
+    };
+    if (parallel) {
+      tbb::parallel_for(size_t { 0 }, factors.size(), scan);
+    } else {
+      for (size_t i = 0; i < factors.size(); ++i)
+        scan(i);
+    }
+    size_t best = factors.size();
+    for (size_t i = 0; i < factors.size(); ++i) {
+      ++report.simulations;
+      if (!scanned[i].completed)
+        ++report.diverged;
+      else if (scanned[i].cost < (best < factors.size() ? scanned[best].cost : current.cost))
+        best = i;
+    }
+    if (best < factors.size()) {
+      report.fitted.young = start.young * factors[best];
+      current = std::move(scanned[best]);
+      record(0, current, options.initial_lambda, 0);
+    }
+  }
 
   // Levenberg–Marquardt in the transformed coordinates u. The current point is report.fitted,
   // `current` its evaluation; a trial waits in trial_parameters and `trial` until the driver
@@ -346,7 +431,7 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
       for (const double step : { h, -h }) {
         NominalParameters perturbed = report.fitted;
         transform.set(fitted[i], u[i] + step, perturbed);
-        const Evaluation e = evaluate(scene, type, perturbed, obs, frames);
+        const Evaluation e = evaluate(motions, type, perturbed);
         ++runs[static_cast<size_t>(i)];
         if (e.completed) {
           J.col(i) = (e.residual - current.residual) / step;
@@ -380,7 +465,7 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
     trial_parameters = report.fitted;
     for (int i = 0; i < p; ++i)
       transform.set(fitted[i], u[i] + delta[i], trial_parameters);
-    trial = evaluate(scene, type, trial_parameters, obs, frames);
+    trial = evaluate(motions, type, trial_parameters);
     ++report.simulations;
     if (interrupt_requested()) {
       interrupted();

@@ -5,10 +5,12 @@
 /// positions, by Levenberg–Marquardt on forward simulations. The learned correction must beat it
 /// where the nominal model is wrong in kind (paper Fig. 11).
 #include <elastolearn/core/progress.hpp>
+#include <elastolearn/learn/motion.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>
 
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -68,6 +70,11 @@ struct ParameterFitOptions {
   /// for α₀ and 10⁻² · dt for α₁ (far below any damping visible over the observed motion).
   double alpha0_floor = 0;
   double alpha1_floor = 0;
+  /// Before Levenberg–Marquardt, when E is fitted: simulate E = start × 2^(j/2) over
+  /// [start / range, start × range] and start from the best (the objective is multimodal in E:
+  /// a model out of phase by a whole period is a local minimum). ≤ 1: no scan. The default
+  /// range 4 costs 8 simulations.
+  double young_scan_range = 4;
   /// Run the finite-difference simulations of one Jacobian concurrently (oneTBB); each holds
   /// its own simulator (mesh, matrix, factorisation), so memory grows with the parameter count.
   /// Meshes of more than kParallelFitMaxDofs unknowns run them one after the other: each
@@ -128,5 +135,11 @@ struct ParameterFitReport {
 ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticModelType type,
     const NominalParameters& start, const observe::Observation& obs,
     const ParameterFitOptions& options = {}, const ProgressCallback& progress = {});
+
+/// The same fit to several motions of one object at once: Φ is summed over them (each scene's
+/// material is replaced as above; `frames` applies to each motion). Errors name the motion.
+ParameterFitReport fit_parameters(std::span<const Motion> motions, material::ElasticModelType type,
+    const NominalParameters& start, const ParameterFitOptions& options = {},
+    const ProgressCallback& progress = {});
 
 } // namespace elastolearn::learn
