@@ -83,9 +83,17 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
   EXPECT_EQ(r.candidates[0].kind, CandidateKind::Nominal);
   EXPECT_EQ(r.candidates[1].kind, CandidateKind::FittedNominal);
   ASSERT_TRUE(r.candidates[1].completed);
+  // The choice is the lowest validation error among the eligible candidates (completed and
+  // stable where a larger motion goes); the nominals are always eligible.
+  EXPECT_TRUE(r.choice().eligible());
   for (const Candidate& k : r.candidates) {
-    if (k.completed) {
+    if (k.eligible()) {
       EXPECT_LE(r.choice().validation.rms, k.validation.rms);
+    }
+    if (!k.correction) {
+      EXPECT_EQ(k.extrapolation.samples, 0) << "the nominals are not checked";
+    } else if (k.completed) {
+      EXPECT_GT(k.extrapolation.samples, 0);
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);
