@@ -20,6 +20,7 @@
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/material/nn_correction.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -124,7 +125,10 @@ nlohmann::json recipe_json(const elastolearn::learn::RecipeResult& r) {
         { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
         { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr },
         { "extrapolation_unstable_samples", c.extrapolation.unstable_samples },
-        { "extrapolation_samples", c.extrapolation.samples }, { "eligible", c.eligible() } });
+        { "extrapolation_samples", c.extrapolation.samples }, { "eligible", c.eligible() },
+        // null: infinite (noise σ = 0 and it is better than the reference)
+        { "significance",
+            std::isfinite(c.significance) ? nlohmann::json(c.significance) : nullptr } });
   return { { "noise_sigma_m", r.noise.sigma }, { "noise_estimated", r.noise.estimated },
     { "smoothing_rms_change_m", r.noise.smoothing_residual },
     { "training_frames", r.training_frames }, { "validation_frames", r.validation_frames },
@@ -272,11 +276,20 @@ void run_learn(const LearnOptions& o) {
     const auto& c = result.candidates[i];
     const std::string name = learn::to_string(c.kind)
         + (c.iteration >= 0 ? " (iteration " + std::to_string(c.iteration) + ")" : "");
+    const bool reference = c.kind == learn::CandidateKind::FittedNominal
+        || (c.kind == learn::CandidateKind::Nominal && !o.recipe.fit_parameters);
+    std::string note;
+    if (static_cast<int>(i) == result.chosen)
+      note = "   <- chosen";
+    else if (c.completed && !c.eligible())
+      note = "   (unstable in a larger motion: not eligible)";
+    else if (c.completed && !reference && c.significance < learn::kSignificance)
+      note = "   (" + std::string(c.significance > 0 ? "better" : "no better")
+          + " than the fitted nominal by " + elastolearn::to_text(c.significance)
+          + " noise deviations: not significant)";
     if (c.completed)
-      std::printf("  %-28s %10.4f %%%s\n", name.c_str(), 100 * c.validation.rms / diagonal,
-          static_cast<int>(i) == result.chosen ? "   <- chosen"
-              : c.eligible()                   ? ""
-                                               : "   (unstable in a larger motion: not eligible)");
+      std::printf(
+          "  %-28s %10.4f %%%s\n", name.c_str(), 100 * c.validation.rms / diagonal, note.c_str());
     else
       std::printf("  %-28s   diverged\n", name.c_str());
   }

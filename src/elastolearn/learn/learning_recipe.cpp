@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 
 namespace elastolearn::learn {
@@ -167,16 +168,39 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
 /// every correction that fails, while here a failing candidate only loses the choice.
 constexpr std::array<double, 2> kExtrapolation { 1.5, 2.0 };
 
+/// The positions of the observed vertices in `frames`, flat (frame, observed vertex, xyz).
+VecX at_observed_vertices(std::span<const VecX> frames, const std::vector<int>& vertex_ids) {
+  const auto k = static_cast<Eigen::Index>(vertex_ids.size());
+  VecX out(static_cast<Eigen::Index>(frames.size()) * k * 3);
+  for (size_t t = 0; t < frames.size(); ++t)
+    for (Eigen::Index j = 0; j < k; ++j)
+      out.segment<3>((static_cast<Eigen::Index>(t) * k + j) * 3)
+          = frames[t].segment<3>(3 * vertex_ids[static_cast<size_t>(j)]);
+  return out;
+}
+
+/// An observation's positions, flat like at_observed_vertices.
+VecX flat_positions(const observe::Observation& o) {
+  const Eigen::Index k = o.num_observed();
+  VecX out(static_cast<Eigen::Index>(o.num_frames()) * k * 3);
+  for (int t = 0; t < o.num_frames(); ++t)
+    for (Eigen::Index j = 0; j < k; ++j)
+      out.segment<3>((static_cast<Eigen::Index>(t) * k + j) * 3)
+          = o.positions[static_cast<size_t>(t)].row(j).transpose();
+  return out;
+}
+
 /// The candidate's error on the held-out data (completed false if its simulation diverged) and
-/// its material's stability where a larger motion goes.
-void validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
+/// its material's stability where a larger motion goes. Returns its predictions of the held-out
+/// observations (at_observed_vertices; empty if it diverged).
+VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
   sim::Scene scene = split.validation.scene;
   scene.material = nominal;
   scene.material.correction = c.correction;
   const sim::ForwardRun run = sim::simulate_positions(scene);
   c.completed = run.completed;
   if (!run.completed)
-    return;
+    return {};
   const std::vector<VecX> compared(
       run.positions.begin() + split.first_validation_frame, run.positions.end());
   c.validation = observation_error(compared, split.validation.observed);
@@ -185,6 +209,7 @@ void validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
     c.extrapolation = material_stability(*nominal.elastic, c.correction.get(),
         amplified_stretches(stretches, kExtrapolation, 40000));
   }
+  return at_observed_vertices(compared, split.validation.observed.vertex_ids);
 }
 
 void say(const RecipeCallbacks& callbacks, const std::string& line) {
@@ -199,6 +224,34 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0, do
 }
 
 } // namespace
+
+int choose_candidate(std::vector<Candidate>& candidates, std::span<const VecX> predictions,
+    const VecX& observed, int reference, double sigma) {
+  int chosen = -1;
+  const Candidate* ref = reference >= 0 ? &candidates[static_cast<size_t>(reference)] : nullptr;
+  if (ref && !ref->completed)
+    ref = nullptr;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    Candidate& c = candidates[i];
+    if (!c.completed)
+      continue;
+    if (ref && static_cast<int>(i) != reference) {
+      const VecX& r = predictions[static_cast<size_t>(reference)];
+      const VecX& p = predictions[i];
+      const double gain = (r - observed).squaredNorm() - (p - observed).squaredNorm();
+      const double spread = 2 * sigma * (p - r).norm();
+      c.significance = spread > 0 ? gain / spread
+          : gain > 0              ? std::numeric_limits<double>::infinity()
+                                  : 0;
+    }
+    const bool passes = !ref || static_cast<int>(i) == reference || c.significance >= kSignificance;
+    if (c.eligible() && passes
+        && (chosen < 0
+            || c.validation.rms < candidates[static_cast<size_t>(chosen)].validation.rms))
+      chosen = static_cast<int>(i);
+  }
+  return chosen;
+}
 
 RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions& options,
     const RecipeCallbacks& callbacks, const RecipeResume* resume) {
@@ -308,6 +361,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   }
 
   // Stage 4: every candidate on the held-out data.
+  std::vector<VecX> predictions; // per candidate, at_observed_vertices
   auto add = [&](CandidateKind kind, int iteration,
                  std::shared_ptr<const material::RbfCorrection> correction, double training) {
     Candidate c;
@@ -315,7 +369,8 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     c.iteration = iteration;
     c.correction = std::move(correction);
     c.training.rms = training;
-    validate_candidate(c, split, kind == CandidateKind::Nominal ? given : result.fitted_nominal);
+    predictions.push_back(validate_candidate(
+        c, split, kind == CandidateKind::Nominal ? given : result.fitted_nominal));
     say(callbacks,
         "candidate " + to_string(kind) + (iteration >= 0 ? " " + std::to_string(iteration) : "")
             + (c.completed ? format(": validation error rms %.4f %%, max %.4f %%",
@@ -357,11 +412,9 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // A resumed run knows the earlier iterations only through the best one.
   if (result.loop.best && tried.find(result.loop.best_iteration) == tried.end())
     add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best, result.loop.best_error);
-  for (size_t i = 0; i < result.candidates.size(); ++i) {
-    const Candidate& c = result.candidates[i];
-    if (c.eligible() && (result.chosen < 0 || c.validation.rms < result.choice().validation.rms))
-      result.chosen = static_cast<int>(i);
-  }
+  result.chosen
+      = choose_candidate(result.candidates, predictions, flat_positions(split.validation.observed),
+          options.fit_parameters ? 1 : 0, result.noise.sigma);
   if (result.chosen < 0)
     throw InputError(split.validation.name,
         "no candidate, not even the nominal material, simulates the held-out data");

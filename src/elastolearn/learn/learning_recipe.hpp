@@ -10,8 +10,9 @@
 ///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit;
 ///   4. validation: every candidate (the given nominal, the fitted nominal, each completed
 ///      correction of the loop and of the forward fit) simulates the held-out data; among those
-///      whose material stays stable where a larger motion goes, the one with the smallest RMS
-///      error there is the result.
+///      whose material stays stable where a larger motion goes and that beat the fitted nominal
+///      by more than noise could (z ≥ kSignificance), the one with the smallest RMS error there
+///      is the result; the fitted nominal if none.
 /// The validation choice is what makes the result never worse than fitting parameters on data
 /// nobody tuned the recipe for: the fitted nominal is always a candidate.
 #include <elastolearn/learn/learning_loop.hpp>
@@ -70,11 +71,21 @@ struct Candidate {
   /// goes. Not checked (all stable) for the nominals.
   StabilityReport extrapolation;
   ErrorSummary training; ///< at the training observations [m] (the loop's own signal)
+  /// Its improvement on the reference (the fitted nominal, or the given one without a fit) in
+  /// standard deviations of what noise alone would give: z = (‖r − o‖² − ‖c − o‖²) / (2σ‖c − r‖)
+  /// over the held-out observations o, with r, c the reference's and this candidate's predictions
+  /// (the noise term of the difference, −2 nᵀ(c − r), has standard deviation 2σ‖c − r‖). 0 for
+  /// the reference itself.
+  double significance = 0;
   /// Eligible for the choice: its validation completed and its material extrapolates stably.
   bool eligible() const { return completed && extrapolation.stable(); }
 };
 
 /// Everything the recipe decided and measured.
+/// How many noise standard deviations a candidate must beat the fitted nominal by on the held-out
+/// data to replace it (one-sided: a 2.3 % chance that noise alone passes a candidate no better).
+inline constexpr double kSignificance = 2;
+
 struct RecipeResult {
   NoiseLevel noise;
   int training_frames = 0; ///< frames per training motion used (single motion: the split)
@@ -111,6 +122,15 @@ struct RecipeResume {
 /// constant Rayleigh damping (fit-parameters needs both).
 NominalParameters nominal_parameters_of(
     const fem::MaterialModel& material, material::ElasticModelType& type);
+
+/// Stage 4's choice. `predictions[i]` is candidate i's prediction of the held-out observations
+/// `observed` (both flat: frame, observed vertex, xyz; empty if it did not complete), `reference`
+/// the index of the fitted nominal (or −1: no reference), σ the noise per coordinate. Sets every
+/// other completed candidate's `significance` against the reference and returns the index of the
+/// eligible candidate with the lowest validation RMS among the reference and the candidates with
+/// significance ≥ kSignificance (−1 if none is eligible).
+int choose_candidate(std::vector<Candidate>& candidates, std::span<const VecX> predictions,
+    const VecX& observed, int reference, double sigma);
 
 /// Run all stages (from `resume` on, if given: stage 2 is then not repeated). Returns with
 /// `interrupted` set if callbacks.loop.interrupted asked to stop (the last checkpoint holds the
