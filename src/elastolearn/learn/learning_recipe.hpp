@@ -67,8 +67,8 @@ struct Candidate {
   bool completed = false; ///< the validation simulation completed
   ErrorSummary validation; ///< at the held-out observations [m]
   /// Its material's stability (material_stability) at the stretches of its validation run
-  /// amplified to σ^1.5 and σ² (amplified_stretches): where a larger motion of the same kind
-  /// goes. Not checked (all stable) for the nominals.
+  /// amplified to σ^1.5 (amplified_stretches): where a larger motion of the same kind goes. Not
+  /// checked (all stable) for the nominals.
   StabilityReport extrapolation;
   ErrorSummary training; ///< at the training observations [m] (the loop's own signal)
   /// Its improvement on the reference (the fitted nominal, or the given one without a fit) in
