@@ -1,0 +1,149 @@
+#include <elastolearn/capture/virtual_scanner.hpp>
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace elastolearn::capture {
+
+namespace {
+
+constexpr FieldErrors fail("scan");
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+/// A counter-based stream of random numbers for one (seed, frame, camera, pixel): each draw
+/// hashes the key with a counter, so no state is shared between pixels or threads.
+class PixelRandom {
+  public:
+  PixelRandom(std::uint64_t seed, long frame, int camera, long long pixel)
+      : m_key(splitmix64(splitmix64(splitmix64(seed) ^ static_cast<std::uint64_t>(frame))
+                  ^ static_cast<std::uint64_t>(camera))
+          ^ static_cast<std::uint64_t>(pixel)) { }
+  /// Uniform in [0, 1).
+  double uniform() {
+    return static_cast<double>(splitmix64(m_key + ++m_counter) >> 11) * 0x1.0p-53;
+  }
+  /// Standard normal (Box–Muller).
+  double normal() {
+    const double u1 = 1.0 - uniform(); // (0, 1]
+    const double u2 = uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+  }
+
+  private:
+  std::uint64_t m_key;
+  std::uint64_t m_counter = 0;
+};
+
+} // namespace
+
+void ScanOptions::validate() const {
+  if (!std::isfinite(noise) || noise < 0)
+    fail("noise", "must be finite and ≥ 0, got " + to_text(noise));
+  if (!(outlier_fraction >= 0 && outlier_fraction <= 1))
+    fail("outliers", "must be a fraction in [0, 1], got " + to_text(outlier_fraction));
+}
+
+VirtualScanner::VirtualScanner(const Faces& faces, int num_vertices,
+    std::vector<DepthCamera> cameras, const ScanOptions& options)
+    : m_caster(faces, num_vertices)
+    , m_cameras(std::move(cameras))
+    , m_options(options) {
+  m_options.validate();
+  if (m_cameras.empty())
+    throw InputError("scan", "no cameras");
+  for (const DepthCamera& camera : m_cameras) {
+    camera.validate("camera '" + camera.name + "'");
+    m_images.push_back({ Eigen::MatrixXd(camera.height, camera.width),
+        Eigen::MatrixXi(camera.height, camera.width) });
+  }
+}
+
+void VirtualScanner::update(ConstRef<Positions> x) {
+  m_caster.update(x);
+}
+
+long long VirtualScanner::num_pixels() const {
+  long long n = 0;
+  for (const DepthCamera& camera : m_cameras)
+    n += camera.num_pixels();
+  return n;
+}
+
+void VirtualScanner::render(int c, DepthImage& image) const {
+  const DepthCamera& camera = m_cameras[static_cast<std::size_t>(c)];
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+        for (int v = rows.begin(); v < rows.end(); ++v) {
+          for (int u = 0; u < camera.width; ++u) {
+            const Vec3 d = camera.pixel_ray(u, v);
+            // d has unit component along the optical axis, so the ray parameter is the depth.
+            const RayHit hit = m_caster.first_hit(camera.position, d, camera.near, camera.far);
+            const bool seen = hit.face >= 0 && hit.normal.dot(d) < 0;
+            image.depth(v, u) = seen ? hit.t : nan;
+            image.face(v, u) = seen ? hit.face : -1;
+          }
+        }
+      });
+}
+
+DepthImage VirtualScanner::depth_image(int camera) const {
+  ELASTOLEARN_CHECK(camera >= 0 && camera < static_cast<int>(m_cameras.size()),
+      "depth_image: camera index out of range");
+  const DepthCamera& c = m_cameras[static_cast<std::size_t>(camera)];
+  DepthImage image { Eigen::MatrixXd(c.height, c.width), Eigen::MatrixXi(c.height, c.width) };
+  render(camera, image);
+  return image;
+}
+
+CloudFrame VirtualScanner::scan(long frame) {
+  long long seen = 0;
+  for (std::size_t c = 0; c < m_cameras.size(); ++c) {
+    render(static_cast<int>(c), m_images[c]);
+    seen += (m_images[c].face.array() >= 0).count();
+  }
+  CloudFrame out;
+  out.points.resize(seen, 3);
+  if (m_options.normals)
+    out.normals.resize(seen, 3);
+  Eigen::Index row = 0;
+  for (std::size_t c = 0; c < m_cameras.size(); ++c) {
+    const DepthCamera& camera = m_cameras[c];
+    const DepthImage& image = m_images[c];
+    for (int v = 0; v < camera.height; ++v) {
+      for (int u = 0; u < camera.width; ++u) {
+        const int face = image.face(v, u);
+        if (face < 0)
+          continue;
+        double z = image.depth(v, u);
+        if (m_options.noise > 0 || m_options.outlier_fraction > 0) {
+          PixelRandom random(m_options.seed, frame, static_cast<int>(c),
+              static_cast<long long>(v) * camera.width + u);
+          if (m_options.outlier_fraction > 0 && random.uniform() < m_options.outlier_fraction)
+            z = camera.near + random.uniform() * (z - camera.near);
+          else if (m_options.noise > 0)
+            z += m_options.noise * random.normal();
+        }
+        out.points.row(row) = (camera.position + z * camera.pixel_ray(u, v)).transpose();
+        if (m_options.normals)
+          out.normals.row(row) = m_caster.face_normal(face).transpose();
+        ++row;
+      }
+    }
+  }
+  return out;
+}
+
+} // namespace elastolearn::capture
