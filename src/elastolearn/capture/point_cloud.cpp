@@ -2,7 +2,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
 
-#include <algorithm>
 #include <cmath>
 
 namespace elastolearn::capture {
@@ -14,14 +13,45 @@ const std::string k_offsets = "/clouds/offsets";
 const std::string k_normals = "/clouds/normals";
 const std::string k_confidence = "/clouds/confidence";
 
-/// "frame t, point j" of global point row i (offsets already checked).
-std::string point_name(const std::vector<Eigen::Index>& offsets, Eigen::Index i) {
-  const auto it = std::upper_bound(offsets.begin(), offsets.end(), i);
-  const auto t = static_cast<Eigen::Index>(it - offsets.begin()) - 1;
-  return "frame " + std::to_string(t) + ", point " + std::to_string(i - offsets[t]);
+/// The checks of CloudFrame::validate on views of one frame.
+void check_frame(ConstRef<Positions> points, ConstRef<Positions> normals,
+    const Eigen::Ref<const VecX>& confidence, const std::string& source, int frame) {
+  const auto where = [&](const std::string& field) { return source + ": " + field; };
+  const auto point = [&](Eigen::Index j) {
+    return "frame " + std::to_string(frame) + ", point " + std::to_string(j);
+  };
+  const Eigen::Index n = points.rows();
+  if (normals.rows() != 0 && normals.rows() != n)
+    throw InputError(where(k_normals),
+        "frame " + std::to_string(frame) + " has " + std::to_string(normals.rows())
+            + " normals for " + std::to_string(n) + " points");
+  if (confidence.size() != 0 && confidence.size() != n)
+    throw InputError(where(k_confidence),
+        "frame " + std::to_string(frame) + " has " + std::to_string(confidence.size())
+            + " confidence values for " + std::to_string(n) + " points");
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(points(j, c)))
+        throw InputError(where(k_points),
+            point(j) + ": non-finite coordinate " + to_text_exact(points(j, c)) + " (component "
+                + std::to_string(c) + ")");
+  for (Eigen::Index j = 0; j < normals.rows(); ++j) {
+    const double length = normals.row(j).norm();
+    if (!(std::abs(length - 1) <= k_normal_length_tolerance))
+      throw InputError(
+          where(k_normals), point(j) + ": not a unit vector (length " + to_text(length) + ")");
+  }
+  for (Eigen::Index j = 0; j < confidence.size(); ++j)
+    if (!(confidence[j] >= 0 && confidence[j] <= 1))
+      throw InputError(where(k_confidence),
+          point(j) + ": " + to_text_exact(confidence[j]) + " is not in [0, 1]");
 }
 
 } // namespace
+
+void CloudFrame::validate(const std::string& source, int frame) const {
+  check_frame(points, normals, confidence, source, frame);
+}
 
 CloudFrame PointCloudSequence::frame(int t) const {
   CloudFrame f;
@@ -44,19 +74,19 @@ void PointCloudSequence::append(const CloudFrame& frame, const std::string& sour
     throw InputError(source,
         "has " + std::to_string(frame.confidence.size()) + " confidence values for "
             + std::to_string(n) + " points");
-  const bool decided = num_points() > 0;
   if (n > 0) {
+    const bool decided = num_points() > 0;
     const bool frame_normals = frame.normals.rows() > 0;
     const bool frame_confidence = frame.confidence.size() > 0;
     if (decided && frame_normals != has_normals())
       throw InputError(source,
           std::string(frame_normals ? "has" : "has no") + " normals, but the frames before "
-              + (has_normals() ? "have" : "have none"));
+              + (has_normals() ? "have them" : "have none"));
     if (decided && frame_confidence != has_confidence())
       throw InputError(source,
           std::string(frame_confidence ? "has" : "has no")
               + " confidence values, but the frames before "
-              + (has_confidence() ? "have" : "have none"));
+              + (has_confidence() ? "have them" : "have none"));
     const Eigen::Index old = num_points();
     points.conservativeResize(old + n, 3);
     points.bottomRows(n) = frame.points;
@@ -89,34 +119,19 @@ void PointCloudSequence::validate(const std::string& source) const {
     throw InputError(where(k_offsets),
         "ends at " + std::to_string(offsets.back()) + " but " + k_points + " has "
             + std::to_string(num_points()) + " points");
-  for (Eigen::Index i = 0; i < points.size(); ++i) {
-    if (!std::isfinite(points.data()[i]))
-      throw InputError(where(k_points),
-          point_name(offsets, i / 3) + ": non-finite coordinate " + to_text_exact(points.data()[i])
-              + " (component " + std::to_string(i % 3) + ")");
-  }
-  if (has_normals()) {
-    if (normals.rows() != num_points())
-      throw InputError(where(k_normals),
-          "has " + std::to_string(normals.rows()) + " rows, " + k_points + " has "
-              + std::to_string(num_points()));
-    for (Eigen::Index i = 0; i < normals.rows(); ++i) {
-      const double length = normals.row(i).norm();
-      if (!(std::abs(length - 1) <= k_normal_length_tolerance))
-        throw InputError(where(k_normals),
-            point_name(offsets, i) + ": not a unit vector (length " + to_text(length) + ")");
-    }
-  }
-  if (has_confidence()) {
-    if (confidence.size() != num_points())
-      throw InputError(where(k_confidence),
-          "has " + std::to_string(confidence.size()) + " values, " + k_points + " has "
-              + std::to_string(num_points()) + " points");
-    for (Eigen::Index i = 0; i < confidence.size(); ++i) {
-      if (!(confidence[i] >= 0 && confidence[i] <= 1))
-        throw InputError(where(k_confidence),
-            point_name(offsets, i) + ": " + to_text_exact(confidence[i]) + " is not in [0, 1]");
-    }
+  if (has_normals() && normals.rows() != num_points())
+    throw InputError(where(k_normals),
+        "has " + std::to_string(normals.rows()) + " rows, " + k_points + " has "
+            + std::to_string(num_points()));
+  if (has_confidence() && confidence.size() != num_points())
+    throw InputError(where(k_confidence),
+        "has " + std::to_string(confidence.size()) + " values, " + k_points + " has "
+            + std::to_string(num_points()) + " points");
+  for (int t = 0; t < num_frames(); ++t) {
+    const Eigen::Index begin = offsets[t], count = frame_size(t);
+    check_frame(points.middleRows(begin, count),
+        has_normals() ? normals.middleRows(begin, count) : normals.middleRows(0, 0),
+        has_confidence() ? confidence.segment(begin, count) : confidence.segment(0, 0), source, t);
   }
   if (!std::isfinite(dt) || dt <= 0)
     throw InputError(where("dt"), "must be positive and finite, got " + to_text_exact(dt));

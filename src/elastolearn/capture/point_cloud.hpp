@@ -15,6 +15,11 @@ struct CloudFrame {
   Positions points; ///< N×3 [m]
   Positions normals; ///< N×3 unit vectors, or 0 rows when the frame has none
   VecX confidence; ///< N values in [0, 1], or empty when the frame has none
+
+  /// Check sizes (normals N×3 or none, confidence N or none), finite points, unit normals
+  /// (k_normal_length_tolerance) and confidence in [0, 1]. Errors are
+  /// InputError("<source>: /clouds/<field>", "frame <frame>, point <j>: …").
+  void validate(const std::string& source, int frame) const;
 };
 
 /// T frames of points stored back to back: frame t is rows offsets[t] … offsets[t+1]−1 of
