@@ -1,6 +1,7 @@
 #include <elastolearn/capture/virtual_scanner.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
+#include <elastolearn/core/interrupt.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -109,41 +110,66 @@ DepthImage VirtualScanner::depth_image(int camera) const {
 }
 
 CloudFrame VirtualScanner::scan(long frame) {
-  long long seen = 0;
+  // Rows of the output, camera by camera and image row by image row, fixed before the parallel
+  // fill so that every pixel's point has its place whatever the threads do.
+  std::vector<std::vector<Eigen::Index>> row_start(m_cameras.size());
+  Eigen::Index seen = 0;
   for (std::size_t c = 0; c < m_cameras.size(); ++c) {
     render(static_cast<int>(c), m_images[c]);
-    seen += (m_images[c].face.array() >= 0).count();
+    const Eigen::MatrixXi& face = m_images[c].face;
+    row_start[c].resize(static_cast<std::size_t>(face.rows()));
+    for (Eigen::Index v = 0; v < face.rows(); ++v) {
+      row_start[c][static_cast<std::size_t>(v)] = seen;
+      seen += (face.row(v).array() >= 0).count();
+    }
   }
   CloudFrame out;
   out.points.resize(seen, 3);
   if (m_options.normals)
     out.normals.resize(seen, 3);
-  Eigen::Index row = 0;
   for (std::size_t c = 0; c < m_cameras.size(); ++c) {
     const DepthCamera& camera = m_cameras[c];
     const DepthImage& image = m_images[c];
-    for (int v = 0; v < camera.height; ++v) {
-      for (int u = 0; u < camera.width; ++u) {
-        const int face = image.face(v, u);
-        if (face < 0)
-          continue;
-        double z = image.depth(v, u);
-        if (m_options.noise > 0 || m_options.outlier_fraction > 0) {
-          PixelRandom random(m_options.seed, frame, static_cast<int>(c),
-              static_cast<long long>(v) * camera.width + u);
-          if (m_options.outlier_fraction > 0 && random.uniform() < m_options.outlier_fraction)
-            z = camera.near + random.uniform() * (z - camera.near);
-          else if (m_options.noise > 0)
-            z += m_options.noise * random.normal();
-        }
-        out.points.row(row) = (camera.position + z * camera.pixel_ray(u, v)).transpose();
-        if (m_options.normals)
-          out.normals.row(row) = m_caster.face_normal(face).transpose();
-        ++row;
-      }
-    }
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+          for (int v = rows.begin(); v < rows.end(); ++v) {
+            Eigen::Index row = row_start[c][static_cast<std::size_t>(v)];
+            for (int u = 0; u < camera.width; ++u) {
+              const int face = image.face(v, u);
+              if (face < 0)
+                continue;
+              double z = image.depth(v, u);
+              if (m_options.noise > 0 || m_options.outlier_fraction > 0) {
+                PixelRandom random(m_options.seed, frame, static_cast<int>(c),
+                    static_cast<long long>(v) * camera.width + u);
+                if (m_options.outlier_fraction > 0 && random.uniform() < m_options.outlier_fraction)
+                  z = camera.near + random.uniform() * (z - camera.near);
+                else if (m_options.noise > 0)
+                  z += m_options.noise * random.normal();
+              }
+              out.points.row(row) = (camera.position + z * camera.pixel_ray(u, v)).transpose();
+              if (m_options.normals)
+                out.normals.row(row) = m_caster.face_normal(face).transpose();
+              ++row;
+            }
+          }
+        });
   }
   return out;
+}
+
+void scan_frames(VirtualScanner& scanner, const std::vector<Positions>& frames,
+    const std::function<void(long frame, const CloudFrame& cloud)>& sink,
+    const ProgressCallback& progress) {
+  const long T = static_cast<long>(frames.size());
+  for (long t = 0; t < T; ++t) {
+    if (interrupt_requested())
+      throw InputError("scan", "interrupted before frame " + std::to_string(t));
+    scanner.update(frames[static_cast<std::size_t>(t)]);
+    sink(t, scanner.scan(t));
+    if (progress)
+      progress(t + 1, T, "frame " + std::to_string(t + 1) + "/" + std::to_string(T));
+  }
 }
 
 } // namespace elastolearn::capture

@@ -20,7 +20,10 @@
 #include <elastolearn/capture/point_cloud.hpp>
 #include <elastolearn/capture/ray_caster.hpp>
 
+#include <elastolearn/core/progress.hpp>
+
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace elastolearn::capture {
@@ -74,5 +77,13 @@ class VirtualScanner {
   ScanOptions m_options;
   std::vector<DepthImage> m_images; ///< one per camera, reused across frames
 };
+
+/// Scan every frame of a motion (frames[t]: num_vertices × 3 [m]) and hand each cloud to
+/// `sink(t, cloud)` in frame order; `progress` (optional) is told after each frame. Throws
+/// InputError("scan", ...) when an interrupt (Ctrl-C) is requested between frames, and whatever
+/// update() or the sink throws.
+void scan_frames(VirtualScanner& scanner, const std::vector<Positions>& frames,
+    const std::function<void(long frame, const CloudFrame& cloud)>& sink,
+    const ProgressCallback& progress = {});
 
 } // namespace elastolearn::capture
