@@ -14,6 +14,9 @@ constexpr const char* k_kind = "elastolearn-cameras";
 constexpr int k_version = 1;
 
 capture::DepthCamera read_camera(const JsonObject& c, int index) {
+  // A typo must not fall back to a default (an "upp" would leave "up" at +y).
+  c.reject_unknown_keys(
+      { "name", "position", "look_at", "up", "resolution", "fov_y", "intrinsics", "near", "far" });
   capture::DepthCamera camera;
   camera.name = c.string("name", "camera" + std::to_string(index));
   camera.position = c.vec3("position");
@@ -55,8 +58,6 @@ capture::DepthCamera read_camera(const JsonObject& c, int index) {
       c.fail("far",
           "must be greater than near (" + to_text(camera.near) + "), got " + to_text(camera.far));
   }
-  c.reject_unknown_keys(
-      { "name", "position", "look_at", "up", "resolution", "fov_y", "intrinsics", "near", "far" });
   camera.validate(c.file() + ": " + c.field(""));
   return camera;
 }
