@@ -3,6 +3,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -123,13 +125,9 @@ void SurfaceRayCaster::update(ConstRef<Positions> x) {
   s.built = true;
 }
 
-RayHit SurfaceRayCaster::first_hit(
-    const Vec3& origin, const Vec3& direction, double t_min, double t_max) const {
-  const Impl& s = *m_impl;
-  ELASTOLEARN_CHECK(s.built, "SurfaceRayCaster::first_hit before update()");
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  RTCRayHit rh;
+namespace {
+
+void set_ray(RTCRayHit& rh, const Vec3& origin, const Vec3& direction, double t_min, double t_max) {
   rh.ray.org_x = static_cast<float>(origin.x());
   rh.ray.org_y = static_cast<float>(origin.y());
   rh.ray.org_z = static_cast<float>(origin.z());
@@ -146,14 +144,17 @@ RayHit SurfaceRayCaster::first_hit(
   rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(s.scene, &context, &rh);
+}
+
+/// The hit of a traced ray, its distance recomputed in double against the face's plane.
+RayHit exact_hit(const RTCRayHit& rh, const Faces& faces, const Positions& x, const Vec3& origin,
+    const Vec3& direction, double t_min, double t_max) {
   RayHit hit;
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
     return hit;
   const int f = static_cast<int>(rh.hit.primID);
-  const Vec3 x0 = s.x.row(s.faces(f, 0)).transpose();
-  const Vec3 n
-      = (s.x.row(s.faces(f, 1)).transpose() - x0).cross(s.x.row(s.faces(f, 2)).transpose() - x0);
+  const Vec3 x0 = x.row(faces(f, 0)).transpose();
+  const Vec3 n = (x.row(faces(f, 1)).transpose() - x0).cross(x.row(faces(f, 2)).transpose() - x0);
   const double dn = direction.dot(n);
   // The double-precision distance to the face's plane; Embree's float distance for a ray that
   // grazes the plane (where the plane distance is ill-conditioned).
@@ -166,6 +167,42 @@ RayHit SurfaceRayCaster::first_hit(
   hit.t = t;
   hit.normal = n.normalized();
   return hit;
+}
+
+/// Rays per stream call: 64 RTCRayHit (5 KiB) live on the stack.
+constexpr int k_stream = 64;
+
+} // namespace
+
+RayHit SurfaceRayCaster::first_hit(
+    const Vec3& origin, const Vec3& direction, double t_min, double t_max) const {
+  const Impl& s = *m_impl;
+  ELASTOLEARN_CHECK(s.built, "SurfaceRayCaster::first_hit before update()");
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  set_ray(rh, origin, direction, t_min, t_max);
+  rtcIntersect1(s.scene, &context, &rh);
+  return exact_hit(rh, s.faces, s.x, origin, direction, t_min, t_max);
+}
+
+void SurfaceRayCaster::first_hits(const Vec3& origin, const Vec3* directions, int count,
+    double t_min, double t_max, RayHit* out) const {
+  const Impl& s = *m_impl;
+  ELASTOLEARN_CHECK(s.built, "SurfaceRayCaster::first_hits before update()");
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  RTCRayHit rays[k_stream];
+  for (int begin = 0; begin < count; begin += k_stream) {
+    const int n = std::min(k_stream, count - begin);
+    for (int i = 0; i < n; ++i)
+      set_ray(rays[i], origin, directions[begin + i], t_min, t_max);
+    rtcIntersect1M(s.scene, &context, rays, static_cast<unsigned>(n), sizeof(RTCRayHit));
+    for (int i = 0; i < n; ++i)
+      out[begin + i]
+          = exact_hit(rays[i], s.faces, s.x, origin, directions[begin + i], t_min, t_max);
+  }
 }
 
 } // namespace elastolearn::capture

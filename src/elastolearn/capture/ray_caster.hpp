@@ -38,6 +38,12 @@ class SurfaceRayCaster {
   /// be unit length). Thread safe between updates; call update() at least once first.
   RayHit first_hit(const Vec3& origin, const Vec3& direction, double t_min, double t_max) const;
 
+  /// first_hit for `count` rays from one origin (directions[i] → out[i]), traced together as a
+  /// coherent stream: Embree groups them into packets, which is faster for the neighbouring
+  /// pixels of a camera. Thread safe between updates.
+  void first_hits(const Vec3& origin, const Vec3* directions, int count, double t_min, double t_max,
+      RayHit* out) const;
+
   int num_faces() const;
   /// Unit normal of face f at the current positions, (x1 − x0) × (x2 − x0) normalised (zero for a
   /// degenerate face).

@@ -6,6 +6,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -87,14 +88,22 @@ void VirtualScanner::render(int c, DepthImage& image) const {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   tbb::parallel_for(
       tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+        // A row at a time, in chunks: neighbouring pixels' rays are traced together.
+        constexpr int chunk = 64;
+        Vec3 d[chunk];
+        RayHit hits[chunk];
         for (int v = rows.begin(); v < rows.end(); ++v) {
-          for (int u = 0; u < camera.width; ++u) {
-            const Vec3 d = camera.pixel_ray(u, v);
+          for (int u0 = 0; u0 < camera.width; u0 += chunk) {
+            const int n = std::min(chunk, camera.width - u0);
+            for (int i = 0; i < n; ++i)
+              d[i] = camera.pixel_ray(u0 + i, v);
             // d has unit component along the optical axis, so the ray parameter is the depth.
-            const RayHit hit = m_caster.first_hit(camera.position, d, camera.near, camera.far);
-            const bool seen = hit.face >= 0 && hit.normal.dot(d) < 0;
-            image.depth(v, u) = seen ? hit.t : nan;
-            image.face(v, u) = seen ? hit.face : -1;
+            m_caster.first_hits(camera.position, d, n, camera.near, camera.far, hits);
+            for (int i = 0; i < n; ++i) {
+              const bool seen = hits[i].face >= 0 && hits[i].normal.dot(d[i]) < 0;
+              image.depth(v, u0 + i) = seen ? hits[i].t : nan;
+              image.face(v, u0 + i) = seen ? hits[i].face : -1;
+            }
           }
         }
       });

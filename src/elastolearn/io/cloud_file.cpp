@@ -169,8 +169,8 @@ capture::PointCloudSequence read_clouds_h5(const std::filesystem::path& path) {
   const hsize_t T = shape_of(file, k_time, 1, false, "(T,)")[0];
   if (T + 1 != T1)
     file.fail(k_time,
-        "has " + std::to_string(T) + " frames but " + k_offsets + " has " + std::to_string(T1)
-            + " entries (T + 1 = " + std::to_string(T1 - 1) + " frames)");
+        "has " + std::to_string(T) + " frames but " + k_offsets + " describes "
+            + std::to_string(T1 - 1) + " (its " + std::to_string(T1) + " entries are T + 1)");
   const std::vector<double> offsets = file.read_f64(k_offsets);
   clouds.offsets.assign(offsets.size(), 0);
   for (std::size_t t = 0; t < offsets.size(); ++t) {
