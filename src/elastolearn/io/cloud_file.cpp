@@ -48,7 +48,7 @@ struct CloudWriter::Impl {
       , file(h5::File::create(atomic.temp_path(), name))
       , dt(dt_)
       , start_time(start)
-      , points(file, k_points, { 3 }) { }
+      , points(file, k_points, { 3 }, false) { }
 
   AtomicFile atomic; ///< destroyed last: removes the temporary file unless committed
   std::string name;
@@ -93,9 +93,9 @@ void CloudWriter::append(const capture::CloudFrame& frame) {
     const bool has_confidence = frame.confidence.size() > 0;
     if (!s.decided) {
       if (has_normals)
-        s.normals.emplace(s.file, k_normals, h5::Shape { 3 });
+        s.normals.emplace(s.file, k_normals, h5::Shape { 3 }, false);
       if (has_confidence)
-        s.confidence.emplace(s.file, k_confidence, h5::Shape {});
+        s.confidence.emplace(s.file, k_confidence, h5::Shape {}, false);
       s.decided = true;
     }
     if (has_normals != s.normals.has_value())

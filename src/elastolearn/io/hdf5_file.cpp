@@ -602,7 +602,7 @@ void File::close() {
 // --- AppendableDataset -----------------------------------------------------------------------
 
 AppendableDataset::AppendableDataset(
-    File& file, const std::string& dataset, const Shape& frame_shape)
+    File& file, const std::string& dataset, const Shape& frame_shape, bool compress)
     : m_file(&file)
     , m_name(dataset)
     , m_frame_shape(frame_shape)
@@ -626,7 +626,7 @@ AppendableDataset::AppendableDataset(
   Handle space = make_space(dims, &max_dims);
   Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
   H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
-  if (deflate_available()) {
+  if (compress && deflate_available()) {
     H5Pset_shuffle(dcpl.id()); // byte-transpose doubles: deflate then finds the common exponents
     H5Pset_deflate(dcpl.id(), 1);
   }

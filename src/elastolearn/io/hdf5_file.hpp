@@ -185,8 +185,11 @@ class File {
 /// exactly once; flush() or close() writes a partly filled last chunk.
 class AppendableDataset {
   public:
-  /// Create `dataset` in `file` with zero frames. `file` must outlive this object.
-  AppendableDataset(File& file, const std::string& dataset, const Shape& frame_shape);
+  /// Create `dataset` in `file` with zero frames. `file` must outlive this object. `compress`
+  /// false stores the chunks as they are (for data whose low bits are noise, such as scanned
+  /// coordinates, deflate saves little and costs much).
+  AppendableDataset(
+      File& file, const std::string& dataset, const Shape& frame_shape, bool compress = true);
   /// Append one frame of prod(frame_shape) values (copied). Throws InputError.
   void append(const double* frame);
   /// Frames appended so far (written or buffered).
