@@ -61,6 +61,14 @@ TEST(CameraFile, ReadsFieldOfViewAndIntrinsicsCameras) {
   }
 }
 
+TEST(CameraFile, TheExampleFileReads) {
+  const auto cameras = read_camera_file(
+      std::filesystem::path(ELASTOLEARN_EXAMPLES_DIR) / "06_point_clouds" / "cameras.json");
+  ASSERT_EQ(cameras.size(), 2u);
+  EXPECT_EQ(cameras[1].name, "oblique");
+  EXPECT_EQ(cameras[1].width, 512);
+}
+
 TEST(CameraFile, ErrorsNameTheField) {
   ScratchDir dir;
   const auto rejected = [&](const std::string& text, const std::vector<std::string>& parts) {
