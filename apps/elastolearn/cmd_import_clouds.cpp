@@ -4,9 +4,13 @@
 #include "command.hpp"
 
 #include <elastolearn/core/command_paths.hpp>
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/io/cloud_file.hpp>
 #include <elastolearn/io/cloud_import.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace {
@@ -25,25 +29,34 @@ void run_import(const ImportOptions& opts) {
   for (const auto& file : files)
     inputs.push_back({ file, "point-cloud frame" });
   check_command_paths(inputs, { { opts.output, "point-cloud output (-o)" } });
-  const capture::PointCloudSequence clouds
-      = io::import_point_clouds(opts.folder, opts.dt, opts.start_time);
-  io::write_clouds_h5(opts.output, clouds,
-      { { "source", opts.folder }, { "first_file", files.front().filename().string() },
-          { "last_file", files.back().filename().string() } });
-  int empty = 0;
-  Eigen::Index fewest = clouds.num_points(), most = 0;
-  for (int t = 0; t < clouds.num_frames(); ++t) {
-    empty += clouds.frame_size(t) == 0;
-    fewest = std::min(fewest, clouds.frame_size(t));
-    most = std::max(most, clouds.frame_size(t));
-  }
-  std::printf("imported %d frames (%s .. %s), dt = %g s: %ld points, %ld .. %ld per frame",
-      clouds.num_frames(), files.front().filename().c_str(), files.back().filename().c_str(),
-      clouds.dt, long(clouds.num_points()), long(fewest), long(most));
+  if (!(opts.dt > 0) || !std::isfinite(opts.dt))
+    throw InputError("--dt", "the time between frames must be positive, got " + to_text(opts.dt));
+  if (!std::isfinite(opts.start_time))
+    throw InputError("--start-time", "must be finite");
+  // Frame by frame from the folder to the file: a long capture never has to fit in memory.
+  io::CloudWriter writer(opts.output, opts.dt, opts.start_time);
+  long empty = 0;
+  long long fewest = -1, most = 0;
+  bool normals = false, confidence = false;
+  io::read_point_cloud_folder(
+      opts.folder, [&](const std::filesystem::path&, const capture::CloudFrame& frame) {
+        writer.append(frame);
+        const long long n = frame.points.rows();
+        empty += n == 0;
+        fewest = fewest < 0 ? n : std::min(fewest, n);
+        most = std::max(most, n);
+        normals |= frame.normals.rows() > 0;
+        confidence |= frame.confidence.size() > 0;
+      });
+  writer.finish({ { "source", opts.folder }, { "first_file", files.front().filename().string() },
+      { "last_file", files.back().filename().string() } });
+  std::printf("imported %ld frames (%s .. %s), dt = %g s: %lld points, %lld .. %lld per frame",
+      writer.frames(), files.front().filename().c_str(), files.back().filename().c_str(), opts.dt,
+      writer.points(), fewest, most);
   if (empty > 0)
-    std::printf(", %d empty frame%s", empty, empty == 1 ? "" : "s");
-  std::printf("%s%s\npoint clouds: %s\n", clouds.has_normals() ? ", with normals" : "",
-      clouds.has_confidence() ? ", with confidence" : "", opts.output.c_str());
+    std::printf(", %ld empty frame%s", empty, empty == 1 ? "" : "s");
+  std::printf("%s%s\npoint clouds: %s\n", normals ? ", with normals" : "",
+      confidence ? ", with confidence" : "", opts.output.c_str());
 }
 
 void add_import_clouds_command(CLI::App& root) {

@@ -36,13 +36,10 @@ capture::CloudFrame frame_of(int n, double shift, bool normals, bool confidence)
 }
 
 capture::PointCloudSequence sequence(bool normals, bool confidence) {
-  capture::PointCloudSequence s;
-  s.dt = 0.01;
-  s.start_time = 0.5;
-  s.append(frame_of(3, 0, normals, confidence), "test");
-  s.append(frame_of(0, 0, normals, confidence), "test"); // an empty frame
-  s.append(frame_of(5, 0.7, normals, confidence), "test");
-  return s;
+  return capture::PointCloudSequence::from_frames(
+      { frame_of(3, 0, normals, confidence), frame_of(0, 0, normals, confidence), // empty frame
+          frame_of(5, 0.7, normals, confidence) },
+      0.01, 0.5, "test");
 }
 
 /// Write raw datasets (no validation) to make broken files.
@@ -107,10 +104,7 @@ TEST(CloudFile, LayoutIsWhatTheDocumentationTellsH5pyUsers) {
 
 TEST(CloudFile, AllFramesEmptyIsAValidFile) {
   ScratchDir dir;
-  capture::PointCloudSequence s;
-  s.dt = 0.1;
-  s.append({}, "test");
-  s.append({}, "test");
+  const auto s = capture::PointCloudSequence::from_frames({ {}, {} }, 0.1, 0, "test");
   write_clouds_h5(dir / "c.h5", s);
   const auto r = read_clouds_h5(dir / "c.h5");
   EXPECT_EQ(r.num_frames(), 2);
@@ -127,7 +121,7 @@ TEST(CloudFile, WriterRefusesABadFrameAndLeavesNoFile) {
     expect_input_error([&] { writer.append(nan); },
         { "c.h5", "/clouds/points", "frame 1, point 1", "non-finite" });
     expect_input_error([&] { writer.append(frame_of(2, 0, true, false)); },
-        { "/clouds/normals", "frame 1 has normals", "have none" });
+        { "c.h5: frame 1", "has normals", "have none" });
     capture::CloudFrame colour = frame_of(2, 0, false, false);
     colour.normals = Positions::Constant(2, 3, 255);
     expect_input_error([&] { writer.append(colour); }, { "not a unit vector" });

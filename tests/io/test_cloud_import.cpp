@@ -169,5 +169,5 @@ TEST(ImportPointClouds, ClearErrorsForFoldersAndDisagreeingFrames) {
   write_file(dir / "f_3.xyz", "0 0 0\n1 x 0\n");
   expect_input_error([&] { import_point_clouds(dir.path(), 0.01); }, { "f_3.xyz:2" });
   std::filesystem::remove(dir / "f_3.xyz");
-  expect_input_error([&] { import_point_clouds(dir.path(), -1); }, { "--dt" });
+  expect_input_error([&] { import_point_clouds(dir.path(), -1); }, { "dt", "positive" });
 }

@@ -64,42 +64,56 @@ CloudFrame PointCloudSequence::frame(int t) const {
   return f;
 }
 
-void PointCloudSequence::append(const CloudFrame& frame, const std::string& source) {
-  const Eigen::Index n = frame.points.rows();
-  if (frame.normals.rows() != 0 && frame.normals.rows() != n)
-    throw InputError(source,
-        "has " + std::to_string(frame.normals.rows()) + " normals for " + std::to_string(n)
-            + " points");
-  if (frame.confidence.size() != 0 && frame.confidence.size() != n)
-    throw InputError(source,
-        "has " + std::to_string(frame.confidence.size()) + " confidence values for "
-            + std::to_string(n) + " points");
-  if (n > 0) {
-    const bool decided = num_points() > 0;
-    const bool frame_normals = frame.normals.rows() > 0;
-    const bool frame_confidence = frame.confidence.size() > 0;
-    if (decided && frame_normals != has_normals())
-      throw InputError(source,
-          std::string(frame_normals ? "has" : "has no") + " normals, but the frames before "
-              + (has_normals() ? "have them" : "have none"));
-    if (decided && frame_confidence != has_confidence())
-      throw InputError(source,
-          std::string(frame_confidence ? "has" : "has no")
-              + " confidence values, but the frames before "
-              + (has_confidence() ? "have them" : "have none"));
-    const Eigen::Index old = num_points();
-    points.conservativeResize(old + n, 3);
-    points.bottomRows(n) = frame.points;
-    if (frame_normals) {
-      normals.conservativeResize(old + n, 3);
-      normals.bottomRows(n) = frame.normals;
-    }
-    if (frame_confidence) {
-      confidence.conservativeResize(old + n);
-      confidence.tail(n) = frame.confidence;
-    }
+void FrameLayout::check(const CloudFrame& frame, const std::string& source) {
+  if (frame.points.rows() == 0)
+    return;
+  const bool normals = frame.normals.rows() > 0, confidence = frame.confidence.size() > 0;
+  if (!m_decided) {
+    m_decided = true;
+    m_normals = normals;
+    m_confidence = confidence;
+    return;
   }
-  offsets.push_back(num_points());
+  if (normals != m_normals)
+    throw InputError(source,
+        std::string(normals ? "has" : "has no") + " normals, but the frames before "
+            + (m_normals ? "have them" : "have none"));
+  if (confidence != m_confidence)
+    throw InputError(source,
+        std::string(confidence ? "has" : "has no") + " confidence values, but the frames before "
+            + (m_confidence ? "have them" : "have none"));
+}
+
+PointCloudSequence PointCloudSequence::from_frames(const std::vector<CloudFrame>& frames, double dt,
+    double start_time, const std::string& source) {
+  FrameLayout layout;
+  Eigen::Index total = 0;
+  for (std::size_t t = 0; t < frames.size(); ++t) {
+    const std::string where = source + ": frame " + std::to_string(t);
+    frames[t].validate(source, static_cast<int>(t));
+    layout.check(frames[t], where);
+    total += frames[t].points.rows();
+  }
+  PointCloudSequence s;
+  s.dt = dt;
+  s.start_time = start_time;
+  s.points.resize(total, 3);
+  if (layout.normals())
+    s.normals.resize(total, 3);
+  if (layout.confidence())
+    s.confidence.resize(total);
+  s.offsets.assign(1, 0);
+  for (const CloudFrame& f : frames) {
+    const Eigen::Index begin = s.offsets.back(), n = f.points.rows();
+    s.points.middleRows(begin, n) = f.points;
+    if (n > 0 && layout.normals())
+      s.normals.middleRows(begin, n) = f.normals;
+    if (n > 0 && layout.confidence())
+      s.confidence.segment(begin, n) = f.confidence;
+    s.offsets.push_back(begin + n);
+  }
+  s.validate(source);
+  return s;
 }
 
 void PointCloudSequence::validate(const std::string& source) const {

@@ -45,16 +45,32 @@ struct PointCloudSequence {
   /// A copy of frame t with its normals and confidence.
   CloudFrame frame(int t) const;
 
-  /// Append a frame at the end. The first frame appended to an empty sequence decides whether
-  /// the sequence has normals and confidence (an empty frame decides nothing); later frames must
-  /// agree. Throws InputError(source, ...) on disagreement or mismatched sizes.
-  void append(const CloudFrame& frame, const std::string& source);
+  /// The sequence of `frames` (copied once), frame t taken at start_time + t·dt, checked with
+  /// FrameLayout (errors name "<source>: frame t") and validate(source). Throws InputError.
+  static PointCloudSequence from_frames(const std::vector<CloudFrame>& frames, double dt,
+      double start_time, const std::string& source);
 
   /// Check consistency: T ≥ 1, offsets as documented, every point finite, normals (if any) N×3
   /// finite of length 1 within 1e-3, confidence (if any) N values in [0, 1], dt finite and
   /// positive, start_time finite. Throws InputError("<source>: <field>", what is wrong, the frame
   /// and point, and the offending value).
   void validate(const std::string& source) const;
+};
+
+/// Whether the frames of a sequence carry normals and confidence: the first frame with points
+/// decides, and every later frame with points must agree (empty frames agree with anything).
+class FrameLayout {
+  public:
+  /// Check `frame` (and let it decide, if it is the first with points). Throws
+  /// InputError(source, "has normals, but the frames before have none") and the like.
+  void check(const CloudFrame& frame, const std::string& source);
+  bool normals() const { return m_normals; }
+  bool confidence() const { return m_confidence; }
+
+  private:
+  bool m_decided = false;
+  bool m_normals = false;
+  bool m_confidence = false;
 };
 
 /// Length tolerance of a unit normal: |‖n‖ − 1| ≤ 1e-3 (float32 normals written by scanning tools

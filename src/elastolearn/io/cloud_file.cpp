@@ -59,7 +59,7 @@ struct CloudWriter::Impl {
   std::optional<h5::AppendableDataset> normals;
   std::optional<h5::AppendableDataset> confidence;
   std::vector<std::int64_t> offsets { 0 };
-  bool decided = false; ///< a frame with points has fixed normals/confidence
+  capture::FrameLayout layout;
   bool finished = false;
 };
 
@@ -88,29 +88,16 @@ void CloudWriter::append(const capture::CloudFrame& frame) {
   const int t = static_cast<int>(frames());
   frame.validate(s.name, t);
   const Eigen::Index n = frame.points.rows();
+  s.layout.check(frame, s.name + ": frame " + std::to_string(t));
   if (n > 0) {
-    const bool has_normals = frame.normals.rows() > 0;
-    const bool has_confidence = frame.confidence.size() > 0;
-    if (!s.decided) {
-      if (has_normals)
-        s.normals.emplace(s.file, k_normals, h5::Shape { 3 }, false);
-      if (has_confidence)
-        s.confidence.emplace(s.file, k_confidence, h5::Shape {}, false);
-      s.decided = true;
-    }
-    if (has_normals != s.normals.has_value())
-      throw InputError(s.name + ": " + k_normals,
-          "frame " + std::to_string(t) + (has_normals ? " has" : " has no")
-              + " normals, but the frames before " + (s.normals ? "have them" : "have none"));
-    if (has_confidence != s.confidence.has_value())
-      throw InputError(s.name + ": " + k_confidence,
-          "frame " + std::to_string(t) + (has_confidence ? " has" : " has no")
-              + " confidence values, but the frames before "
-              + (s.confidence ? "have them" : "have none"));
+    if (s.layout.normals() && !s.normals)
+      s.normals.emplace(s.file, k_normals, h5::Shape { 3 }, false);
+    if (s.layout.confidence() && !s.confidence)
+      s.confidence.emplace(s.file, k_confidence, h5::Shape {}, false);
     append_rows(s.points, frame.points);
-    if (has_normals)
+    if (s.normals)
       append_rows(*s.normals, frame.normals);
-    if (has_confidence)
+    if (s.confidence)
       for (Eigen::Index j = 0; j < n; ++j)
         s.confidence->append(&frame.confidence[j]);
   }

@@ -219,17 +219,25 @@ std::vector<std::filesystem::path> list_point_cloud_files(const std::filesystem:
   return files;
 }
 
+void read_point_cloud_folder(const std::filesystem::path& folder,
+    const std::function<void(const std::filesystem::path& file, const capture::CloudFrame& frame)>&
+        sink) {
+  capture::FrameLayout layout;
+  for (const auto& file : list_point_cloud_files(folder)) {
+    const capture::CloudFrame frame = read_point_cloud_file(file);
+    layout.check(frame, file.string());
+    sink(file, frame);
+  }
+}
+
 capture::PointCloudSequence import_point_clouds(
     const std::filesystem::path& folder, double dt, double start_time) {
   if (!std::isfinite(dt) || dt <= 0)
-    throw InputError("--dt", "the time between frames must be positive, got " + to_text(dt));
-  capture::PointCloudSequence clouds;
-  clouds.dt = dt;
-  clouds.start_time = start_time;
-  for (const auto& file : list_point_cloud_files(folder))
-    clouds.append(read_point_cloud_file(file), file.string());
-  clouds.validate(folder.string());
-  return clouds;
+    throw InputError("dt", "the time between frames must be positive, got " + to_text(dt));
+  std::vector<capture::CloudFrame> frames;
+  read_point_cloud_folder(folder,
+      [&](const std::filesystem::path&, const capture::CloudFrame& f) { frames.push_back(f); });
+  return capture::PointCloudSequence::from_frames(frames, dt, start_time, folder.string());
 }
 
 } // namespace elastolearn::io

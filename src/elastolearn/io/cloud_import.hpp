@@ -13,6 +13,7 @@
 #include <elastolearn/capture/point_cloud.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,9 +34,16 @@ bool natural_less(const std::string& a, const std::string& b);
 /// InputError(folder, ...) if it is missing, not a folder, or holds no such file.
 std::vector<std::filesystem::path> list_point_cloud_files(const std::filesystem::path& folder);
 
-/// Every cloud file of `folder` (list_point_cloud_files) as one frame, frames dt [s] apart from
-/// start_time [s]. All frames with points must agree on having normals and confidence; the error
+/// Read the cloud files of `folder` (list_point_cloud_files) in order, handing each frame to
+/// `sink(file, frame)` as it is read, so that a long capture never has to fit in memory. Frames
+/// with points must agree on having normals and confidence (capture::FrameLayout); the error
 /// names the first file that does not. Throws InputError.
+void read_point_cloud_folder(const std::filesystem::path& folder,
+    const std::function<void(const std::filesystem::path& file, const capture::CloudFrame& frame)>&
+        sink);
+
+/// Every cloud file of `folder` as one frame of a sequence, frames dt [s] apart from start_time
+/// [s] (read_point_cloud_folder, in memory). Throws InputError.
 capture::PointCloudSequence import_point_clouds(
     const std::filesystem::path& folder, double dt, double start_time = 0);
 
