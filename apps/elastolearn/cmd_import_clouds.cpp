@@ -75,4 +75,4 @@ void add_import_clouds_command(CLI::App& root) {
 
 } // namespace
 
-ELASTOLEARN_COMMAND(31, add_import_clouds_command)
+ELASTOLEARN_COMMAND(32, add_import_clouds_command)

@@ -56,7 +56,7 @@ void run_scan(const ScanCommandOptions& opts) {
     throw InputError(opts.trajectory + ": /positions", "no frames to scan");
   const double dt = traj.positions.size() >= 2
       ? observe::uniform_time_step(traj.time, opts.trajectory + ": /time")
-      : 1.0;
+      : 1.0; // a static scan: one frame, any spacing (docs/file_formats.md)
 
   capture::VirtualScanner scanner(
       surface, static_cast<int>(traj.rest_positions.rows()), cameras, opts.scan);
@@ -113,4 +113,4 @@ void add_scan_command(CLI::App& root) {
 
 } // namespace
 
-ELASTOLEARN_COMMAND(32, add_scan_command)
+ELASTOLEARN_COMMAND(31, add_scan_command)

@@ -60,6 +60,7 @@ struct CloudWriter::Impl {
   std::optional<h5::AppendableDataset> confidence;
   std::vector<std::int64_t> offsets { 0 };
   capture::FrameLayout layout;
+  bool failed = false; ///< a frame was written only in part
   bool finished = false;
 };
 
@@ -89,7 +90,12 @@ void CloudWriter::append(const capture::CloudFrame& frame) {
   frame.validate(s.name, t);
   const Eigen::Index n = frame.points.rows();
   s.layout.check(frame, s.name + ": frame " + std::to_string(t));
+  if (s.failed)
+    throw InputError(s.name, "an earlier write failed; the file cannot be continued");
   if (n > 0) {
+    // A write that fails half-way leaves the datasets out of step: the file is then never
+    // published (finish refuses, the destructor removes it).
+    s.failed = true;
     if (s.layout.normals() && !s.normals)
       s.normals.emplace(s.file, k_normals, h5::Shape { 3 }, false);
     if (s.layout.confidence() && !s.confidence)
@@ -100,6 +106,7 @@ void CloudWriter::append(const capture::CloudFrame& frame) {
     if (s.confidence)
       for (Eigen::Index j = 0; j < n; ++j)
         s.confidence->append(&frame.confidence[j]);
+    s.failed = false;
   }
   s.offsets.push_back(s.offsets.back() + n);
 }
@@ -108,6 +115,8 @@ void CloudWriter::finish(const std::map<std::string, std::string>& metadata) {
   Impl& s = *m_impl;
   if (s.finished)
     throw InputError(s.name, "already finished");
+  if (s.failed)
+    throw InputError(s.name, "an earlier write failed; nothing was published");
   if (frames() < 1)
     throw InputError(s.name + ": " + k_offsets, "no frames to write");
   for (const auto& [key, value] : metadata)
