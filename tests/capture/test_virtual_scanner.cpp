@@ -117,6 +117,34 @@ TEST(DepthCamera, ProjectsItsPixelRaysBackToThePixelCentres) {
   EXPECT_NEAR(c.rotation.determinant(), 1.0, 1e-14);
 }
 
+TEST(SurfaceRayCaster, SingleRaysAndStreamsAgreeAndRespectTheRange) {
+  const Surface sphere = icosphere(Vec3::Zero(), 1, 2);
+  SurfaceRayCaster caster(sphere.faces, static_cast<int>(sphere.x.rows()));
+  caster.update(sphere.x);
+  const Vec3 eye(0, 0, 3);
+  std::vector<Vec3> d;
+  for (int i = 0; i < 150; ++i) // a fan of rays, some missing the sphere
+    d.push_back(Vec3(0.005 * (i - 75), 0.002 * i, -1));
+  std::vector<RayHit> hits(d.size());
+  caster.first_hits(eye, d.data(), static_cast<int>(d.size()), 0, 10, hits.data());
+  int hit = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const RayHit one = caster.first_hit(eye, d[i], 0, 10);
+    EXPECT_EQ(one.face, hits[i].face) << i;
+    EXPECT_EQ(one.t, hits[i].t) << i;
+    hit += one.face >= 0;
+  }
+  EXPECT_GT(hit, 50);
+  EXPECT_LT(hit, 150);
+  // Straight down the axis: the near pole at t = 2, or nothing if the range ends before it.
+  EXPECT_NEAR(caster.first_hit(eye, Vec3(0, 0, -1), 0, 10).t, 2, 1e-12);
+  EXPECT_EQ(caster.first_hit(eye, Vec3(0, 0, -1), 0, 1.9).face, -1);
+  // Starting past the near side (a vertex at each pole) finds the far side: a back face.
+  const RayHit far = caster.first_hit(eye, Vec3(0, 0, -1), 2.5, 10);
+  EXPECT_NEAR(far.t, 4, 1e-12);
+  EXPECT_LT(far.normal.z(), -0.95); // outward, away from the eye
+}
+
 TEST(VirtualScanner, ReproducesThePlaneDepthMap) {
   // An oblique plane facing the camera: depth z(u, v) = n·(p0 − e) / (n·d(u, v)) exactly.
   const Vec3 n = Vec3(0.3, 0.2, 1).normalized(), p0(0.05, -0.02, 0);
