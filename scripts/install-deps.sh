@@ -13,6 +13,7 @@ packages=(
   nlohmann-json3-dev       # scene / material JSON
   libnanoflann-dev         # k-d trees
   libtbb-dev               # parallel element loops
+  libembree-dev            # ray casting for the virtual depth scanner (Embree 3)
   libgtest-dev libgmock-dev libbenchmark-dev
   tetgen                   # external tetrahedralizer (AGPL: run as a program, never linked)
   clang-format             # scripts/check-format.sh (Debian 12's is version 14, the reference)

@@ -1,8 +1,9 @@
-// elastolearn info FILE: a summary of a tet mesh, surface mesh, trajectory, observation, scene or
-// learned material.
+// elastolearn info FILE: a summary of a tet mesh, surface mesh, trajectory, observation, point
+// clouds, scene or learned material.
 #include "command.hpp"
 
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/io/cloud_file.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/observation_file.hpp>
@@ -61,6 +62,28 @@ void print_observation(const std::filesystem::path& path) {
     std::printf("  %s: %s\n", k.c_str(), v.c_str());
 }
 
+void print_clouds(const std::filesystem::path& path) {
+  const capture::PointCloudSequence c = io::read_clouds_h5(path);
+  Eigen::Index fewest = c.num_points(), most = 0;
+  int empty = 0;
+  for (int t = 0; t < c.num_frames(); ++t) {
+    fewest = std::min(fewest, c.frame_size(t));
+    most = std::max(most, c.frame_size(t));
+    empty += c.frame_size(t) == 0;
+  }
+  std::printf("  point clouds: %d frames, t = %g .. %g s (dt = %g s), %ld points, %ld .. %ld per "
+              "frame, %d empty%s%s\n",
+      c.num_frames(), c.start_time, c.start_time + (c.num_frames() - 1) * c.dt, c.dt,
+      long(c.num_points()), long(fewest), long(most), empty, c.has_normals() ? ", normals" : "",
+      c.has_confidence() ? ", confidence" : "");
+  if (c.num_points() > 0)
+    print_box(
+        Box3(c.points.colwise().minCoeff().transpose(), c.points.colwise().maxCoeff().transpose()));
+  for (const auto& [k, v] : io::read_clouds_metadata(path))
+    if (k != "cameras") // one long JSON line; h5py shows it
+      std::printf("  %s: %s\n", k.c_str(), v.c_str());
+}
+
 void info(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();
   std::error_code ec;
@@ -69,6 +92,8 @@ void info(const std::filesystem::path& path) {
   std::printf("%s\n", path.c_str());
   if ((ext == ".h5" || ext == ".hdf5") && io::is_observation_h5(path)) {
     print_observation(path);
+  } else if ((ext == ".h5" || ext == ".hdf5") && io::is_clouds_h5(path)) {
+    print_clouds(path);
   } else if (ext == ".h5" || ext == ".hdf5") {
     const auto t = io::read_trajectory_h5(path);
     std::printf("  trajectory: %zu frames, t = %g .. %g s, %ld vertices, %ld tets, %ld edges, %ld "
@@ -122,8 +147,8 @@ void info(const std::filesystem::path& path) {
 void add_info_command(CLI::App& root) {
   auto files = std::make_shared<std::vector<std::string>>();
   auto* cmd = root.add_subcommand("info",
-      "Summarise a mesh (.node/.ele/.msh/.veg/.obj/.off/.ply/.stl), trajectory or observation "
-      "(.h5), scene or learned material (.json)");
+      "Summarise a mesh (.node/.ele/.msh/.veg/.obj/.off/.ply/.stl), trajectory, observation or "
+      "point clouds (.h5), scene or learned material (.json)");
   cmd->add_option("files", *files, "files to describe")->required();
   cmd->callback([files] {
     for (const auto& f : *files)

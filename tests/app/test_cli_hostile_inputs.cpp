@@ -54,6 +54,11 @@ const char* kScene = R"({
 const char* kMaterial = R"({"format": "elastolearn-material/1",
   "material": {"model": "corotated", "young": 1e5, "poisson": 0.3, "density": 1000}})";
 
+/// One camera looking at the bar of kScene from above.
+const char* kCameras = R"({"format": "elastolearn-cameras/1", "cameras": [{"name": "top",
+  "position": [0.1, 0.5, 0.025], "look_at": [0.1, 0, 0.025], "up": [0, 0, -1],
+  "resolution": [16, 12], "fov_y": 40}]})";
+
 /// One positively oriented tet.
 const char* kNode = "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n";
 const char* kEle = "1 4 0\n0 0 1 2 3\n";
@@ -131,6 +136,17 @@ H5Spec observation_spec() {
   return s;
 }
 
+/// A valid point-cloud file: 3 points in 2 frames of 10 ms (the second frame empty).
+H5Spec clouds_spec() {
+  H5Spec s;
+  s.f64["/clouds/points"] = { { 3, 3 }, { 0, 0, 0, 0.1, 0, 0, 0, 0.1, 0 } };
+  s.i32["/clouds/offsets"] = { { 3 }, { 0, 3, 3 } };
+  s.f64["/time"] = { { 2 }, { 0, 0.01 } };
+  s.attributes["format"] = "elastolearn-clouds/1";
+  s.attributes["dt"] = "0.01";
+  return s;
+}
+
 void write_h5(const fs::path& path, const H5Spec& spec) {
   h5::File file = h5::File::create(path);
   for (const auto& [name, data] : spec.f64)
@@ -182,6 +198,10 @@ void write_base_inputs(const fs::path& dir) {
   write_text(dir / "springs.json", kSprings);
   write_text(dir / "ids.txt", "0 1\n");
   write_text(dir / "notadir", "a regular file: nothing can be created under it\n");
+  write_text(dir / "cam.json", kCameras);
+  write_text(dir / "frames/frame_1.xyz", "0 0 0\n0.1 0 0\n");
+  write_text(dir / "frames/frame_2.xyz", "0 0 0.1\n");
+  fs::create_directories(dir / "empty");
 
   // The scene's own trajectory (12 vertices, 6 frames) and an observation of it.
   const mesh::TetMesh bar = mesh::make_box_bar(Vec3(0.2, 0.05, 0.05), { 2, 1, 1 });
@@ -203,6 +223,7 @@ void write_base_inputs(const fs::path& dir) {
   }
   io::write_trajectory_h5(dir / "traj.h5", traj);
   io::write_observation_h5(dir / "obs.h5", obs);
+  write_h5(dir / "clouds.h5", clouds_spec());
 
   springs::TrainingOptions training;
   training.steps = 50;
@@ -266,6 +287,13 @@ Maker observation(const std::string& name, std::function<void(H5Spec&)> edit) {
     write_h5(dir / name, s);
   };
 }
+Maker clouds(const std::string& name, std::function<void(H5Spec&)> edit) {
+  return [=](const fs::path& dir) {
+    H5Spec s = clouds_spec();
+    edit(s);
+    write_h5(dir / name, s);
+  };
+}
 Maker huge(
     const std::string& name, H5Spec (*spec)(), const std::string& dataset, const h5::Shape& shape) {
   return [=](const fs::path& dir) { write_h5_huge(dir / name, spec(), dataset, shape); };
@@ -302,6 +330,9 @@ const std::string kPlyHeader
       "float y\nproperty float z\nelement face 1\nproperty list uchar int "
       "vertex_indices\nend_header\n";
 const std::string kPlyVertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+/// A point-cloud PLY header for two points (the body follows on lines 8 and 9).
+const std::string kPlyCloudHeader = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                                    "property float y\nproperty float z\nend_header\n";
 
 struct Case {
   std::string name; ///< unique, says what is hostile
@@ -390,6 +421,44 @@ const std::vector<Case> kCases = {
   { "observation_is_a_trajectory", nothing(), kLearn + "traj.h5 -o out.json", { "traj.h5", "observation" } },
   { "observation_frames_differ_from_scene", observation("o.h5", [](H5Spec&) { }), kLearn + "o.h5 -o out.json", { "o.h5" } },
   { "checkpoint_garbled_on_resume", text("out.json.checkpoint.json", "{\"format\": "), kLearn + "obs.h5 -o out.json --resume", { "out.json.checkpoint.json:1:" } },
+
+  // ---- point clouds: HDF5, per-frame PLY/XYZ folders, cameras, scans -------------------------
+  { "clouds_nan", clouds("c.h5", [](H5Spec& s) { s.f64["/clouds/points"].second[4] = kNaN; }), "info c.h5", { "c.h5: /clouds/points", "frame 0, point 1", "non-finite" } },
+  { "clouds_frame_count_mismatch", clouds("c.h5", [](H5Spec& s) { s.f64["/time"] = { { 3 }, { 0, 0.01, 0.02 } }; }), "info c.h5", { "c.h5: /time", "3 frames", "/clouds/offsets" } },
+  { "clouds_offsets_decrease", clouds("c.h5", [](H5Spec& s) { s.i32["/clouds/offsets"].second = { 0, 3, 2 }; }), "info c.h5", { "c.h5: /clouds/offsets" } },
+  { "clouds_offsets_beyond_points", clouds("c.h5", [](H5Spec& s) { s.i32["/clouds/offsets"].second = { 0, 3, 2000000000 }; }), "info c.h5", { "c.h5: /clouds/offsets" } },
+  { "clouds_normals_not_unit", clouds("c.h5", [](H5Spec& s) { s.f64["/clouds/normals"] = { { 3, 3 }, std::vector<double>(9, 255) }; }), "info c.h5", { "c.h5: /clouds/normals", "not a unit vector" } },
+  { "clouds_dt_missing", clouds("c.h5", [](H5Spec& s) { s.attributes.erase("dt"); }), "info c.h5", { "c.h5", "dt" } },
+  { "clouds_huge", huge("c.h5", clouds_spec, "/clouds/points", { 4000000000, 3 }), "info c.h5", { "c.h5", "/clouds/points" } },
+  { "clouds_truncated", truncated("c.h5", "clouds.h5", -100), "info c.h5", { "c.h5" } },
+  { "clouds_garbled", garbled("c.h5", "clouds.h5", 500), "info c.h5", { "c.h5" } },
+  { "import_empty_folder", nothing(), "import-clouds empty --dt 0.01 -o out.h5", { "empty", "no .ply or .xyz files" } },
+  { "import_missing_folder", nothing(), "import-clouds nope --dt 0.01 -o out.h5", { "nope", "no such folder" } },
+  { "import_folder_is_a_file", nothing(), "import-clouds notadir --dt 0.01 -o out.h5", { "notadir", "not a folder" } },
+  { "import_bad_xyz_line", text("frames/frame_10.xyz", "0 0 0\n1 one 2\n"), "import-clouds frames --dt 0.01 -o out.h5", { "frame_10.xyz:2", "'one'" } },
+  { "import_nan_xyz", text("frames/frame_3.xyz", "nan 0 0\n"), "import-clouds frames --dt 0.01 -o out.h5", { "frame_3.xyz:1", "non-finite x" } },
+  { "import_colours_as_normals", text("frames/frame_3.xyz", "0 0 0 255 0 0\n"), "import-clouds frames --dt 0.01 -o out.h5", { "frame_3.xyz:1", "not a unit vector" } },
+  { "import_nan_ply", text("frames/frame_3.ply", kPlyCloudHeader + "0 0 0\n0 nan 1\n"), "import-clouds frames --dt 0.01 -o out.h5", { "frame_3.ply:9", "non-finite y" } },
+  { "import_ply_huge_count", text("frames/frame_3.ply", edit(kPlyCloudHeader, "vertex 2", "vertex 2000000000") + "0 0 0\n"), "import-clouds frames --dt 0.01 -o out.h5", { "frame_3.ply", "end of file" } },
+  { "import_ply_binary_truncated", text("frames/frame_3.ply", edit(kPlyCloudHeader, "ascii", "binary_little_endian") + std::string(20, '\0')), "import-clouds frames --dt 0.01 -o out.h5", { "frame_3.ply", "truncated" } },
+  { "import_ply_garbage", text("frames/frame_3.ply", noise()), "import-clouds frames --dt 0.01 -o out.h5", { "frame_3.ply" } },
+  { "import_mixed_normals", text("frames/frame_3.xyz", "0 0 0 0 0 1\n"), "import-clouds frames --dt 0.01 -o out.h5", { "frame_3.xyz", "has normals", "have none" } },
+  { "import_negative_dt", nothing(), "import-clouds frames --dt -0.01 -o out.h5", { "--dt" } },
+  { "import_output_is_a_frame", nothing(), "import-clouds frames --dt 0.01 -o frames/frame_2.xyz", { "frame_2.xyz", kReplace } },
+  { "camera_empty", text("c.json", ""), "scan traj.h5 --camera c.json -o out.h5", { "c.json", "invalid JSON" } },
+  { "camera_unknown_key", text("c.json", edit(kCameras, "\"up\"", "\"upp\"")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].upp" } },
+  { "camera_both_fov_and_intrinsics", text("c.json", edit(kCameras, "\"fov_y\": 40", "\"fov_y\": 40, \"intrinsics\": {\"fx\": 1, \"fy\": 1, \"cx\": 0, \"cy\": 0}")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0]", "exactly one" } },
+  { "camera_infinite_position", text("c.json", edit(kCameras, "0.5", "1e999")), "scan traj.h5 --camera c.json -o out.h5", { "c.json:2:", "1e999" } },
+  { "camera_huge_resolution", text("c.json", edit(kCameras, "[16, 12]", "[100000, 100000]")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].resolution" } },
+  { "camera_looks_at_itself", text("c.json", edit(kCameras, "[0.1, 0, 0.025]", "[0.1, 0.5, 0.025]")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].look_at" } },
+  { "scan_negative_noise", nothing(), "scan traj.h5 --camera cam.json --noise -1 -o out.h5", { "scan.noise" } },
+  { "scan_outliers_above_one", nothing(), "scan traj.h5 --camera cam.json --outliers 2 -o out.h5", { "scan.outliers" } },
+  { "scan_trajectory_without_surface", trajectory("t.h5", [](H5Spec& s) { s.i32.erase("/tets"); }), "scan t.h5 --camera cam.json -o out.h5", { "t.h5", "neither /tets nor /faces" } },
+  { "scan_trajectory_nan", trajectory("t.h5", [](H5Spec& s) { s.f64["/positions"].second[13] = kNaN; }), "scan t.h5 --camera cam.json -o out.h5", { "t.h5", "/positions" } },
+  { "scan_of_clouds", nothing(), "scan clouds.h5 --camera cam.json -o out.h5", { "clouds.h5", "trajectory" } },
+  { "scan_output_is_trajectory", nothing(), "scan traj.h5 --camera cam.json -o traj.h5", { "traj.h5", kReplace } },
+  { "scan_output_is_camera", nothing(), "scan traj.h5 --camera cam.json -o cam.json", { "cam.json", kReplace } },
+  { "scan_output_under_file", nothing(), "scan traj.h5 --camera cam.json -o notadir/c.h5", { "notadir/c.h5", "not a folder" } },
 
   // ---- TetGen .node/.ele --------------------------------------------------------------------
   { "tetgen_empty_node", both(text("b.node", ""), text("b.ele", kEle)), "info b.node", { "b.node" } },

@@ -17,11 +17,12 @@ TEST(Layering, NoLayerIncludesAHigherOne) {
     { "material", { "core", "material" } },
     { "fem", { "core", "mesh", "material", "fem" } },
     { "sim", { "core", "mesh", "material", "fem", "sim" } },
-    { "observe", { "core", "mesh", "material", "fem", "sim", "observe" } },
-    { "learn", { "core", "mesh", "material", "fem", "sim", "observe", "learn" } },
+    { "capture", { "core", "mesh", "capture" } },
+    { "observe", { "core", "mesh", "material", "fem", "sim", "capture", "observe" } },
+    { "learn", { "core", "mesh", "material", "fem", "sim", "capture", "observe", "learn" } },
     { "springs", { "core", "springs" } },
     { "io",
-        { "core", "mesh", "material", "fem", "sim", "observe", "learn", "springs", "io",
+        { "core", "mesh", "material", "fem", "sim", "capture", "observe", "learn", "springs", "io",
             "config.hpp" } },
   };
   const std::regex include_re(R"(#include\s*<elastolearn/([A-Za-z_.]+))");

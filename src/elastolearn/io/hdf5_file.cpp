@@ -1,8 +1,10 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/io/hdf5_file.hpp>
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <system_error>
 #include <utility>
 
@@ -328,6 +330,10 @@ void File::write(const std::string& dataset, const int* data, const Shape& shape
   write_dataset(*this, dataset, data, shape, H5T_STD_I32LE, H5T_NATIVE_INT);
 }
 
+void File::write(const std::string& dataset, const std::int64_t* data, const Shape& shape) {
+  write_dataset(*this, dataset, data, shape, H5T_STD_I64LE, H5T_NATIVE_INT64);
+}
+
 void Dataset::read(
     void* out, hid_t memory_type, bool integer_only, hsize_t first, hsize_t rows) const {
   ErrorSilencer silence;
@@ -395,6 +401,78 @@ std::vector<int> File::read_i32(const std::string& name) const {
 }
 
 // --- attributes ------------------------------------------------------------------------------
+
+void File::set_number_attribute(const std::string& name, double value, const std::string& object) {
+  ErrorSilencer silence;
+  const std::string where = object + " attribute '" + name + "'";
+  if (H5Aexists_by_name(m_file.id(), object.c_str(), name.c_str(), H5P_DEFAULT) > 0)
+    H5Adelete_by_name(m_file.id(), object.c_str(), name.c_str(), H5P_DEFAULT);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attr(H5Acreate_by_name(m_file.id(), object.c_str(), name.c_str(), H5T_IEEE_F64LE,
+                  space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      H5Aclose);
+  if (!attr.valid() || H5Awrite(attr.id(), H5T_NATIVE_DOUBLE, &value) < 0)
+    fail(where, with_reason("cannot write attribute"));
+  if (!attr.close())
+    fail(where, "cannot write attribute");
+}
+
+int File::check_format(const std::string& kind, int max_version, const std::string& what) const {
+  const std::string expected = kind + "/" + std::to_string(max_version);
+  const std::optional<std::string> format = attribute("format");
+  if (!format) {
+    fail("",
+        "not an elastolearn " + what + ": the root attribute 'format' is missing (expected '"
+            + expected + "')");
+  }
+  const std::string prefix = kind + "/";
+  int version = 0;
+  if (format->rfind(prefix, 0) == 0) {
+    const std::string v = format->substr(prefix.size());
+    const auto result = std::from_chars(v.data(), v.data() + v.size(), version);
+    if (result.ec != std::errc() || result.ptr != v.data() + v.size())
+      version = 0;
+  }
+  if (version < 1) {
+    fail("",
+        "format '" + *format + "' is not an elastolearn " + what + " (expected '" + expected
+            + "')");
+  }
+  if (version > max_version) {
+    fail("",
+        "format '" + *format + "' is newer than this elastolearn reads (up to '" + expected + "')");
+  }
+  return version;
+}
+
+double File::positive_attribute(const std::string& name, const std::string& meaning) const {
+  const std::string where = "/ attribute '" + name + "'";
+  const std::optional<std::string> text = attribute(name);
+  if (!text)
+    fail(where, "missing (" + meaning + ")");
+  double value = 0;
+  const char* end = text->data() + text->size();
+  const auto result = std::from_chars(text->data(), end, value);
+  if (result.ec != std::errc() || result.ptr != end)
+    fail(where, "is not a number: '" + *text + "'");
+  if (!std::isfinite(value) || value <= 0)
+    fail(where, "must be positive and finite, got " + *text);
+  return value;
+}
+
+void File::check_even_times(
+    const std::string& dataset, const std::vector<double>& time, double dt) const {
+  for (std::size_t t = 0; t < time.size(); ++t) {
+    if (!std::isfinite(time[t]))
+      fail(dataset, "frame " + std::to_string(t) + ": non-finite time " + to_text_exact(time[t]));
+    if (t > 0 && !(std::abs(time[t] - time[t - 1] - dt) <= 1e-6 * dt)) {
+      fail(dataset,
+          "frames " + std::to_string(t - 1) + " and " + std::to_string(t) + " are "
+              + to_text_exact(time[t] - time[t - 1]) + " s apart, but dt is " + to_text_exact(dt)
+              + " s");
+    }
+  }
+}
 
 void File::set_attribute(
     const std::string& name, const std::string& value, const std::string& object) {
@@ -524,7 +602,7 @@ void File::close() {
 // --- AppendableDataset -----------------------------------------------------------------------
 
 AppendableDataset::AppendableDataset(
-    File& file, const std::string& dataset, const Shape& frame_shape)
+    File& file, const std::string& dataset, const Shape& frame_shape, bool compress)
     : m_file(&file)
     , m_name(dataset)
     , m_frame_shape(frame_shape)
@@ -548,7 +626,7 @@ AppendableDataset::AppendableDataset(
   Handle space = make_space(dims, &max_dims);
   Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
   H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
-  if (deflate_available()) {
+  if (compress && deflate_available()) {
     H5Pset_shuffle(dcpl.id()); // byte-transpose doubles: deflate then finds the common exponents
     H5Pset_deflate(dcpl.id(), 1);
   }

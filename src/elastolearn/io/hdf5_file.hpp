@@ -7,6 +7,7 @@
 /// layer from one thread at a time.
 #include <hdf5.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -129,6 +130,7 @@ class File {
   /// must not exist yet. Throws InputError.
   void write(const std::string& dataset, const double* data, const Shape& shape);
   void write(const std::string& dataset, const int* data, const Shape& shape);
+  void write(const std::string& dataset, const std::int64_t* data, const Shape& shape);
 
   /// Whole dataset into `out` (see Dataset::read).
   void read(const std::string& name, double* out) const { dataset(name).read(out); }
@@ -140,6 +142,20 @@ class File {
   /// Set (or replace) a variable-length UTF-8 string attribute on `object` (h5py reads it as str).
   void set_attribute(
       const std::string& name, const std::string& value, const std::string& object = "/");
+  /// Set (or replace) a float64 scalar attribute on `object` (h5py reads it as a number).
+  void set_number_attribute(const std::string& name, double value, const std::string& object = "/");
+  /// Check the root attribute `format` = "<kind>/<version>" with 1 ≤ version ≤ max_version and
+  /// return the version. Throws InputError naming the file when it is missing, names another kind
+  /// ("… is not an elastolearn <what>"), or is newer than max_version.
+  int check_format(const std::string& kind, int max_version, const std::string& what) const;
+  /// The root attribute `name` as a positive finite number (a float attribute, or a string
+  /// holding one). Throws InputError("<file>: / attribute '<name>'", ...) when it is missing
+  /// (the message says it holds `meaning`), not a number, or not positive.
+  double positive_attribute(const std::string& name, const std::string& meaning) const;
+  /// Check frame times read from `dataset`: finite, each interval dt within 1e-6 relative
+  /// (recorded times are sums of steps and carry rounding). Throws InputError naming the frames.
+  void check_even_times(
+      const std::string& dataset, const std::vector<double>& time, double dt) const;
   /// A scalar attribute as text: strings as they are (fixed or variable length), numbers in
   /// shortest round-trip form. Empty if absent. Throws InputError for other kinds.
   std::optional<std::string> attribute(
@@ -169,8 +185,11 @@ class File {
 /// exactly once; flush() or close() writes a partly filled last chunk.
 class AppendableDataset {
   public:
-  /// Create `dataset` in `file` with zero frames. `file` must outlive this object.
-  AppendableDataset(File& file, const std::string& dataset, const Shape& frame_shape);
+  /// Create `dataset` in `file` with zero frames. `file` must outlive this object. `compress`
+  /// false stores the chunks as they are (for data whose low bits are noise, such as scanned
+  /// coordinates, deflate saves little and costs much).
+  AppendableDataset(
+      File& file, const std::string& dataset, const Shape& frame_shape, bool compress = true);
   /// Append one frame of prod(frame_shape) values (copied). Throws InputError.
   void append(const double* frame);
   /// Frames appended so far (written or buffered).

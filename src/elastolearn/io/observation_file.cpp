@@ -17,52 +17,8 @@ const std::string k_ids = "/observed/vertex_ids";
 const std::string k_positions = "/observed/positions";
 const std::string k_time = "/time";
 
-/// A float64 scalar attribute on the root group (h5py reads it as a number).
-void set_number_attribute(h5::File& file, const char* name, double value) {
-  h5::ErrorSilencer silence;
-  h5::Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-  h5::Handle attr(H5Acreate_by_name(file.id(), "/", name, H5T_IEEE_F64LE, space.id(), H5P_DEFAULT,
-                      H5P_DEFAULT, H5P_DEFAULT),
-      H5Aclose);
-  if (!attr.valid() || H5Awrite(attr.id(), H5T_NATIVE_DOUBLE, &value) < 0) {
-    const std::string reason = h5::take_error_message();
-    file.fail(std::string("/ attribute '") + name + "'", "cannot write attribute: " + reason);
-  }
-  if (!attr.close())
-    file.fail(std::string("/ attribute '") + name + "'", "cannot write attribute");
-}
-
-/// Parse all of `text` as a double, or return false.
-bool parse_double(const std::string& text, double& value) {
-  const char* end = text.data() + text.size();
-  const auto result = std::from_chars(text.data(), end, value);
-  return result.ec == std::errc() && result.ptr == end;
-}
-
 void check_format(const h5::File& file) {
-  const std::string expected = std::string(k_kind) + "/" + std::to_string(k_version);
-  const std::optional<std::string> format = file.attribute("format");
-  if (!format) {
-    file.fail("",
-        "not an elastolearn observation: the root attribute 'format' is missing (expected '"
-            + expected + "')");
-  }
-  const std::string prefix = std::string(k_kind) + "/";
-  int version = 0;
-  if (format->rfind(prefix, 0) == 0) {
-    const std::string v = format->substr(prefix.size());
-    const auto result = std::from_chars(v.data(), v.data() + v.size(), version);
-    if (result.ec != std::errc() || result.ptr != v.data() + v.size())
-      version = 0;
-  }
-  if (version < 1) {
-    file.fail("",
-        "format '" + *format + "' is not an elastolearn observation (expected '" + expected + "')");
-  }
-  if (version > k_version) {
-    file.fail("",
-        "format '" + *format + "' is newer than this elastolearn reads (up to '" + expected + "')");
-  }
+  file.check_format(k_kind, k_version, "observation");
 }
 
 /// Shape of `dataset`, which must have `rank` dimensions; `pattern` names them for the message.
@@ -76,15 +32,7 @@ h5::Shape shape_of_rank(const h5::File& file, const std::string& dataset, std::s
 }
 
 double read_dt(const h5::File& file) {
-  const std::optional<std::string> text = file.attribute("dt");
-  if (!text)
-    file.fail("/ attribute 'dt'", "missing (the time between frames, in seconds)");
-  double dt = 0;
-  if (!parse_double(*text, dt))
-    file.fail("/ attribute 'dt'", "is not a number: '" + *text + "'");
-  if (!std::isfinite(dt) || dt <= 0)
-    file.fail("/ attribute 'dt'", "must be positive and finite, got " + *text);
-  return dt;
+  return file.positive_attribute("dt", "the time between frames, in seconds");
 }
 
 } // namespace
@@ -110,7 +58,7 @@ void write_observation_h5(const std::filesystem::path& path, const observe::Obse
   file.write(k_positions, positions.data(), { T, k, 3 });
   file.write(k_time, time.data(), { T });
   file.set_attribute("format", std::string(k_kind) + "/" + std::to_string(k_version));
-  set_number_attribute(file, "dt", obs.dt);
+  file.set_number_attribute("dt", obs.dt);
   for (const auto& [key, value] : metadata)
     file.set_attribute(key, value);
   file.close();
@@ -147,17 +95,7 @@ observe::Observation read_observation_h5(const std::filesystem::path& path) {
   const std::vector<double> time = file.read_f64(k_time);
   if (!time.empty())
     obs.start_time = time.front();
-  for (std::size_t t = 0; t < time.size(); ++t) {
-    if (!std::isfinite(time[t]))
-      file.fail(
-          k_time, "frame " + std::to_string(t) + ": non-finite time " + to_text_exact(time[t]));
-    if (t > 0 && !(std::abs(time[t] - time[t - 1] - obs.dt) <= 1e-6 * obs.dt)) {
-      file.fail(k_time,
-          "frames " + std::to_string(t - 1) + " and " + std::to_string(t) + " are "
-              + to_text_exact(time[t] - time[t - 1]) + " s apart, but dt is "
-              + to_text_exact(obs.dt) + " s");
-    }
-  }
+  file.check_even_times(k_time, time, obs.dt);
   obs.validate(file.name());
   return obs;
 }

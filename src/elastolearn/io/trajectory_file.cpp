@@ -285,35 +285,7 @@ h5::Shape require_shape(const h5::File& file, const std::string& dataset, const 
 }
 
 void check_format(const h5::File& file) {
-  const std::string expected = std::string(k_kind) + "/" + std::to_string(k_version);
-  const std::optional<std::string> format = file.attribute("format");
-  if (!format) {
-    file.fail("",
-        "not an elastolearn trajectory: the root attribute 'format' is missing "
-        "(expected '"
-            + expected + "')");
-  }
-  const std::string prefix = std::string(k_kind) + "/";
-  if (format->rfind(prefix, 0) != 0) {
-    file.fail("",
-        "format '" + *format + "' is not an elastolearn trajectory (expected '" + expected + "')");
-  }
-  const std::string version = format->substr(prefix.size());
-  int v = 0;
-  try {
-    std::size_t used = 0;
-    v = std::stoi(version, &used);
-    if (used != version.size())
-      v = 0;
-  } catch (const std::exception&) {
-    v = 0;
-  }
-  if (v < 1)
-    file.fail("", "invalid format version in '" + *format + "'");
-  if (v > k_version) {
-    file.fail("",
-        "format '" + *format + "' is newer than this elastolearn reads (up to '" + expected + "')");
-  }
+  file.check_format(k_kind, k_version, "trajectory");
 }
 
 template <typename Table>
