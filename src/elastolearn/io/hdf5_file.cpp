@@ -328,6 +328,10 @@ void File::write(const std::string& dataset, const int* data, const Shape& shape
   write_dataset(*this, dataset, data, shape, H5T_STD_I32LE, H5T_NATIVE_INT);
 }
 
+void File::write(const std::string& dataset, const std::uint8_t* data, const Shape& shape) {
+  write_dataset(*this, dataset, data, shape, H5T_STD_U8LE, H5T_NATIVE_UINT8);
+}
+
 void Dataset::read(
     void* out, hid_t memory_type, bool integer_only, hsize_t first, hsize_t rows) const {
   ErrorSilencer silence;

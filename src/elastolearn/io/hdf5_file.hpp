@@ -7,6 +7,7 @@
 /// layer from one thread at a time.
 #include <hdf5.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -129,6 +130,8 @@ class File {
   /// must not exist yet. Throws InputError.
   void write(const std::string& dataset, const double* data, const Shape& shape);
   void write(const std::string& dataset, const int* data, const Shape& shape);
+  /// Stored as unsigned 8-bit integers (numpy uint8).
+  void write(const std::string& dataset, const std::uint8_t* data, const Shape& shape);
 
   /// Whole dataset into `out` (see Dataset::read).
   void read(const std::string& name, double* out) const { dataset(name).read(out); }

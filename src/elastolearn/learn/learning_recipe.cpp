@@ -98,12 +98,7 @@ constexpr size_t kLoopCandidates = 3;
 
 /// Frames [first, last] of an observation (first becomes frame 0).
 observe::Observation frame_range(const observe::Observation& o, int first, int last) {
-  observe::Observation out;
-  out.vertex_ids = o.vertex_ids;
-  out.dt = o.dt;
-  out.start_time = o.start_time + first * o.dt;
-  out.positions.assign(o.positions.begin() + first, o.positions.begin() + last + 1);
-  return out;
+  return o.frame_range(first, last);
 }
 
 /// The training and validation data of stage 1.
@@ -212,7 +207,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     long weight = 0;
     for (const Motion& m : motions) {
       const double s = observe::estimate_noise(m.observed);
-      const long n = static_cast<long>(m.observed.num_frames()) * m.observed.num_observed();
+      const long n = m.observed.num_valid();
       sum += s * s * static_cast<double>(n);
       weight += n;
     }
@@ -234,6 +229,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
 
   // Stage 1: training and validation data.
   Split split = split_motions(motions, options.validation_fraction, std::move(smoothed));
+  if (split.validation.observed.num_valid() == 0)
+    throw InputError(split.validation.name,
+        "/observed/valid: no observed vertex is seen in the held-out frames ("
+            + split.description + "), so no candidate can be validated");
   result.training_frames = split.training.front().scene.frames;
   result.validation_frames = split.validation.observed.num_frames();
   result.validation_data = split.description;

@@ -82,6 +82,8 @@ Evaluation evaluate(const sim::Scene& base, material::ElasticModelType type,
   const auto sink = [&](int frame, double, const VecX& x, const VecX&) {
     const Positions& observed = obs.positions[static_cast<size_t>(frame)];
     for (int j = 0; j < k; ++j) {
+      if (!obs.is_valid(frame, j))
+        continue; // a lost entry: its residual stays 0
       const Vec3 d
           = x.segment<3>(3 * obs.vertex_ids[static_cast<size_t>(j)]) - observed.row(j).transpose();
       e.residual.segment<3>((static_cast<Eigen::Index>(frame) * k + j) * 3) = d;
@@ -265,7 +267,8 @@ ParameterFitReport fit_parameters(const sim::Scene& scene, material::ElasticMode
     options.alpha1_floor > 0 ? options.alpha1_floor : 1e-2 * scene.dt };
   const auto& fitted = options.parameters;
   const int p = static_cast<int>(fitted.size());
-  const int samples = (frames + 1) * obs.num_observed();
+  // Seen (frame, vertex) entries of frames 0..frames: the RMS is over those.
+  const int samples = static_cast<int>(std::max(1L, obs.frame_range(0, frames).num_valid()));
   const double error_floor = options.error_tolerance > 0
       ? options.error_tolerance
       : 1e-10 * scene.mesh.bounding_box_diagonal();
