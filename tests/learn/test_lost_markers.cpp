@@ -111,8 +111,19 @@ TEST(LostMarkers, ParameterFitIgnoresLostEntries) {
     EXPECT_EQ(r->final_rms, a.final_rms);
     EXPECT_EQ(r->final_max, a.final_max);
   }
-  EXPECT_TRUE(std::isfinite(a.final_rms));
-  EXPECT_LT(a.final_rms, 0.5 * a.initial_rms) << "the fit still learns from the seen entries";
+  // The same fit from the complete data (the truth at every entry): losing a fifth of the
+  // entries moves the fitted E by 2.6 % (measured) after the same three iterations.
+  observe::Observation complete = c.observed;
+  complete.valid.resize(0, 0);
+  const auto truth_run = sim::simulate_positions(c.truth);
+  for (int t = 0; t < complete.num_frames(); ++t)
+    for (int j = 0; j < complete.num_observed(); ++j)
+      complete.positions[t].row(j)
+          = truth_run.positions[t].segment<3>(3 * complete.vertex_ids[j]).transpose();
+  const auto f = fit_parameters(c.nominal, type, start, complete, options);
+  EXPECT_NEAR(a.fitted.young / f.fitted.young, 1, 0.05);
+  EXPECT_NEAR(a.final_rms / f.final_rms, 1, 0.1);
+  EXPECT_LT(a.final_rms, 0.8 * a.initial_rms) << "the fit learns from the seen entries";
 }
 
 TEST(LostMarkers, SpaceTimeAndForwardFitIgnoreLostEntries) {
@@ -132,7 +143,7 @@ TEST(LostMarkers, SpaceTimeAndForwardFitIgnoreLostEntries) {
     BlockBandedMatrix normal(c.nominal.frames + 1, 3);
     VecX gradient;
     problem.assemble(run.positions, normal, gradient);
-    return std::tuple { problem.evaluate(run.positions), normal.block(30, 30), gradient };
+    return std::tuple { problem.evaluate(run.positions), MatX(normal.block(30, 30)), gradient };
   };
   const auto [value, block, gradient] = evaluate(c.observed);
   EXPECT_GT(value.position_squares, 0);
@@ -215,8 +226,8 @@ TEST(LostMarkers, RecipeResultDoesNotDependOnLostPositionsAndBeatsTheNominal) {
     EXPECT_EQ(b.candidates[i].validation.samples, a.candidates[i].validation.samples) << i;
   }
   EXPECT_EQ(b.chosen, a.chosen);
-  // The result predicts a different motion (a swing) much better than the nominal: the truth's
-  // nominal error is ~5 % of the size here; with complete data the recipe reaches ~0.1 %.
+  // The result predicts a different motion (a swing) much better than the nominal (measured:
+  // err_L 4.45 % nominal, 0.56 % learned with this small budget).
   const sim::Scene swing = bar(material::ElasticModelType::NeoHookean, 1e6, true);
   const auto test_error = [&](const fem::MaterialModel& material) {
     sim::Scene s = swing;
