@@ -70,7 +70,8 @@ void print_observation(const std::filesystem::path& path) {
         total - o.num_valid(), total, 100.0 * double(total - o.num_valid()) / double(total),
         never_seen);
   }
-  std::printf("  observed points over all frames%s:\n", o.valid.size() == 0 ? "" : " (seen entries)");
+  std::printf(
+      "  observed points over all frames%s:\n", o.valid.size() == 0 ? "" : " (seen entries)");
   print_box(box);
   std::printf("  largest motion of an observed point from %s: %g m\n",
       o.valid.size() == 0 ? "frame 0" : "the first frame it was seen in", max_motion);

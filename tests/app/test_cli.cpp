@@ -159,7 +159,8 @@ TEST_F(CliTest, ObserveDropoutLosesBurstsReproduciblyAndInfoCountsThem) {
   const auto traj = m_dir / "bar.h5";
   ASSERT_EQ(run("simulate " + scene.string() + " -o " + traj.string() + " -q").exit_code, 0);
   const auto plain = m_dir / "plain.h5", a = m_dir / "a.h5", b = m_dir / "b.h5";
-  const std::string observe = "observe " + traj.string() + " --visible-fraction 1 --noise 1e-4 --seed 7";
+  const std::string observe
+      = "observe " + traj.string() + " --visible-fraction 1 --noise 1e-4 --seed 7";
   ASSERT_EQ(run(observe + " -o " + plain.string()).exit_code, 0);
   for (const auto& out : { a, b }) {
     const auto r = run(observe + " --dropout 0.3 --dropout-burst 3 -o " + out.string());

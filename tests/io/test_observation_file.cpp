@@ -331,7 +331,8 @@ TEST(ObservationFile, AcceptsAUserWrittenMaskAndRejectsEachKindOfBadOne) {
     r.u8["/observed/valid"] = { { 1, 1, 0, 1, 1, 1 }, { 3, 2 } };
     r.f64["/observed/positions"].first[3] = std::nan(""); // frame 0, point 1: seen
     expect_rejected(dir, r,
-        { "/observed/positions", "frame 0", "non-finite", "vertex 1", "/observed/valid marks as seen" });
+        { "/observed/positions", "frame 0", "non-finite", "vertex 1",
+            "/observed/valid marks as seen" });
   }
 }
 

@@ -162,8 +162,7 @@ TEST(LostMarkers, SpaceTimeAndForwardFitIgnoreLostEntries) {
   const RbfDesign design(centres, RbfFitOptions {});
   const VecX start = VecX::Zero(design.num_unknowns());
   const auto pass = [&](const observe::Observation& o) {
-    return simulate_with_sensitivities(
-        c.nominal, o, mesh, design, start, Sensitivities::projected);
+    return simulate_with_sensitivities(c.nominal, o, mesh, design, start, Sensitivities::projected);
   };
   const ForwardSensitivityPass a = pass(c.observed);
   ASSERT_TRUE(a.completed) << a.message;

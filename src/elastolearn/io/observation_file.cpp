@@ -145,8 +145,8 @@ void write_observation_h5(const std::filesystem::path& path, const observe::Obse
   file.write(k_time, time.data(), { T });
   if (obs.valid.size() != 0)
     file.write(k_valid, obs.valid.data(), { T, k });
-  file.set_attribute("format",
-      std::string(k_kind) + "/" + std::to_string(obs.valid.size() != 0 ? k_version : 1));
+  file.set_attribute(
+      "format", std::string(k_kind) + "/" + std::to_string(obs.valid.size() != 0 ? k_version : 1));
   set_number_attribute(file, "dt", obs.dt);
   for (const auto& [key, value] : metadata)
     file.set_attribute(key, value);

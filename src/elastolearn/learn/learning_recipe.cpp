@@ -231,8 +231,8 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   Split split = split_motions(motions, options.validation_fraction, std::move(smoothed));
   if (split.validation.observed.num_valid() == 0)
     throw InputError(split.validation.name,
-        "/observed/valid: no observed vertex is seen in the held-out frames ("
-            + split.description + "), so no candidate can be validated");
+        "/observed/valid: no observed vertex is seen in the held-out frames (" + split.description
+            + "), so no candidate can be validated");
   result.training_frames = split.training.front().scene.frames;
   result.validation_frames = split.validation.observed.num_frames();
   result.validation_data = split.description;

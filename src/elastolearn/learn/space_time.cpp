@@ -114,7 +114,8 @@ struct SpaceTimeProblem::Impl {
     VecX e(static_cast<Eigen::Index>(observed_dofs.size()));
     const double* d = observed.positions[frame].data();
     for (size_t i = 0; i < observed_dofs.size(); ++i)
-      e[static_cast<Eigen::Index>(i)] = seen(frame, i) ? x[observed_dofs[i]] - d[observed_row[i]] : 0.0;
+      e[static_cast<Eigen::Index>(i)]
+          = seen(frame, i) ? x[observed_dofs[i]] - d[observed_row[i]] : 0.0;
     return e;
   }
   /// r_i into residual / residual_free; x_{−1} = x_0 − h v_0.
