@@ -172,12 +172,9 @@ Row run_case(const LearningCase& c) {
   auto observed = observe::observe_vertices(frames, c.train.dt, ids, 0.0, 1);
   observe::drop_markers(observed, g_dropout, 5, 2);
   row.observed = observed.num_observed();
-  if (g_dropout > 0) {
-    const long total = static_cast<long>(observed.num_frames()) * observed.num_observed();
-    std::printf("   dropout: %ld of %ld marker-frames lost (%.1f %%) in bursts of mean 5 frames\n",
-        total - observed.num_valid(), total,
-        100.0 * double(total - observed.num_valid()) / double(total));
-  }
+  if (g_dropout > 0)
+    std::printf("   dropout: %s in bursts of mean 5 frames\n",
+        observe::describe_lost_entries(observed).c_str());
   std::printf("   truth simulated in %.1f s: max displacement train %.1f %%, test %.1f %% of the "
               "diagonal (%.3f m); "
               "observing %d of %zu surface vertices\n",

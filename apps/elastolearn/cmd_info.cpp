@@ -63,13 +63,10 @@ void print_observation(const std::filesystem::path& path) {
     }
     never_seen += first < 0 ? 1 : 0;
   }
-  if (o.valid.size() != 0) {
-    const long total = static_cast<long>(o.num_frames()) * o.num_observed();
-    std::printf("  /observed/valid: %ld of %ld vertex-frames lost (%.1f %%), %d vertices never "
-                "seen\n",
-        total - o.num_valid(), total, 100.0 * double(total - o.num_valid()) / double(total),
+  if (o.valid.size() != 0)
+    std::printf("  /observed/valid: %s, %d vertices never seen\n",
+        o.has_lost_entries() ? observe::describe_lost_entries(o).c_str() : "nothing lost",
         never_seen);
-  }
   std::printf(
       "  observed points over all frames%s:\n", o.valid.size() == 0 ? "" : " (seen entries)");
   print_box(box);

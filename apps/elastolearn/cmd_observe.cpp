@@ -87,12 +87,9 @@ void run_observe(const ObserveOptions& opts) {
   if (opts.noise > 0)
     std::printf(", noise sigma = %g m (%.3g %% of the size)", opts.noise,
         100 * opts.noise / mesh.bounding_box_diagonal());
-  if (opts.dropout > 0) {
-    const long total = static_cast<long>(obs.num_frames()) * obs.num_observed();
-    std::printf(", %ld of %ld vertex-frames lost (%.1f %%, bursts of mean %g frames)",
-        total - obs.num_valid(), total, 100.0 * double(total - obs.num_valid()) / double(total),
+  if (opts.dropout > 0)
+    std::printf(", %s in bursts of mean %g frames", observe::describe_lost_entries(obs).c_str(),
         opts.dropout_burst);
-  }
   std::printf("\nobservation: %s\n", opts.output.c_str());
 }
 

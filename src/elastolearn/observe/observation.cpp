@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace elastolearn::observe {
 
@@ -124,6 +125,17 @@ void Observation::validate(
         "observation time step " + to_text_exact(dt) + " s does not match the scene's "
             + to_text_exact(expected_dt) + " s");
   }
+}
+
+std::string describe_lost_entries(const Observation& observed) {
+  if (!observed.has_lost_entries())
+    return "";
+  const long total = static_cast<long>(observed.num_frames()) * observed.num_observed();
+  const long lost = total - observed.num_valid();
+  char text[96];
+  std::snprintf(text, sizeof text, "%ld of %ld vertex-frames lost (%.1f %%)", lost, total,
+      100.0 * static_cast<double>(lost) / static_cast<double>(total));
+  return text;
 }
 
 double uniform_time_step(const std::vector<double>& time, const std::string& source) {

@@ -55,6 +55,10 @@ struct Observation {
       int num_vertices, int expected_frames, double expected_dt, const std::string& source) const;
 };
 
+/// "7717 of 39396 vertex-frames lost (19.6 %)" for an observation with lost entries, "" for one
+/// without (for the commands' summaries).
+std::string describe_lost_entries(const Observation& observed);
+
 /// The constant spacing of `time` (T ≥ 2 increasing times [s]): time[1] − time[0], after
 /// checking that every interval matches it within 1e-6 relative (recorded times are sums of
 /// steps, so they carry rounding). Throws InputError(source, ...) for T < 2 or uneven spacing.

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <string>
 #include <vector>
 
 namespace elastolearn::observe {
@@ -79,13 +80,14 @@ struct MaskGroup {
 /// of every point without a mask). Points never seen are in no group.
 std::vector<MaskGroup> mask_groups(const Observation& observed) {
   std::vector<MaskGroup> groups;
-  std::map<std::vector<std::uint8_t>, size_t> index;
+  std::map<std::string, size_t> index; // a mask column's bytes → its group
   for (int j = 0; j < observed.num_observed(); ++j) {
     std::vector<std::uint8_t> seen = seen_frames(observed, j);
     const long count = std::count(seen.begin(), seen.end(), std::uint8_t(1));
     if (count == 0)
       continue;
-    const auto [it, added] = index.try_emplace(seen, groups.size());
+    const auto [it, added]
+        = index.try_emplace(std::string(seen.begin(), seen.end()), groups.size());
     if (added)
       groups.push_back({ std::move(seen), {}, count });
     groups[it->second].points.push_back(j);
