@@ -22,6 +22,7 @@
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <span>
@@ -81,8 +82,10 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
 }
 
 /// --dropout P: the fraction of the named cases' training marker-frames lost in occlusion bursts
-/// (observe::drop_markers, mean burst 5 frames, seed 2; issue 20's "lost markers").
+/// (observe::drop_markers, mean burst 5 frames; issue 20's "lost markers"); --dropout-seed S
+/// draws the bursts (default 2).
 double g_dropout = 0;
+std::uint64_t g_dropout_seed = 2;
 bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and the nominal test,
                            ///< then stop (for tuning scenes)
 /// The recipe every case learns with: its defaults, changed only by the expert flags below, which
@@ -170,7 +173,7 @@ Row run_case(const LearningCase& c) {
     frames.emplace_back(unflatten(x));
   const auto ids = observe::select_visible_vertices(c.train.mesh, c.visible_fraction, 1);
   auto observed = observe::observe_vertices(frames, c.train.dt, ids, 0.0, 1);
-  observe::drop_markers(observed, g_dropout, 5, 2);
+  observe::drop_markers(observed, g_dropout, 5, g_dropout_seed);
   row.observed = observed.num_observed();
   if (g_dropout > 0)
     std::printf("   dropout: %s in bursts of mean 5 frames\n",
@@ -586,6 +589,8 @@ int main(int argc, char** argv) {
       quick = true;
     else if (a == "--dropout" && i + 1 < argc)
       g_dropout = std::stod(argv[++i]);
+    else if (a == "--dropout-seed" && i + 1 < argc)
+      g_dropout_seed = std::stoull(argv[++i]);
     else if (a == "--truth-only")
       g_truth_only = true;
     else if (a == "--no-fit")
@@ -644,7 +649,7 @@ int main(int argc, char** argv) {
       draw_only = true;
     else if (a == "--help" || a == "-h") {
       std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] "
-                  "[--dropout P] [--modes "
+                  "[--dropout P [--dropout-seed S]] [--modes "
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
                   "[--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
@@ -663,7 +668,7 @@ int main(int argc, char** argv) {
           "its default options (the learning overrides above do not apply); --random-case I: only "
           "case I of that draw; --draw-only: print the draws without simulating\n--dropout P: "
           "the named cases' training observations lose a fraction P of their marker-frames in "
-          "occlusion bursts (mean 5 frames)\n");
+          "occlusion bursts (mean 5 frames) drawn from --dropout-seed S (default 2)\n");
       return 0;
     } else if (a == "all")
       names.insert(names.end(), kCases.begin(), kCases.end());
