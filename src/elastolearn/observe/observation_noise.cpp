@@ -184,13 +184,13 @@ double estimate_noise(const Observation& observed) {
         magnitudes.push_back(std::abs(d));
       }
     if (magnitudes.empty())
-      return 0;
+      continue; // no point seen in order + 1 consecutive frames
     double gain = 0; // Σ stencil² = C(2k, k)
     for (double s : stencil)
       gain += s * s;
     best = std::min(best, 1.4826 * median_of(magnitudes) / std::sqrt(gain));
   }
-  return best;
+  return std::isfinite(best) ? best : 0;
 }
 
 Observation fill_lost_entries(const Observation& observed) {

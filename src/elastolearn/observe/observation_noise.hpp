@@ -23,7 +23,8 @@
 namespace elastolearn::observe {
 
 /// σ [m] estimated from the observation's own frames (0 with fewer than 6 frames, or when no
-/// point was seen in 5 consecutive frames).
+/// point was seen in 3 consecutive frames; orders whose k + 1 frames were never all seen are
+/// skipped).
 double estimate_noise(const Observation& observed);
 
 struct SmoothingResult {
