@@ -4,8 +4,8 @@
 // then compare nominal / fitted / learned with the truth on a different, larger test motion.
 // err_L = max vertex position error over the test trajectory, % of the rest bounding-box diagonal.
 //
-//   bench_learning [--quick] [--data DIR] [--modes R --kernels M ...] [CASE ...]   (no case = all;
-//   --help)
+//   bench_learning [--quick] [--data DIR] [--dropout P] [--modes R --kernels M ...] [CASE ...]
+//   (no case = all; --help)
 //   bench_learning --random N --seed S [--random-case I] [--draw-only]   (random cases, each
 //   learned by the one recipe, learn::learn_material, with its default options: issue 19)
 //
@@ -17,10 +17,12 @@
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
+#include <elastolearn/observe/marker_dropout.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <span>
@@ -79,6 +81,11 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
       .max;
 }
 
+/// --dropout P: the fraction of the named cases' training marker-frames lost in occlusion bursts
+/// (observe::drop_markers, mean burst 5 frames; issue 20's "lost markers"); --dropout-seed S
+/// draws the bursts (default 2).
+double g_dropout = 0;
+std::uint64_t g_dropout_seed = 2;
 bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and the nominal test,
                            ///< then stop (for tuning scenes)
 /// The recipe every case learns with: its defaults, changed only by the expert flags below, which
@@ -200,8 +207,12 @@ Row run_case(const LearningCase& c) {
   for (const auto& x : truth_train)
     frames.emplace_back(unflatten(x));
   const auto ids = observe::select_visible_vertices(c.train.mesh, c.visible_fraction, 1);
-  const auto observed = observe::observe_vertices(frames, c.train.dt, ids, 0.0, 1);
+  auto observed = observe::observe_vertices(frames, c.train.dt, ids, 0.0, 1);
+  observe::drop_markers(observed, g_dropout, 5, g_dropout_seed);
   row.observed = observed.num_observed();
+  if (g_dropout > 0)
+    std::printf("   dropout: %s in bursts of mean 5 frames\n",
+        observe::describe_lost_entries(observed).c_str());
   std::printf("   truth simulated in %.1f s: max displacement train %.1f %%, test %.1f %% of the "
               "diagonal (%.3f m); "
               "observing %d of %zu surface vertices\n",
@@ -587,6 +598,10 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     if (a == "--quick")
       quick = true;
+    else if (a == "--dropout" && i + 1 < argc)
+      g_dropout = std::stod(argv[++i]);
+    else if (a == "--dropout-seed" && i + 1 < argc)
+      g_dropout_seed = std::stoull(argv[++i]);
     else if (a == "--truth-only")
       g_truth_only = true;
     else if (a == "--no-fit")
@@ -644,7 +659,8 @@ int main(int argc, char** argv) {
     else if (a == "--draw-only")
       draw_only = true;
     else if (a == "--help" || a == "-h") {
-      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] [--modes "
+      std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] "
+                  "[--dropout P [--dropout-seed S]] [--modes "
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
                   "[--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
@@ -661,7 +677,9 @@ int main(int argc, char** argv) {
           "data/meshes are (extracted there if missing)\n--random N: N random cases drawn from "
           "seed S (default: a fresh seed, printed), each learned by learn::learn_material with "
           "its default options (the learning overrides above do not apply); --random-case I: only "
-          "case I of that draw; --draw-only: print the draws without simulating\n");
+          "case I of that draw; --draw-only: print the draws without simulating\n--dropout P: "
+          "the named cases' training observations lose a fraction P of their marker-frames in "
+          "occlusion bursts (mean 5 frames) drawn from --dropout-seed S (default 2)\n");
       return 0;
     } else if (a == "all")
       names.insert(names.end(), kCases.begin(), kCases.end());

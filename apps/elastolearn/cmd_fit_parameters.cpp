@@ -55,11 +55,13 @@ void run_fit(const FitOptions& o) {
   options.validate();
 
   const double diagonal = scene.mesh.bounding_box_diagonal();
+  const std::string lost = observe::describe_lost_entries(observed);
   std::printf("fitting %s of %s: %d vertices, %d tets, %d of %d frames (dt = %g s), %d observed "
-              "vertices, %s nominal\n",
+              "vertices%s, %s nominal\n",
       o.fit.c_str(), scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(),
       options.frames < 0 ? scene.frames : options.frames, scene.frames, scene.dt,
-      observed.num_observed(), material::to_string(type).c_str());
+      observed.num_observed(), lost.empty() ? "" : (" (" + lost + ")").c_str(),
+      material::to_string(type).c_str());
   std::fflush(stdout);
   const ProgressCallback progress = [&](long, long, const std::string& line) {
     if (o.quiet)

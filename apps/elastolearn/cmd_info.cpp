@@ -45,16 +45,34 @@ void print_observation(const std::filesystem::path& path) {
   std::printf("  vertex ids %d .. %d: the rest mesh has at least %d vertices (the file holds no "
               "mesh)\n",
       *lowest, *highest, *highest + 1);
-  Box3 box(o.positions.front().colwise().minCoeff().transpose(),
-      o.positions.front().colwise().maxCoeff().transpose());
+  // Seen entries only: a lost one's position means nothing (it may be NaN). A point's motion
+  // is measured from the first frame it was seen in.
+  Box3 box;
   double max_motion = 0;
-  for (const auto& p : o.positions) {
-    box.extend(Box3(p.colwise().minCoeff().transpose(), p.colwise().maxCoeff().transpose()));
-    max_motion = std::max(max_motion, (p - o.positions.front()).rowwise().norm().maxCoeff());
+  int never_seen = 0;
+  for (int j = 0; j < o.num_observed(); ++j) {
+    int first = -1;
+    for (int t = 0; t < o.num_frames(); ++t) {
+      if (!o.is_valid(t, j))
+        continue;
+      const Vec3 p = o.positions[static_cast<size_t>(t)].row(j).transpose();
+      box.extend(p);
+      if (first < 0)
+        first = t;
+      max_motion = std::max(
+          max_motion, (p - o.positions[static_cast<size_t>(first)].row(j).transpose()).norm());
+    }
+    never_seen += first < 0 ? 1 : 0;
   }
-  std::printf("  observed points over all frames:\n");
+  if (o.valid.size() != 0)
+    std::printf("  /observed/valid: %s, %d vertices never seen\n",
+        o.has_lost_entries() ? observe::describe_lost_entries(o).c_str() : "nothing lost",
+        never_seen);
+  std::printf(
+      "  observed points over all frames%s:\n", o.valid.size() == 0 ? "" : " (seen entries)");
   print_box(box);
-  std::printf("  largest motion of an observed point from frame 0: %g m\n", max_motion);
+  std::printf("  largest motion of an observed point from %s: %g m\n",
+      o.valid.size() == 0 ? "frame 0" : "the first frame it was seen in", max_motion);
   const auto metadata = io::read_observation_metadata(path);
   if (!metadata.contains("noise_sigma"))
     std::printf("  noise: not recorded\n");

@@ -197,11 +197,14 @@ void run_learn(const LearnOptions& o) {
     std::printf("resuming from %s at iteration %d\n", checkpoint.string().c_str(),
         resume->loop.next_iteration);
   }
-  for (const learn::Motion& m : motions)
+  for (const learn::Motion& m : motions) {
+    const std::string lost = observe::describe_lost_entries(m.observed);
     std::printf("learning from %s: %d vertices, %d tets, %d frames of dt = %g s, %d observed "
-                "vertices, nominal %s\n",
+                "vertices%s, nominal %s\n",
         m.name.c_str(), m.scene.mesh.num_vertices(), m.scene.mesh.num_tets(), m.scene.frames,
-        m.scene.dt, m.observed.num_observed(), m.scene.material.elastic->name().c_str());
+        m.scene.dt, m.observed.num_observed(), lost.empty() ? "" : (" (" + lost + ")").c_str(),
+        m.scene.material.elastic->name().c_str());
+  }
   std::fflush(stdout);
   const double diagonal = scene.mesh.bounding_box_diagonal();
 

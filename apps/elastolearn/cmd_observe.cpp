@@ -1,7 +1,7 @@
-// elastolearn observe traj.h5 (--visible-fraction F | --vertices FILE) [--noise SIGMA] [--seed S]
-//                    -o obs.h5
+// elastolearn observe traj.h5 (--visible-fraction F | --vertices FILE) [--noise SIGMA]
+//                    [--dropout P [--dropout-burst L]] [--seed S] -o obs.h5
 // Observations for learning (paper 000 §7): some surface vertices of a trajectory, spread over
-// the surface, with optional Gaussian noise. Format: docs/observations.md.
+// the surface, with optional Gaussian noise and lost markers. Format: docs/observations.md.
 #include "command.hpp"
 
 #include <elastolearn/core/command_paths.hpp>
@@ -9,11 +9,13 @@
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/mesh/tet_mesh.hpp>
+#include <elastolearn/observe/marker_dropout.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 
 namespace {
 
@@ -23,6 +25,8 @@ struct ObserveOptions {
   std::string vertices;
   double fraction = 0;
   double noise = 0;
+  double dropout = 0;
+  double dropout_burst = 5;
   std::uint64_t seed = 1;
 };
 
@@ -60,14 +64,21 @@ void run_observe(const ObserveOptions& opts) {
   } else {
     ids = observe::select_visible_vertices(mesh, opts.fraction, opts.seed);
   }
-  const observe::Observation obs = observe::observe_vertices(
+  observe::Observation obs = observe::observe_vertices(
       traj.positions, dt, ids, opts.noise, opts.seed, traj.time.front());
+  // The dropout draws from its own stream (seed + 1), so adding it leaves the noise unchanged.
+  observe::drop_markers(obs, opts.dropout, opts.dropout_burst, opts.seed + 1);
   const std::string selection = opts.vertices.empty()
       ? "visible fraction " + exact(opts.fraction) + " (farthest-point sampling)"
       : "vertex list " + opts.vertices;
-  io::write_observation_h5(opts.output, obs,
-      { { "source", opts.trajectory }, { "selection", selection },
-          { "noise_sigma", exact(opts.noise) }, { "seed", std::to_string(opts.seed) } });
+  std::map<std::string, std::string> metadata { { "source", opts.trajectory },
+    { "selection", selection }, { "noise_sigma", exact(opts.noise) },
+    { "seed", std::to_string(opts.seed) } };
+  if (opts.dropout > 0) {
+    metadata["dropout"] = exact(opts.dropout);
+    metadata["dropout_burst"] = exact(opts.dropout_burst);
+  }
+  io::write_observation_h5(opts.output, obs, metadata);
 
   const int surface = static_cast<int>(mesh.surface_vertices().size());
   std::printf("observed %d vertices (%d surface vertices, %.1f %%) over %d frames, dt = %g s",
@@ -76,6 +87,9 @@ void run_observe(const ObserveOptions& opts) {
   if (opts.noise > 0)
     std::printf(", noise sigma = %g m (%.3g %% of the size)", opts.noise,
         100 * opts.noise / mesh.bounding_box_diagonal());
+  if (opts.dropout > 0)
+    std::printf(", %s in bursts of mean %g frames", observe::describe_lost_entries(obs).c_str(),
+        opts.dropout_burst);
   std::printf("\nobservation: %s\n", opts.output.c_str());
 }
 
@@ -93,7 +107,13 @@ void add_observe_command(CLI::App& root) {
   fraction->excludes(vertices);
   vertices->excludes(fraction);
   cmd->add_option("--noise", opts->noise, "Gaussian noise standard deviation [m] (default 0)");
-  cmd->add_option("--seed", opts->seed, "seed for the vertex choice and the noise (default 1)");
+  cmd->add_option("--dropout", opts->dropout,
+      "lost markers: fraction [0, 1) of vertex-frames lost in occlusion bursts (written as NaN, "
+      "/observed/valid 0; default 0)");
+  cmd->add_option("--dropout-burst", opts->dropout_burst,
+      "mean length of a burst of loss [frames] (geometric; default 5)");
+  cmd->add_option(
+      "--seed", opts->seed, "seed for the vertex choice, the noise and the dropout (default 1)");
   cmd->callback([opts, fraction, vertices] {
     if (fraction->count() == 0 && vertices->count() == 0) {
       throw elastolearn::InputError(

@@ -154,6 +154,43 @@ TEST_F(CliTest, ObserveSamplesSurfaceVerticesReproducibly) {
   EXPECT_FALSE(fs::exists(m_dir / "c.h5"));
 }
 
+TEST_F(CliTest, ObserveDropoutLosesBurstsReproduciblyAndInfoCountsThem) {
+  const auto scene = write("bar.json", kSmallScene);
+  const auto traj = m_dir / "bar.h5";
+  ASSERT_EQ(run("simulate " + scene.string() + " -o " + traj.string() + " -q").exit_code, 0);
+  const auto plain = m_dir / "plain.h5", a = m_dir / "a.h5", b = m_dir / "b.h5";
+  const std::string observe
+      = "observe " + traj.string() + " --visible-fraction 1 --noise 1e-4 --seed 7";
+  ASSERT_EQ(run(observe + " -o " + plain.string()).exit_code, 0);
+  for (const auto& out : { a, b }) {
+    const auto r = run(observe + " --dropout 0.3 --dropout-burst 3 -o " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("vertex-frames lost"), std::string::npos) << r.output;
+  }
+  const auto p = elastolearn::io::read_observation_h5(plain);
+  const auto oa = elastolearn::io::read_observation_h5(a),
+             ob = elastolearn::io::read_observation_h5(b);
+  ASSERT_EQ(oa.valid.rows(), oa.num_frames());
+  EXPECT_TRUE((oa.valid == ob.valid).all()) << "same seed, same bursts";
+  EXPECT_EQ(p.valid.size(), 0);
+  // Seen entries are the plain observation's (the dropout draws from its own stream, so the
+  // noise is unchanged); lost ones are NaN.
+  for (int t = 0; t < oa.num_frames(); ++t)
+    for (int j = 0; j < oa.num_observed(); ++j) {
+      if (oa.is_valid(t, j))
+        EXPECT_EQ(oa.positions[t].row(j), p.positions[t].row(j));
+      else
+        EXPECT_TRUE(oa.positions[t].row(j).array().isNaN().all());
+    }
+  const long lost = long(oa.num_frames()) * oa.num_observed() - oa.num_valid();
+  EXPECT_GT(lost, 0);
+  const auto r = run("info " + a.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("/observed/valid: " + std::to_string(lost) + " of"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("dropout: 0.3"), std::string::npos) << r.output;
+}
+
 TEST_F(CliTest, InfoDescribesObservationFiles) {
   const auto traj = m_dir / "bar.h5", obs = m_dir / "obs.h5";
   ASSERT_EQ(

@@ -42,6 +42,7 @@ observe::Observation make_observation(int T = 4, int k = 3) {
 struct RawFile {
   std::map<std::string, std::pair<std::vector<double>, h5::Shape>> f64;
   std::map<std::string, std::pair<std::vector<int>, h5::Shape>> i32;
+  std::map<std::string, std::pair<std::vector<std::uint8_t>, h5::Shape>> u8;
   std::map<std::string, std::string> attributes { { "format", "elastolearn-observation/1" },
     { "dt", "0.01" } };
 
@@ -55,6 +56,8 @@ struct RawFile {
     for (const auto& [name, data] : f64)
       file.write(name, data.first.data(), data.second);
     for (const auto& [name, data] : i32)
+      file.write(name, data.first.data(), data.second);
+    for (const auto& [name, data] : u8)
       file.write(name, data.first.data(), data.second);
     for (const auto& [name, value] : attributes)
       file.set_attribute(name, value);
@@ -145,7 +148,7 @@ TEST(ObservationFile, RejectsEachKindOfBadFile) {
   }
   {
     RawFile r;
-    r.attributes["format"] = "elastolearn-observation/2";
+    r.attributes["format"] = "elastolearn-observation/3";
     expect_rejected(dir, r, { "newer" });
   }
   {
@@ -240,6 +243,97 @@ TEST(ObservationFile, InvalidDataWritesNothing) {
   EXPECT_THROW(write_observation_h5(dir / "obs.h5", obs), InputError);
   EXPECT_EQ(read_observation_h5(dir / "obs.h5").num_frames(), 4);
   EXPECT_EQ(dir.files(), std::vector<std::string> { "obs.h5" });
+}
+
+TEST(ObservationFile, LostMarkersRoundTripWithNaNPositionsAndVersion2) {
+  ScratchDir dir;
+  observe::Observation obs = make_observation(5, 3);
+  obs.valid = observe::ValidityMask::Ones(5, 3);
+  obs.valid(1, 0) = obs.valid(2, 0) = obs.valid(4, 2) = 0;
+  obs.positions[1].row(0).setConstant(std::nan(""));
+  obs.positions[2].row(0) << 1e300, -1e300, INFINITY; // anything, where lost
+  obs.positions[4](2, 1) = std::nan("");
+  write_observation_h5(dir / "obs.h5", obs);
+  const observe::Observation back = read_observation_h5(dir / "obs.h5");
+  ASSERT_EQ(back.valid.rows(), 5);
+  ASSERT_EQ(back.valid.cols(), 3);
+  EXPECT_TRUE((back.valid == obs.valid).all());
+  EXPECT_EQ(back.num_valid(), 12);
+  for (int t = 0; t < 5; ++t)
+    for (int j = 0; j < 3; ++j)
+      if (obs.is_valid(t, j)) {
+        EXPECT_EQ(back.positions[t].row(j), obs.positions[t].row(j));
+      } else {
+        EXPECT_FALSE(back.is_valid(t, j));
+      }
+  EXPECT_TRUE(std::isnan(back.positions[1](0, 0)));
+  // A file with a mask says version 2 (an older reader refuses it rather than reading NaN or
+  // garbage as data); one without stays version 1, and reads back without a mask.
+  EXPECT_EQ(h5::File::open(dir / "obs.h5").attribute("format"), "elastolearn-observation/2");
+  write_observation_h5(dir / "plain.h5", make_observation());
+  EXPECT_EQ(h5::File::open(dir / "plain.h5").attribute("format"), "elastolearn-observation/1");
+  EXPECT_EQ(read_observation_h5(dir / "plain.h5").valid.size(), 0);
+}
+
+TEST(ObservationFile, AcceptsAUserWrittenMaskAndRejectsEachKindOfBadOne) {
+  ScratchDir dir;
+  {
+    // uint8 as the docs write it, NaN exactly where lost, a vertex never seen (ignored).
+    RawFile r;
+    r.attributes["format"] = "elastolearn-observation/2";
+    r.u8["/observed/valid"] = { { 1, 0, 0, 0, 1, 0 }, { 3, 2 } };
+    r.f64["/observed/positions"].first[3] = std::nan(""); // frame 0, point 1
+    r.f64["/observed/positions"].first[6] = std::nan(""); // frame 1, point 0
+    r.write(dir / "ok.h5");
+    const observe::Observation o = read_observation_h5(dir / "ok.h5");
+    EXPECT_EQ(o.num_valid(), 2);
+    EXPECT_TRUE(o.is_valid(0, 0) && o.is_valid(2, 0) && !o.is_valid(1, 0));
+  }
+  {
+    RawFile r; // any integer type: int32 0/1
+    r.i32["/observed/valid"] = { { 1, 1, 0, 1, 1, 1 }, { 3, 2 } };
+    r.write(dir / "ok32.h5");
+    EXPECT_EQ(read_observation_h5(dir / "ok32.h5").num_valid(), 5);
+  }
+  {
+    RawFile r;
+    r.u8["/observed/valid"] = { { 1, 1, 1, 1 }, { 2, 2 } };
+    expect_rejected(dir, r, { "/observed/valid", "expected shape (3, 2)", "(2, 2)" });
+  }
+  {
+    RawFile r;
+    r.u8["/observed/valid"] = { { 1, 1, 1, 1, 1, 1 }, { 6 } };
+    expect_rejected(dir, r, { "/observed/valid", "expected shape (3, 2)", "(6,)" });
+  }
+  {
+    RawFile r;
+    r.i32["/observed/valid"] = { { 1, 1, 1, 2, 1, 1 }, { 3, 2 } };
+    expect_rejected(dir, r, { "/observed/valid", "frame 1, entry 1", "value 2", "0 = lost" });
+  }
+  {
+    RawFile r;
+    r.i32["/observed/valid"] = { { 1, 1, 1, -1, 1, 1 }, { 3, 2 } };
+    expect_rejected(dir, r, { "/observed/valid", "value -1" });
+  }
+  {
+    RawFile r;
+    r.f64["/observed/valid"] = { { 1, 1, 1, 0, 1, 1 }, { 3, 2 } };
+    expect_rejected(dir, r, { "/observed/valid", "integers", "uint8" });
+  }
+  {
+    RawFile r;
+    r.u8["/observed/valid"] = { { 0, 0, 0, 0, 0, 0 }, { 3, 2 } };
+    expect_rejected(dir, r, { "/observed/valid", "every entry is 0" });
+  }
+  {
+    // NaN where the mask says seen: named as such.
+    RawFile r;
+    r.u8["/observed/valid"] = { { 1, 1, 0, 1, 1, 1 }, { 3, 2 } };
+    r.f64["/observed/positions"].first[3] = std::nan(""); // frame 0, point 1: seen
+    expect_rejected(dir, r,
+        { "/observed/positions", "frame 0", "non-finite", "vertex 1",
+            "/observed/valid marks as seen" });
+  }
 }
 
 TEST(VertexIdList, ParsesCommentsCommasAndLines) {

@@ -65,6 +65,58 @@ TEST(Observation, RejectsEachProblemWithAClearMessage) {
   expect_rejected([](Observation& o) { o.start_time = INFINITY; }, { "/time", "start time" });
 }
 
+TEST(Observation, LostEntriesMayHoldAnythingAndTheMaskIsChecked) {
+  Observation obs = valid_observation();
+  obs.valid = ValidityMask::Ones(5, 3);
+  obs.valid(2, 1) = 0;
+  obs.valid(3, 2) = 0;
+  obs.positions[2].row(1).setConstant(std::nan(""));
+  obs.positions[3].row(2) << INFINITY, -1e308, 0;
+  EXPECT_NO_THROW(obs.validate(10, 5, 0.01, "capture.h5"));
+  EXPECT_EQ(obs.num_valid(), 13);
+  EXPECT_TRUE(obs.has_lost_entries());
+  EXPECT_FALSE(obs.is_valid(2, 1));
+  EXPECT_TRUE(obs.is_valid(2, 0));
+  // A vertex never seen is allowed (ignored).
+  obs.valid.col(0).setZero();
+  EXPECT_NO_THROW(obs.validate(10, 5, 0.01, "capture.h5"));
+
+  expect_rejected(
+      [](Observation& o) {
+        o.valid = ValidityMask::Ones(5, 3);
+        o.valid(1, 2) = 0;
+        o.positions[1](1, 0) = std::nan(""); // vertex 0 is seen in frame 1
+      },
+      { "/observed/positions", "frame 1", "nan", "vertex 0", "marks as seen" });
+  expect_rejected([](Observation& o) { o.valid = ValidityMask::Ones(4, 3); },
+      { "/observed/valid", "(4, 3)", "expected (5, 3)" });
+  expect_rejected(
+      [](Observation& o) {
+        o.valid = ValidityMask::Ones(5, 3);
+        o.valid(4, 1) = 7;
+      },
+      { "/observed/valid", "frame 4", "value 7", "vertex 0" });
+  expect_rejected([](Observation& o) { o.valid = ValidityMask::Zero(5, 3); },
+      { "/observed/valid", "every entry is 0" });
+}
+
+TEST(Observation, FrameRangeKeepsTheMaskOfItsFrames) {
+  Observation obs = valid_observation();
+  obs.start_time = 1;
+  obs.valid = ValidityMask::Ones(5, 3);
+  obs.valid(3, 2) = 0;
+  const Observation part = obs.frame_range(2, 4);
+  EXPECT_EQ(part.num_frames(), 3);
+  EXPECT_DOUBLE_EQ(part.start_time, 1.02);
+  EXPECT_EQ(part.positions[0], obs.positions[2]);
+  ASSERT_EQ(part.valid.rows(), 3);
+  EXPECT_FALSE(part.is_valid(1, 2));
+  EXPECT_EQ(part.num_valid(), 8);
+  EXPECT_EQ(valid_observation().frame_range(1, 1).valid.size(), 0);
+  EXPECT_THROW(obs.frame_range(3, 5), InputError);
+  EXPECT_THROW(obs.frame_range(2, 1), InputError);
+}
+
 TEST(UniformTimeStep, AcceptsRoundingAndRejectsGaps) {
   std::vector<double> time;
   double t = 0;

@@ -334,6 +334,10 @@ void File::write(const std::string& dataset, const std::int64_t* data, const Sha
   write_dataset(*this, dataset, data, shape, H5T_STD_I64LE, H5T_NATIVE_INT64);
 }
 
+void File::write(const std::string& dataset, const std::uint8_t* data, const Shape& shape) {
+  write_dataset(*this, dataset, data, shape, H5T_STD_U8LE, H5T_NATIVE_UINT8);
+}
+
 void Dataset::read(
     void* out, hid_t memory_type, bool integer_only, hsize_t first, hsize_t rows) const {
   ErrorSilencer silence;

@@ -131,6 +131,8 @@ class File {
   void write(const std::string& dataset, const double* data, const Shape& shape);
   void write(const std::string& dataset, const int* data, const Shape& shape);
   void write(const std::string& dataset, const std::int64_t* data, const Shape& shape);
+  /// Stored as unsigned 8-bit integers (numpy uint8).
+  void write(const std::string& dataset, const std::uint8_t* data, const Shape& shape);
 
   /// Whole dataset into `out` (see Dataset::read).
   void read(const std::string& name, double* out) const { dataset(name).read(out); }

@@ -12,13 +12,47 @@ namespace elastolearn::io {
 namespace {
 
 constexpr const char* k_kind = "elastolearn-observation";
-constexpr int k_version = 1;
+/// Version 2 adds the optional /observed/valid; a file without it is written as version 1, which
+/// every reader reads. A file with it says 2, so that a reader that would ignore the mask (and
+/// take lost positions for data) refuses it instead.
+constexpr int k_version = 2;
 const std::string k_ids = "/observed/vertex_ids";
 const std::string k_positions = "/observed/positions";
+const std::string k_valid = "/observed/valid";
 const std::string k_time = "/time";
 
 void check_format(const h5::File& file) {
   file.check_format(k_kind, k_version, "observation");
+}
+
+/// The optional /observed/valid: T × k integers, each 0 (lost) or 1 (seen); empty if absent.
+observe::ValidityMask read_valid(const h5::File& file, hsize_t frames, hsize_t points) {
+  if (!file.exists(k_valid))
+    return {};
+  const h5::Dataset dataset = file.dataset(k_valid);
+  if (dataset.number_kind() != h5::NumberKind::integer)
+    file.fail(k_valid,
+        "expected integers 0 (lost) or 1 (seen), e.g. numpy uint8 (from a boolean array: "
+        "valid.astype(numpy.uint8))");
+  const h5::Shape shape = dataset.shape();
+  if (shape.size() != 2 || shape[0] != frames || shape[1] != points) {
+    file.fail(k_valid,
+        "expected shape (" + std::to_string(frames) + ", " + std::to_string(points)
+            + ") (frames, observed vertices) like " + k_positions + ", got "
+            + h5::shape_string(shape));
+  }
+  std::vector<int> values(frames * points);
+  dataset.read(values.data());
+  observe::ValidityMask valid(static_cast<Eigen::Index>(frames), static_cast<Eigen::Index>(points));
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (values[i] != 0 && values[i] != 1) {
+      file.fail(k_valid,
+          "frame " + std::to_string(i / points) + ", entry " + std::to_string(i % points)
+              + ": value " + std::to_string(values[i]) + " (expected 1 = seen or 0 = lost)");
+    }
+    valid.data()[i] = static_cast<std::uint8_t>(values[i]);
+  }
+  return valid;
 }
 
 /// Shape of `dataset`, which must have `rank` dimensions; `pattern` names them for the message.
@@ -57,7 +91,10 @@ void write_observation_h5(const std::filesystem::path& path, const observe::Obse
   file.write(k_ids, obs.vertex_ids.data(), { k });
   file.write(k_positions, positions.data(), { T, k, 3 });
   file.write(k_time, time.data(), { T });
-  file.set_attribute("format", std::string(k_kind) + "/" + std::to_string(k_version));
+  if (obs.valid.size() != 0)
+    file.write(k_valid, obs.valid.data(), { T, k });
+  file.set_attribute(
+      "format", std::string(k_kind) + "/" + std::to_string(obs.valid.size() != 0 ? k_version : 1));
   file.set_number_attribute("dt", obs.dt);
   for (const auto& [key, value] : metadata)
     file.set_attribute(key, value);
@@ -86,6 +123,7 @@ observe::Observation read_observation_h5(const std::filesystem::path& path) {
         "has " + std::to_string(time_shape[0]) + " times but " + k_positions + " has "
             + std::to_string(T) + " frames");
   }
+  obs.valid = read_valid(file, T, k);
   const std::vector<double> values = file.read_f64(k_positions);
   obs.positions.assign(T, Positions(Eigen::Index(k), 3));
   for (hsize_t t = 0; t < T; ++t)

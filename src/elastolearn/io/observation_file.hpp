@@ -3,8 +3,10 @@
 /// and writable with h5py:
 ///   /observed/vertex_ids (k) i32      mesh vertex index of each observed point
 ///   /observed/positions (T, k, 3) f64 observed positions [m], frame by frame
+///   /observed/valid (T, k) u8         optional: 1 = seen, 0 = lost (its position may be NaN)
 ///   /time (T) f64                     frame times [s], evenly spaced by dt
-///   root attributes: format = "elastolearn-observation/1", dt (float64 [s]), plus optional
+///   root attributes: format = "elastolearn-observation/1" ("/2" with /observed/valid),
+///   dt (float64 [s]), plus optional
 ///   free-form string metadata (observe writes source, selection, noise_sigma, seed)
 #include <elastolearn/observe/observation.hpp>
 
@@ -15,15 +17,18 @@
 
 namespace elastolearn::io {
 
-/// Write atomically (temporary file + rename): /time is start_time + t·dt. The observation is
-/// validated first (Observation::validate), so a written file always reads back.
+/// Write atomically (temporary file + rename): /time is start_time + t·dt; /observed/valid and
+/// format version 2 if obs.valid is not empty, else version 1. The observation is validated
+/// first (Observation::validate), so a written file always reads back.
 /// Throws InputError naming the path (and field) on invalid data or when the file cannot be made.
 /// `metadata` become string attributes on the root group ("format" and "dt" are reserved).
 void write_observation_h5(const std::filesystem::path& path, const observe::Observation& obs,
     const std::map<std::string, std::string>& metadata = {});
 
-/// Read and validate an observation file: format attribute, shapes ((k,), (T, k, 3), (T,)),
-/// integer ids ≥ 0 and distinct, finite positions, dt (a number, or a string holding one)
+/// Read and validate an observation file: format attribute, shapes ((k,), (T, k, 3), (T,), and
+/// (T, k) of integers 0/1 for the optional /observed/valid), integer ids ≥ 0 and distinct,
+/// positions finite where seen (anything, NaN included, where lost), at least one entry seen,
+/// dt (a number, or a string holding one)
 /// positive, /time evenly spaced by dt (each interval within 1e-6 relative).
 /// It does not know the mesh: call `obs.validate(num_vertices, frames, dt, path)` against the
 /// scene next. Throws InputError("<file>: <dataset>", ...) on any problem.

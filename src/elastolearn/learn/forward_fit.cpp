@@ -114,6 +114,11 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
   const auto accumulate = [&](int t, const VecX& x) { // the Gauss–Newton sums of frame t
     for (int i = 0; i < k; ++i) {
       const ObservedDof& o = observed_dofs[i];
+      if (!observed.is_valid(t, o.slot)) { // a lost entry adds nothing to E
+        observed_error[i] = 0;
+        observed_rows.row(i).setZero();
+        continue;
+      }
       observed_error[i] = x[dofs.free_dofs()[o.free]] - observed.positions[t](o.slot, o.component);
       observed_rows.row(i) = s_now.row(o.free);
     }

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Fitting a correction's unknowns to the observations through the forward simulation
-/// itself: Levenberg–Marquardt on E(w) = Σ_t Σ_{observed j} ‖x_t,j(w) − o_t,j‖², with the
+/// itself: Levenberg–Marquardt on E(w) = Σ_t Σ_{observed j seen at t} ‖x_t,j(w) − o_t,j‖², with the
 /// trajectory's sensitivities S_t = ∂x_t/∂w from differentiating the backward-Euler steps
 ///   (M/h² + K_t + D_t/h) S_t = (2M/h² + D_t/h) S_{t−1} − (M/h²) S_{t−2} + ∂f_t/∂w
 /// (K ≈ −∂f/∂x, D ≈ −∂f/∂v at the converged step, the simulator's PSD-projected Jacobians;

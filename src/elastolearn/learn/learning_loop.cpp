@@ -2,6 +2,7 @@
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/material_stability.hpp>
+#include <elastolearn/observe/observation_noise.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
@@ -15,14 +16,18 @@ namespace elastolearn::learn {
 
 namespace {
 
-/// The scene with the observed (not already prescribed) vertices following their data.
-sim::Scene constrained_scene(const sim::Scene& scene, const observe::Observation& observed) {
+/// The scene with the observed (not already prescribed) vertices following their data. Lost
+/// entries follow the smoothest continuation of their vertex's seen ones (fill_lost_entries);
+/// a vertex never seen is not tracked.
+sim::Scene constrained_scene(const sim::Scene& scene, const observe::Observation& given) {
   sim::Scene out = scene;
   const auto prescribed = scene.prescribed_vertices();
   auto tracked = std::make_shared<sim::TrackedVertices>();
+  const observe::Observation observed = observe::fill_lost_entries(given);
   std::vector<int> rows;
   for (int j = 0; j < observed.num_observed(); ++j)
-    if (!std::binary_search(prescribed.begin(), prescribed.end(), observed.vertex_ids[j])) {
+    if (!std::binary_search(prescribed.begin(), prescribed.end(), observed.vertex_ids[j])
+        && (observed.valid.size() == 0 || observed.valid.col(j).maxCoeff() != 0)) {
       tracked->vertices.push_back(observed.vertex_ids[j]);
       rows.push_back(j);
     }

@@ -16,6 +16,9 @@
 /// the first `free_halvings` divergences in a row do not count against patience, later ones do.
 /// Every stage is deterministic, and an iteration depends only on the current correction (and
 /// the counters in LearningState), so a run resumed from a checkpoint reaches the same result.
+/// Lost observation entries (Observation::valid) are ignored by every error and position term;
+/// in stage 2 they follow the smoothest continuation of the seen ones (fill_lost_entries), so
+/// no result depends on a lost entry's stored position.
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
 #include <elastolearn/learn/kmeans.hpp>

@@ -101,12 +101,7 @@ constexpr size_t kLoopCandidates = 3;
 
 /// Frames [first, last] of an observation (first becomes frame 0).
 observe::Observation frame_range(const observe::Observation& o, int first, int last) {
-  observe::Observation out;
-  out.vertex_ids = o.vertex_ids;
-  out.dt = o.dt;
-  out.start_time = o.start_time + first * o.dt;
-  out.positions.assign(o.positions.begin() + first, o.positions.begin() + last + 1);
-  return out;
+  return o.frame_range(first, last);
 }
 
 /// The training and validation data of stage 1.
@@ -170,25 +165,28 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
 /// beyond its test's stretches, σ^1.26), whose best of them had tested at 0.7 × the fit's error.
 constexpr std::array<double, 1> kExtrapolation { 1.5 };
 
-/// The positions of the observed vertices in `frames`, flat (frame, observed vertex, xyz).
-VecX at_observed_vertices(std::span<const VecX> frames, const std::vector<int>& vertex_ids) {
-  const auto k = static_cast<Eigen::Index>(vertex_ids.size());
-  VecX out(static_cast<Eigen::Index>(frames.size()) * k * 3);
+/// The positions of the observed vertices in `frames` (those of `o`), flat (frame, observed
+/// vertex, xyz); 0 at o's lost entries, so that they take no part in a comparison.
+VecX at_observed_vertices(std::span<const VecX> frames, const observe::Observation& o) {
+  const Eigen::Index k = o.num_observed();
+  VecX out = VecX::Zero(static_cast<Eigen::Index>(frames.size()) * k * 3);
   for (size_t t = 0; t < frames.size(); ++t)
     for (Eigen::Index j = 0; j < k; ++j)
-      out.segment<3>((static_cast<Eigen::Index>(t) * k + j) * 3)
-          = frames[t].segment<3>(3 * vertex_ids[static_cast<size_t>(j)]);
+      if (o.is_valid(static_cast<int>(t), static_cast<int>(j)))
+        out.segment<3>((static_cast<Eigen::Index>(t) * k + j) * 3)
+            = frames[t].segment<3>(3 * o.vertex_ids[static_cast<size_t>(j)]);
   return out;
 }
 
-/// An observation's positions, flat like at_observed_vertices.
+/// An observation's positions, flat like at_observed_vertices (0 at lost entries).
 VecX flat_positions(const observe::Observation& o) {
   const Eigen::Index k = o.num_observed();
-  VecX out(static_cast<Eigen::Index>(o.num_frames()) * k * 3);
+  VecX out = VecX::Zero(static_cast<Eigen::Index>(o.num_frames()) * k * 3);
   for (int t = 0; t < o.num_frames(); ++t)
     for (Eigen::Index j = 0; j < k; ++j)
-      out.segment<3>((static_cast<Eigen::Index>(t) * k + j) * 3)
-          = o.positions[static_cast<size_t>(t)].row(j).transpose();
+      if (o.is_valid(t, static_cast<int>(j)))
+        out.segment<3>((static_cast<Eigen::Index>(t) * k + j) * 3)
+            = o.positions[static_cast<size_t>(t)].row(j).transpose();
   return out;
 }
 
@@ -211,7 +209,7 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
     c.extrapolation = material_stability(*nominal.elastic, c.correction.get(),
         amplified_stretches(stretches, kExtrapolation, 40000));
   }
-  return at_observed_vertices(compared, split.validation.observed.vertex_ids);
+  return at_observed_vertices(compared, split.validation.observed);
 }
 
 void say(const RecipeCallbacks& callbacks, const std::string& line) {
@@ -281,7 +279,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     long weight = 0;
     for (const Motion& m : motions) {
       const double s = observe::estimate_noise(m.observed);
-      const long n = static_cast<long>(m.observed.num_frames()) * m.observed.num_observed();
+      const long n = m.observed.num_valid();
       sum += s * s * static_cast<double>(n);
       weight += n;
     }
@@ -303,6 +301,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
 
   // Stage 1: training and validation data.
   Split split = split_motions(motions, options.validation_fraction, std::move(smoothed));
+  if (split.validation.observed.num_valid() == 0)
+    throw InputError(split.validation.name,
+        "/observed/valid: no observed vertex is seen in the held-out frames (" + split.description
+            + "), so no candidate can be validated");
   result.training_frames = split.training.front().scene.frames;
   result.validation_frames = split.validation.observed.num_frames();
   result.validation_data = split.description;

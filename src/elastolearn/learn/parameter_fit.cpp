@@ -100,6 +100,8 @@ Evaluation evaluate(std::span<const FitMotion> motions, material::ElasticModelTy
     const auto sink = [&](int frame, double, const VecX& x, const VecX&) {
       const Positions& observed = obs.positions[static_cast<size_t>(frame)];
       for (int j = 0; j < k; ++j) {
+        if (!obs.is_valid(frame, j))
+          continue; // a lost entry: its residual stays 0
         const Vec3 d = x.segment<3>(3 * obs.vertex_ids[static_cast<size_t>(j)])
             - observed.row(j).transpose();
         e.residual.segment<3>(offset + (static_cast<Eigen::Index>(frame) * k + j) * 3) = d;
@@ -300,7 +302,8 @@ ParameterFitReport fit_parameters(std::span<const Motion> data, material::Elasti
               + std::to_string(obs.num_frames() - 1) + " (frames 0.."
               + std::to_string(obs.num_frames() - 1) + ")");
     motions.push_back({ &m.scene, &obs, frames });
-    samples += static_cast<int>(motions.back().samples());
+    // Seen (frame, vertex) entries of frames 0..frames: the RMS is over those.
+    samples += static_cast<int>(std::max(1L, obs.frame_range(0, frames).num_valid()));
     duration = std::max(duration, frames * m.scene.dt);
   }
   const sim::Scene& scene = data.front().scene;

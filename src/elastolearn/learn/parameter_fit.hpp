@@ -121,7 +121,8 @@ struct ParameterFitReport {
 };
 
 /// Fit the nominal parameters to the observation by minimising
-///   Φ(p) = Σ_t Σ_j ‖x_{v_j}(t; p) − s_j(t)‖²   (t = 0..frames, v_j = obs.vertex_ids[j])
+///   Φ(p) = Σ_t Σ_j ‖x_{v_j}(t; p) − s_j(t)‖²   (t = 0..frames, v_j = obs.vertex_ids[j],
+///                                              over the entries seen: Observation::valid)
 /// over x(p), the forward simulation of `scene` with the material of
 /// scene_with_parameters(scene, type, p). Observation frame t is simulated frame t.
 /// Levenberg–Marquardt on transformed parameters u = (log E, logit(ν/0.49), log(α₀ + floor₀),

@@ -107,12 +107,15 @@ struct SpaceTimeProblem::Impl {
       : physics(p)
       , observed(o) { }
 
-  /// S x_i − s_i.
+  /// The observed dof i is seen in `frame` (Observation::valid).
+  bool seen(int frame, size_t i) const { return observed.is_valid(frame, observed_row[i] / 3); }
+  /// S x_i − s_i, 0 at the entries lost in that frame.
   VecX position_error(const VecX& x, int frame) const {
     VecX e(static_cast<Eigen::Index>(observed_dofs.size()));
     const double* d = observed.positions[frame].data();
     for (size_t i = 0; i < observed_dofs.size(); ++i)
-      e[static_cast<Eigen::Index>(i)] = x[observed_dofs[i]] - d[observed_row[i]];
+      e[static_cast<Eigen::Index>(i)]
+          = seen(frame, i) ? x[observed_dofs[i]] - d[observed_row[i]] : 0.0;
     return e;
   }
   /// r_i into residual / residual_free; x_{−1} = x_0 − h v_0.
@@ -238,8 +241,20 @@ void SpaceTimeProblem::assemble(
   }
   const double lambda2 = s.lambda * s.lambda;
   const MatX position_normal = lambda2 * s.observed_basis.transpose() * s.observed_basis;
+  MatX seen_basis; // S Φ with the rows lost in a frame zeroed
   for (int i = 0; i <= T; ++i) {
-    normal.block(i, i) += position_normal;
+    bool all_seen = true;
+    for (size_t o = 0; o < s.observed_dofs.size() && all_seen; ++o)
+      all_seen = s.seen(i, o);
+    if (all_seen) {
+      normal.block(i, i) += position_normal;
+    } else {
+      seen_basis = s.observed_basis;
+      for (size_t o = 0; o < s.observed_dofs.size(); ++o)
+        if (!s.seen(i, o))
+          seen_basis.row(static_cast<Eigen::Index>(o)).setZero();
+      normal.block(i, i).noalias() += lambda2 * seen_basis.transpose() * seen_basis;
+    }
     gradient.segment(static_cast<Eigen::Index>(i) * r, r).noalias()
         += lambda2 * s.observed_basis.transpose() * s.position_error(x[i], i);
   }
@@ -308,10 +323,8 @@ SpaceTimeResult optimize_space_time(TrajectoryPhysics& physics, ConstRef<MatX> b
   result.objective = current.total();
   const double free_count = static_cast<double>(physics.dofs().num_free());
   result.physics_rms = std::sqrt(current.residual_squares / (T * free_count));
-  const double observed_points = current.position_squares > 0 || observed.num_observed() > 0
-      ? static_cast<double>(observed.num_observed())
-      : 1.0;
-  result.position_rms = std::sqrt(current.position_squares / ((T + 1) * observed_points));
+  const double seen_entries = static_cast<double>(std::max(1L, observed.num_valid()));
+  result.position_rms = std::sqrt(current.position_squares / seen_entries);
   result.seconds = seconds_since(start_time);
   return result;
 }

@@ -6,7 +6,8 @@
 /// (3n × r, zero rows at prescribed dofs) the POD basis. Objective (Gauss–Newton on)
 ///   E(z) = ½ Σ_{i=1..T} ‖s Φᵀ r_i(x)‖²  +  ½ λ² Σ_{i=0..T} ‖S x_i − s_i‖²
 /// with r_i the discrete equation of motion (TrajectoryPhysics, Eq. 2/3), S the observed dofs
-/// and s_i their data (Eq. 4), and s = τ²/m̄ (m̄ the mean vertex mass, τ = 1 % of the duration
+/// seen in frame i (Observation::valid: a lost entry has no position term) and s_i their data
+/// (Eq. 4), and s = τ²/m̄ (m̄ the mean vertex mass, τ = 1 % of the duration
 /// T·h), which turns forces into the displacement they cause over τ, so that both terms are in
 /// metres, λ is dimensionless and the balance does not depend on the time step. r_i couples x_i,
 /// x_{i−1}, x_{i−2}, so JᵀJ is block-banded in time with block bandwidth 2: each Gauss–Newton step
@@ -37,7 +38,7 @@ struct SpaceTimeResult {
   double initial_objective = 0; ///< E at the origin trajectory [m²]
   double objective = 0; ///< E at the result [m²]
   double physics_rms = 0; ///< √(mean over steps and free dofs of r_i²) of the result [N]
-  double position_rms = 0; ///< √(mean over frames and observed vertices of ‖S x_i − s_i‖²) [m]
+  double position_rms = 0; ///< √(mean over seen (frame, vertex) entries of ‖S x_i − s_i‖²) [m]
   int iterations = 0;
   double seconds = 0;
 };

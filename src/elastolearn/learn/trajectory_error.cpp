@@ -107,6 +107,8 @@ ErrorSummary observation_error(const std::vector<VecX>& frames, const observe::O
               + " rows, expected " + std::to_string(count));
     }
     for (int j = 0; j < count; ++j) {
+      if (!obs.is_valid(t, j))
+        continue; // a lost entry: its position means nothing
       const int v = obs.vertex_ids[j];
       acc.add((frames[t].segment<3>(3 * v) - observed.row(j).transpose()).norm(), t, v);
     }

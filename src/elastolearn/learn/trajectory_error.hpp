@@ -31,7 +31,8 @@ ErrorSummary position_error(
     const std::vector<VecX>& a, const std::vector<VecX>& b, const std::vector<int>& vertices = {});
 
 /// Errors of simulated frames (flat 3n) at the observed vertices against the observation:
-/// frame t is compared with observation frame t, for t < min(T_frames, T_obs).
+/// frame t is compared with observation frame t, for t < min(T_frames, T_obs), at the entries
+/// seen (Observation::valid; lost ones are skipped and not counted in `samples`).
 /// Throws InputError if either is empty, frames differ in size, or an observed vertex id is
 /// out of range of the frames.
 ErrorSummary observation_error(const std::vector<VecX>& frames, const observe::Observation& obs);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace elastolearn::observe {
 
@@ -11,8 +12,30 @@ namespace {
 
 const std::string k_ids = "/observed/vertex_ids";
 const std::string k_positions = "/observed/positions";
+const std::string k_valid = "/observed/valid";
 
 } // namespace
+
+long Observation::num_valid() const {
+  if (valid.size() == 0)
+    return static_cast<long>(num_frames()) * num_observed();
+  return static_cast<long>((valid != 0).count());
+}
+
+Observation Observation::frame_range(int first, int last) const {
+  if (first < 0 || last < first || last >= num_frames())
+    throw InputError("observation",
+        "frames " + std::to_string(first) + ".." + std::to_string(last) + " are not within 0.."
+            + std::to_string(num_frames() - 1));
+  Observation out;
+  out.vertex_ids = vertex_ids;
+  out.dt = dt;
+  out.start_time = start_time + first * dt;
+  out.positions.assign(positions.begin() + first, positions.begin() + last + 1);
+  if (valid.size() != 0)
+    out.valid = valid.middleRows(first, last - first + 1);
+  return out;
+}
 
 void Observation::validate(const std::string& source) const {
   const auto where = [&](const std::string& field) { return source + ": " + field; };
@@ -40,6 +63,24 @@ void Observation::validate(const std::string& source) const {
   }
   if (positions.empty())
     throw InputError(where(k_positions), "no frames");
+  if (valid.size() != 0) {
+    if (valid.rows() != num_frames() || valid.cols() != k) {
+      throw InputError(where(k_valid),
+          "has shape (" + std::to_string(valid.rows()) + ", " + std::to_string(valid.cols())
+              + "), expected (" + std::to_string(num_frames()) + ", " + std::to_string(k)
+              + "): one entry per frame and observed vertex");
+    }
+    for (Eigen::Index t = 0; t < valid.rows(); ++t)
+      for (Eigen::Index j = 0; j < k; ++j)
+        if (valid(t, j) > 1) {
+          throw InputError(where(k_valid),
+              "frame " + std::to_string(t) + ": value " + std::to_string(int(valid(t, j)))
+                  + " for vertex " + std::to_string(vertex_ids[j])
+                  + " (expected 1 = seen or 0 = lost)");
+        }
+    if (num_valid() == 0)
+      throw InputError(where(k_valid), "every entry is 0: no vertex was seen in any frame");
+  }
   for (std::size_t t = 0; t < positions.size(); ++t) {
     const Positions& x = positions[t];
     if (x.rows() != k) {
@@ -48,11 +89,12 @@ void Observation::validate(const std::string& source) const {
               + " rows, expected one per observed vertex (" + std::to_string(k) + ")");
     }
     for (Eigen::Index i = 0; i < x.size(); ++i) {
-      if (!std::isfinite(x.data()[i])) {
+      if (!std::isfinite(x.data()[i]) && is_valid(static_cast<int>(t), static_cast<int>(i / 3))) {
         throw InputError(where(k_positions),
             "frame " + std::to_string(t) + ": non-finite value " + to_text_exact(x.data()[i])
                 + " for vertex " + std::to_string(vertex_ids[i / 3]) + " (component "
-                + std::to_string(i % 3) + ")");
+                + std::to_string(i % 3) + ")"
+                + (valid.size() != 0 ? ", which /observed/valid marks as seen" : ""));
       }
     }
   }
@@ -83,6 +125,17 @@ void Observation::validate(
         "observation time step " + to_text_exact(dt) + " s does not match the scene's "
             + to_text_exact(expected_dt) + " s");
   }
+}
+
+std::string describe_lost_entries(const Observation& observed) {
+  if (!observed.has_lost_entries())
+    return "";
+  const long total = static_cast<long>(observed.num_frames()) * observed.num_observed();
+  const long lost = total - observed.num_valid();
+  char text[96];
+  std::snprintf(text, sizeof text, "%ld of %ld vertex-frames lost (%.1f %%)", lost, total,
+      100.0 * static_cast<double>(lost) / static_cast<double>(total));
+  return text;
 }
 
 double uniform_time_step(const std::vector<double>& time, const std::string& source) {
