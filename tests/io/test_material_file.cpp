@@ -221,7 +221,7 @@ TEST(MaterialFile, NnRoundTripIsBitExact) {
     EXPECT_EQ(p.layers[k].bias, q.layers[k].bias) << "layer " << k;
   }
   expect_same_function(*original, *back);
-  EXPECT_EQ(describe_correction(*back), "nn, 6-6-6-1, with damping correction");
+  EXPECT_EQ(describe_correction(*back), "nn (stress, elu), 6-6-6-1, with damping correction");
 }
 
 TEST(MaterialFile, NominalOnlyFileGivesTheSceneMaterialModel) {
