@@ -8,12 +8,14 @@
 //   Stress networks (the paper's setting): {batch norm, none} × {ELU, ReLU, sigmoid}, 6-6, from
 //   the stress-kernel teacher.
 //   Energy networks (NnKind::Energy): squareplus, softplus, tanh, ELU, sigmoid, 8-8, no batch
-//   norm, from the energy-kernel teacher.
+//   norm, from the energy-kernel teacher, its tails as the polynomial (distill_rbf's default);
+//   and squareplus with a least-squares polynomial (cubic, quadratic) or none.
 // Prints a markdown table (docs/learning.md, "Activation and batch normalisation").
 //
 //   ./build/bench/bench_nn_activations
 #include "correction_cases.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -52,6 +54,10 @@ struct Config {
   material::NnKind kind;
   material::Activation activation;
   bool batch_norm;
+  /// Energy networks' polynomial: -1 the teacher's tails (distill_rbf's default), else the
+  /// least-squares fit of this degree (NnDistillationOptions::energy_polynomial_degree).
+  int polynomial_degree = -1;
+  bool show_polynomial = false; ///< also print the polynomial alone's errors
 };
 
 } // namespace
@@ -68,9 +74,13 @@ int main() {
     { "BN + ReLU", K::Stress, A::Relu, true }, { "BN + sigmoid", K::Stress, A::Sigmoid, true },
     { "ELU", K::Stress, A::Elu, false }, { "ReLU", K::Stress, A::Relu, false },
     { "sigmoid", K::Stress, A::Sigmoid, false },
-    { "squareplus", K::Energy, A::Squareplus, false },
+    { "squareplus", K::Energy, A::Squareplus, false, -1, true },
     { "softplus", K::Energy, A::Softplus, false }, { "tanh", K::Energy, A::Tanh, false },
-    { "ELU", K::Energy, A::Elu, false }, { "sigmoid", K::Energy, A::Sigmoid, false } };
+    { "ELU", K::Energy, A::Elu, false }, { "sigmoid", K::Energy, A::Sigmoid, false },
+    { "squareplus, least-squares cubic polynomial", K::Energy, A::Squareplus, false, 3, true },
+    { "squareplus, least-squares quadratic polynomial", K::Energy, A::Squareplus, false, 2,
+        true },
+    { "squareplus, no polynomial", K::Energy, A::Squareplus, false, 0 } };
   const material::RbfCorrection stress_teacher = bench::teacher_rbf(false);
   const material::RbfCorrection energy_teacher = bench::teacher_rbf(true);
   const MatX stretches = bench::training_stretches(4000, 7);
@@ -87,6 +97,8 @@ int main() {
     learn::NnDistillationOptions& training = c.kind == K::Stress ? o.stress : o.energy;
     training.training.activation = c.activation;
     training.training.batch_norm = c.batch_norm;
+    o.teacher_polynomial = c.polynomial_degree < 0;
+    training.energy_polynomial_degree = std::max(c.polynomial_degree, 0);
     const material::RbfCorrection& teacher
         = c.kind == K::Stress ? stress_teacher : energy_teacher;
     try {
@@ -96,6 +108,16 @@ int main() {
       for (const auto& t : tests)
         std::printf(" %.2f %% |", 100 * relative_error(r.correction, teacher, t));
       std::printf("\n");
+      if (c.show_polynomial) {
+        // The polynomial alone (the MLP's output layer zeroed): what extrapolates.
+        material::NnCorrection::Parameters p = r.correction.parameters();
+        p.layers.back().weight.setZero();
+        const material::NnCorrection poly(p);
+        std::printf("| | (its polynomial alone) | | | |");
+        for (const auto& t : tests)
+          std::printf(" %.2f %% |", 100 * relative_error(poly, teacher, t));
+        std::printf("\n");
+      }
     } catch (const std::exception& e) {
       std::printf("| %s | %s | failed: %s |\n", material::to_string(c.kind).c_str(), c.label,
           e.what());

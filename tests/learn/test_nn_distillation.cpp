@@ -371,9 +371,9 @@ class KnownEnergy final : public material::Correction {
 
 TEST(NnDistillation, EnergyNetworkFitsAKnownEnergyThroughItsGradient) {
   // The network sees only N (stresses), never Ψ: its gradient must reproduce them. Measured
-  // (8-8 squareplus): validation 1.8 % of the target RMS (training 0.9 %); the polynomial alone
+  // (8-8 squareplus): validation 2.1 % of the target RMS (training 0.8 %); the polynomial alone
   // (the same network with its output layer zeroed) leaves 31 %: the MLP must remove most of it.
-  // Bounds 3 % and a factor 8, with margin for other compilers' rounding.
+  // Bounds 4 % and a factor 7, with margin for other compilers' rounding.
   const KnownEnergy truth;
   const StressSamples samples = random_samples(truth, 6000, 17);
   const NnDistillationOptions o = energy_distillation_options();
@@ -393,8 +393,8 @@ TEST(NnDistillation, EnergyNetworkFitsAKnownEnergyThroughItsGradient) {
             << " s, relative RMS train " << r.relative_training_rms() << " validation "
             << r.relative_validation_rms() << ", polynomial alone " << poly_rms << "\n";
   EXPECT_EQ(r.correction.parameters().kind, material::NnKind::Energy);
-  EXPECT_LT(r.relative_validation_rms(), 0.03);
-  EXPECT_LT(r.relative_validation_rms(), poly_rms / 8);
+  EXPECT_LT(r.relative_validation_rms(), 0.04);
+  EXPECT_LT(r.relative_validation_rms(), poly_rms / 7);
   // Same seed, same network.
   EXPECT_EQ(distill_nn_correction(samples, o).correction.parameters().layers[1].weight,
       r.correction.parameters().layers[1].weight);
@@ -431,4 +431,34 @@ TEST(NnDistillation, DistilRbfPicksTheKindFromTheTeacherAndCarriesItsDamping) {
   NnDistillationOptions bad = energy_distillation_options();
   bad.training.batch_norm = true;
   EXPECT_THROW(distill_nn_correction(random_samples(energy_teacher, 100, 1), bad), InputError);
+}
+
+TEST(NnDistillation, TeacherTailsAreTheEnergyNetworksPolynomialExactly) {
+  // An energy RBF's linear and quadratic tails as the polynomial c: the energy network with a
+  // zero MLP reproduces the tails' N (kernel weights zero) to rounding, and ΔΨ up to a constant.
+  material::RbfCorrection::Parameters p = smooth_teacher().parameters();
+  p.energy_kernels = true;
+  p.weights.setZero();
+  p.constant = 700;
+  p.quadratic = Eigen::Vector4d(3e4, 2e4, 1e4, -1e4); // an energy tail: q₁ = 2 q₂
+  const material::RbfCorrection tails(p);
+  const auto c = rbf_energy_polynomial(tails);
+  ASSERT_TRUE(c.has_value());
+  material::NnCorrection::Parameters n;
+  n.kind = material::NnKind::Energy;
+  n.input_mean = VecX::Zero(3);
+  n.input_scale = VecX::Ones(3);
+  n.polynomial = *c;
+  n.layers.push_back({ MatX::Zero(1, 3), VecX::Zero(1) });
+  const material::NnCorrection net(n);
+  const Vec3 rest = Vec3::Ones();
+  for (const Vec3& s : { Vec3(1.1, 0.95, 0.9), Vec3(1.3, 1.3, 0.7), Vec3(0.8, 1.0, 1.25) }) {
+    const Vec3 expected = tails.correction(s, Vec3::Zero());
+    EXPECT_LE((net.correction(s, Vec3::Zero()) - expected).norm(), 1e-9 * expected.norm());
+    EXPECT_NEAR(net.elastic_energy(s) - net.elastic_energy(rest),
+        tails.elastic_energy(s) - tails.elastic_energy(rest), 1e-9 * std::abs(tails.elastic_energy(s)));
+  }
+  p.neo_hookean = Eigen::Vector2d(1e3, 0);
+  EXPECT_FALSE(rbf_energy_polynomial(material::RbfCorrection(p)).has_value());
+  EXPECT_FALSE(rbf_energy_polynomial(smooth_teacher()).has_value()); // stress kernels
 }

@@ -89,6 +89,9 @@ void DistillationSampleOptions::validate() const {
 
 void NnDistillationOptions::validate() const {
   training.validate();
+  if (energy_polynomial_degree != 0 && energy_polynomial_degree != 2
+      && energy_polynomial_degree != 3)
+    fail("energy_polynomial_degree", "must be 0, 2 or 3, got " + to_text(energy_polynomial_degree));
   if (kind == material::NnKind::Energy && training.batch_norm)
     fail("training.batch_norm", "must be off for an energy network (train_gradient_mlp)");
   if (!(validation_fraction > 0 && validation_fraction < 1))
@@ -286,7 +289,7 @@ NnDistillationResult measured(material::NnCorrection correction, const MlpTraini
 /// ∇_σ m(p) of the energy polynomial m = (p₁, p₁², p₂, p₁³, p₁p₂, p₃) (NnKind::Energy): 3 × 6.
 Eigen::Matrix<double, 3, 6> polynomial_stress_basis(const Vec3& stretches) {
   const Vec3 e = stretches - Vec3::Ones();
-  const Vec3 p = material::energy_input(stretches);
+  const Vec3 p = material::power_sums(stretches);
   Eigen::Matrix<double, 3, 6> m;
   m.col(0).setOnes();
   m.col(1).setConstant(2 * p[0]);
@@ -370,22 +373,32 @@ NnDistillationResult distill_energy_network(
   for (Eigen::Index c = 0; c < 6; ++c)
     if (!(column_norm[c] > 0))
       column_norm[c] = 1;
-  const VecX scaled = (basis * column_norm.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(rhs);
-  const Eigen::Matrix<double, 6, 1> polynomial = scaled.cwiseQuotient(column_norm);
+  const int terms = o.energy_polynomial_degree == 3 ? 6 : o.energy_polynomial_degree == 2 ? 3 : 0;
+  Eigen::Matrix<double, 6, 1> polynomial = Eigen::Matrix<double, 6, 1>::Zero();
+  if (o.energy_polynomial) {
+    polynomial = *o.energy_polynomial;
+  } else if (terms > 0) {
+    const VecX scaled = (basis.leftCols(terms) * column_norm.head(terms).cwiseInverse().asDiagonal())
+                            .colPivHouseholderQr()
+                            .solve(rhs);
+    polynomial.head(terms) = scaled.cwiseQuotient(column_norm.head(terms));
+  }
 
-  // Inputs p, standardised with the training states' statistics.
+  // Inputs x = energy_input(σ), standardised with the training states' statistics.
   MatX p_train(3, n_train);
   for (Eigen::Index j = 0; j < n_train; ++j)
     p_train.col(j) = material::energy_input(row(train[std::size_t(j)]));
   VecX in_mean, in_scale;
   row_statistics(p_train, in_mean, in_scale);
-  // D = ∂p̃/∂σ: row c of ∂p/∂σ = (1, 2e, 3e²) over the scale s_c; D(c, i) at row c + 3i.
+  // D = ∂x̃/∂σ = diag(1/s) (∂x/∂p)(∂p/∂σ), ∂p_j/∂σ_i = (1, 2e_i, 3e_i²)_j; D(c, i) at row c + 3i.
   const auto chain = [&](const Vec3& s, auto&& map) {
     const Vec3 e = s - Vec3::Ones();
+    Mat3 x_p;
+    material::energy_input(s, &x_p);
     for (int i = 0; i < 3; ++i) {
-      map(0 + 3 * i) = 1 / in_scale[0];
-      map(1 + 3 * i) = 2 * e[i] / in_scale[1];
-      map(2 + 3 * i) = 3 * e[i] * e[i] / in_scale[2];
+      const Vec3 p_sigma(1, 2 * e[i], 3 * e[i] * e[i]);
+      for (int c = 0; c < 3; ++c)
+        map(c + 3 * i) = x_p.row(c).dot(p_sigma) / in_scale[c];
     }
   };
   const auto gradient_samples = [&](const std::vector<int>& states, GradientSamples& g) {
@@ -420,6 +433,21 @@ NnDistillationResult distill_energy_network(
   p.polynomial = polynomial;
   p.layers = fold_batch_norm(trained.network);
   return measured(material::NnCorrection(std::move(p)), trained.report, samples, train, valid);
+}
+
+std::optional<Eigen::Matrix<double, 6, 1>> rbf_energy_polynomial(
+    const material::RbfCorrection& rbf) {
+  const auto& p = rbf.parameters();
+  if (!p.energy_kernels || !p.neo_hookean.isZero(0))
+    return std::nullopt;
+  // N_k = a e_k + b (p₁ − e_k) + c is the gradient of ½(a − b) p₂ + ½ b p₁² + c p₁;
+  // q = α(3, 6, 3, 0) + β(3, 2, 1, −2) + γ(3, 0, 0, 0) that of α p₁³ + β p₁p₂ + γ p₃.
+  const Eigen::Vector4d& q = p.quadratic;
+  const double beta = -0.5 * q[3], alpha = (q[2] - beta) / 3,
+               gamma = (q[0] - 3 * alpha - 3 * beta) / 3;
+  Eigen::Matrix<double, 6, 1> c;
+  c << p.constant, 0.5 * p.other_slope, 0.5 * (p.own_slope - p.other_slope), alpha, beta, gamma;
+  return c;
 }
 
 void RbfDistillationOptions::validate() const {
@@ -462,8 +490,10 @@ NnDistillationResult distill_rbf(const material::RbfCorrection& teacher, ConstRe
   }
   if (!samples.targets.allFinite())
     fail("teacher", "the teacher correction returned a non-finite value");
-  NnDistillationResult r = distill_nn_correction(
-      samples, kind == material::NnKind::Energy ? o.energy : o.stress);
+  NnDistillationOptions training = kind == material::NnKind::Energy ? o.energy : o.stress;
+  if (kind == material::NnKind::Energy && o.teacher_polynomial && !training.energy_polynomial)
+    training.energy_polynomial = rbf_energy_polynomial(teacher);
+  NnDistillationResult r = distill_nn_correction(samples, training);
   r.correction = with_teacher_damping(r.correction, teacher);
   return r;
 }

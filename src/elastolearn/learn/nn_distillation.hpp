@@ -96,6 +96,13 @@ struct NnDistillationOptions {
   /// + ELU, paper §6.2); energy_distillation_options() gives the energy network's.
   MlpTrainingOptions training;
   double validation_fraction = 0.2; ///< held-out share of the samples, in (0, 1)
+  /// Energy network: the degree of the polynomial energy cᵀ m(p) fitted before the MLP: 3 (all
+  /// of m), 2 (p₁, p₁², p₂: the isotropic linear stress, 2Δμ e + Δλ tr e plus a pressure) or 0
+  /// (none).
+  int energy_polynomial_degree = 3;
+  /// Energy network: a given polynomial c instead of the least-squares fit (distill_rbf passes
+  /// the teacher's tails, rbf_energy_polynomial).
+  std::optional<Eigen::Matrix<double, 6, 1>> energy_polynomial;
   /// Throws InputError("distillation.<field>" or "mlp_training.<field>", ...).
   void validate() const;
 };
@@ -137,14 +144,21 @@ NnDistillationResult distill_stress_network(
 
 /// Train the energy network correction (material::NnKind::Energy) on `samples` (stretches and
 /// targets N_teacher(σ); rates are ignored, as N does not depend on them): split the states as
-/// distill_stress_network; fit the polynomial c by linear least squares to the training split's
-/// N (so it carries the teacher's linear and quadratic tails); standardise p = energy_input(σ)
+/// distill_stress_network; take options.energy_polynomial as the polynomial c or fit it (terms up
+/// to energy_polynomial_degree) by linear least squares to the training split's N; standardise x = energy_input(σ)
 /// with the training states' mean and standard deviation and scale the residual by its RMS over
-/// the RMS of the chain map D = ∂p̃/∂σ; train the MLP on the residual through its gradient
+/// the RMS of the chain map D = ∂x̃/∂σ; train the MLP on the residual through its gradient
 /// (train_gradient_mlp; options.training.batch_norm must be off). RMS errors as
 /// distill_stress_network. Deterministic for a given seed. Throws InputError as it.
 NnDistillationResult distill_energy_network(
     const StressSamples& samples, const NnDistillationOptions& options);
+
+/// The energy polynomial c (NnKind::Energy's m(p) = (p₁, p₁², p₂, p₁³, p₁p₂, p₃)) of an RBF's
+/// linear and quadratic tails: ½(a − b) p₂ + ½ b p₁² + c p₁ and α p₁³ + β p₁p₂ + γ p₃ (as
+/// RbfCorrection::elastic_energy). nullopt for stress kernels or a neo-Hookean tail (not a
+/// polynomial).
+std::optional<Eigen::Matrix<double, 6, 1>> rbf_energy_polynomial(
+    const material::RbfCorrection& rbf);
 
 /// What distil_rbf does besides training.
 struct RbfDistillationOptions {
@@ -159,6 +173,11 @@ struct RbfDistillationOptions {
   /// on them, so varied rates teach the network not to either (docs/learning.md, "Samples").
   double rate_sigma = 3;
   std::uint64_t seed = 1; ///< jitter and rates
+  /// Energy network: the teacher's tails as its polynomial (rbf_energy_polynomial), unless the
+  /// energy options give one; false: the least-squares fit of `energy`. The fit extrapolates
+  /// badly: it gives the kernels' curvature inside the data to the polynomial, which grows
+  /// outside it (docs/learning.md, "Activation and batch normalisation").
+  bool teacher_polynomial = true;
   NnDistillationOptions stress; ///< training of a stress network
   NnDistillationOptions energy = energy_distillation_options(); ///< of an energy network
   /// Throws InputError("distillation.<field>", ...).
@@ -168,7 +187,9 @@ struct RbfDistillationOptions {
 /// The one call for distilling a learned RBF: samples at the training stretches `stretches`
 /// (n × 3, any order per row; e.g. the learning loop's trajectory stretches) and their jittered
 /// copies, targets N_teacher(σ), a network of options.kind (default: by the teacher's
-/// energy_kernels) trained on them (distill_nn_correction), and the teacher's damping Δα₁ attached
+/// energy_kernels) trained on them (distill_nn_correction; an energy network takes the teacher's
+/// tails as its polynomial, rbf_energy_polynomial, so that the MLP fits the kernels alone and
+/// the network extrapolates like the teacher), and the teacher's damping Δα₁ attached
 /// (with_teacher_damping). The result's correction is ready to simulate with; its RMS errors
 /// (relative_validation_rms()) are the distillation error against the teacher.
 /// Throws InputError("distillation.<field>", ...) for bad options or stretches (fewer than 2

@@ -209,10 +209,41 @@ NnInput nn_input(const Vec3& s, const Vec3& f, int k) {
   return x;
 }
 
-Vec3 energy_input(const Vec3& stretches) {
+Vec3 power_sums(const Vec3& stretches) {
   const Vec3 e = stretches - Vec3::Ones();
   const Vec3 e2 = e.cwiseProduct(e);
   return { e.sum(), e2.sum(), e2.dot(e) };
+}
+
+namespace {
+
+/// x = energy_input of p, ∂x/∂p and, per input c, the nonzero second derivatives: ∂²q/∂p₂²,
+/// ∂²x₃/∂p₂² and ∂²x₃/∂p₂∂p₃ (x₁ = p₁ is linear, x₃ is linear in p₃).
+struct EnergyInput {
+  Vec3 x;
+  Mat3 d_p;
+  double q_22, x3_22, x3_23;
+};
+
+EnergyInput energy_input_of(const Vec3& p) {
+  constexpr double eps2 = energy_input_epsilon * energy_input_epsilon;
+  const double q2 = p[1] + eps2, q = std::sqrt(q2), inv_q2 = 1 / q2;
+  EnergyInput in;
+  in.x = Vec3(p[0], q, p[2] * inv_q2);
+  in.d_p << 1, 0, 0, 0, 0.5 / q, 0, 0, -p[2] * inv_q2 * inv_q2, inv_q2;
+  in.q_22 = -0.25 / (q * q2);
+  in.x3_22 = 2 * p[2] * inv_q2 * inv_q2 * inv_q2;
+  in.x3_23 = -inv_q2 * inv_q2;
+  return in;
+}
+
+} // namespace
+
+Vec3 energy_input(const Vec3& stretches, Mat3* d_p) {
+  const EnergyInput in = energy_input_of(power_sums(stretches));
+  if (d_p)
+    *d_p = in.d_p;
+  return in.x;
 }
 
 NnCorrection::NnCorrection(Parameters p)
@@ -424,24 +455,36 @@ Vec3 NnCorrection::stress_correction(
 }
 
 Vec3 NnCorrection::energy_correction(const Vec3& s, Mat3* hessian) const {
-  // p = energy_input(σ). Forward: z_k = W_k a_{k−1} + b_k, a_k = f(z_k), and the pre-activation
+  // p = energy_input(σ) here. Forward: z_k = W_k a_{k−1} + b_k, a_k = f(z_k), and the pre-activation
   // gradients J_k = ∂z_k/∂p (J_1 = W_1, J_k = W_k diag(f'(z_{k−1})) J_{k−1}). Reverse:
   // δ_k = ∂g/∂a_k, t_k = δ_k ⊙ f'(z_k) = ∂g/∂z_k, δ_{k−1} = W_kᵀ t_k; ∇_p g = W_1ᵀ t_1 and
   // ∇²_p g = Σ_k Σ_r δ_k,r f''(z_k,r) J_k,r J_k,rᵀ. The value g itself is not needed.
   const Vec3 e = s - Vec3::Ones();
-  const Vec3 p(e.sum(), e.squaredNorm(), e.cwiseProduct(e).dot(e));
-  Mat3 h_p;
-  Vec3 grad_p;
+  const Vec3 p = power_sums(s);
+  const EnergyInput in = energy_input_of(p);
+  Mat3 h_x;
+  Mat3* want_h = hessian ? &h_x : nullptr;
+  Vec3 g_x;
   if (m_fixed_width == 6)
-    grad_p = energy_two_layers<6>(m_flat.data(), m_offset, m_p.activation, p, hessian ? &h_p : nullptr);
+    g_x = energy_two_layers<6>(m_flat.data(), m_offset, m_p.activation, in.x, want_h);
   else if (m_fixed_width == 8)
-    grad_p = energy_two_layers<8>(m_flat.data(), m_offset, m_p.activation, p, hessian ? &h_p : nullptr);
+    g_x = energy_two_layers<8>(m_flat.data(), m_offset, m_p.activation, in.x, want_h);
   else
-    grad_p = energy_network_gradient(p, hessian ? &h_p : nullptr);
+    g_x = energy_network_gradient(in.x, want_h);
+  // From x to p: ∇_p = (∂x/∂p)ᵀ ∇_x, ∇²_p = (∂x/∂p)ᵀ ∇²_x (∂x/∂p) + Σ_c ∂g/∂x_c ∇²_p x_c.
+  const Vec3 grad_p = in.d_p.transpose() * g_x;
+  Mat3 h_p;
+  if (hessian) {
+    h_p = in.d_p.transpose() * h_x.selfadjointView<Eigen::Upper>() * in.d_p;
+    h_p(1, 1) += g_x[1] * in.q_22 + g_x[2] * in.x3_22;
+    h_p(1, 2) += g_x[2] * in.x3_23;
+    h_p(2, 1) = h_p(1, 2);
+  }
   return energy_chain(e, p, grad_p, hessian ? &h_p : nullptr, hessian);
 }
 
 Vec3 NnCorrection::energy_network_gradient(const Vec3& p, Mat3* hessian_p) const {
+  // (p is the network input x = energy_input(σ) here.)
   std::array<double, k_max> a, z, delta, t;
   std::array<double, k_max * k_max_hidden * 3> J; // layer k unit r at J[(k·k_max + r)·3]
   std::array<double, k_max * k_max_hidden> slope, curvature;
@@ -559,10 +602,10 @@ Vec3 NnCorrection::energy_chain(
 double NnCorrection::elastic_energy(const Vec3& stretches) const {
   if (m_p.kind != NnKind::Energy)
     fail("kind", "a stress network has no energy");
-  const Vec3 p = energy_input(stretches);
+  const Vec3 p = power_sums(stretches), x = energy_input(stretches);
   std::array<double, k_max> a;
   int width = 3;
-  const double* in = p.data();
+  const double* in = x.data();
   std::array<double, k_max> next;
   for (int k = 0; k + 1 < m_layers; ++k) {
     const double* W = m_flat.data() + m_offset[std::size_t(k)];

@@ -29,11 +29,22 @@ namespace elastolearn::material {
 using NnInput = Eigen::Matrix<double, 6, 1>;
 NnInput nn_input(const Vec3& stretches, const Vec3& stretch_rates, int k);
 
-/// The 3 inputs of the energy network: the power sums of e = σ − 1,
-///   p = (Σ e_k, Σ e_k², Σ e_k³)                                                        [-]
-/// which generate every symmetric polynomial of the stretches (Newton's identities), so a smooth
-/// function of p is a smooth isotropic energy, and the same for every ordering of σ.
-Vec3 energy_input(const Vec3& stretches);
+/// The power sums of e = σ − 1: p = (Σ e_k, Σ e_k², Σ e_k³) [-]. They generate every symmetric
+/// polynomial of the stretches (Newton's identities), so a smooth function of p is a smooth
+/// isotropic energy, the same for every ordering of σ.
+Vec3 power_sums(const Vec3& stretches);
+
+/// ε of energy_input [-]: the strain below which its second and third inputs are quadratic and
+/// cubic in e (as p₂, p₃), above which they grow linearly.
+constexpr double energy_input_epsilon = 0.01;
+
+/// The 3 inputs of the energy network, smooth functions of p = power_sums(σ) that all grow
+/// linearly with the strain:
+///   x = (p₁, q, p₃/q²),   q = √(p₂ + ε²),  ε = energy_input_epsilon                 [-]
+/// p₂ and p₃ themselves grow like ‖e‖² and ‖e‖³, so at twice the training's strain they lie
+/// 4× and 8× as far out as p₁, and a network of them extrapolated far worse (docs/learning.md,
+/// "Energy network"). `d_p`, if not null, receives ∂x/∂p (rows = x).
+Vec3 energy_input(const Vec3& stretches, Mat3* d_p = nullptr);
 
 /// What the network represents.
 enum class NnKind {
@@ -46,7 +57,8 @@ enum class NnKind {
   /// depend on the arbitrary U, V at repeated stretches. ∂N/∂σ is not symmetric in general.
   Stress,
   /// The learned energy of RbfCorrection::Parameters::energy_kernels, as a network:
-  ///   ΔΨ(σ) = cᵀ m(p) + μ_y + s_y · MLP((p − μ_x) ⊘ s_x),   p = energy_input(σ)     [J/m³]
+  ///   ΔΨ(σ) = cᵀ m(p) + μ_y + s_y · MLP((x − μ_x) ⊘ s_x),   p = power_sums(σ),
+  ///           x = energy_input(σ)                                                  [J/m³]
   ///   m(p)  = (p₁, p₁², p₂, p₁³, p₁p₂, p₃)   (`polynomial` c [Pa]: every isotropic
   ///           quadratic and cubic energy in e, i.e. the RBF's linear and quadratic tails)
   ///   N = ∇_σ ΔΨ,  ∂N/∂σ = ∇²_σ ΔΨ (exact, symmetric).
@@ -148,9 +160,9 @@ class NnCorrection final : public Correction {
   Vec3 stress_correction(const Vec3& s, const Vec3& f, Mat3* d_stretches, Mat3* d_rates) const;
   /// Energy kind: N = ∇ΔΨ and, if `hessian` is non-null, ∇²ΔΨ.
   Vec3 energy_correction(const Vec3& s, Mat3* hessian) const;
-  /// Energy kind: ∇_p g of the MLP part at p and, if `hessian_p` is non-null, ∇²_p g (any
-  /// architecture; the common ones run fixed-size kernels instead).
-  Vec3 energy_network_gradient(const Vec3& p, Mat3* hessian_p) const;
+  /// Energy kind: ∇_x g of the MLP part at x = energy_input(σ) and, if `hessian_x` is
+  /// non-null, ∇²_x g (any architecture; the common ones run fixed-size kernels instead).
+  Vec3 energy_network_gradient(const Vec3& x, Mat3* hessian_x) const;
   /// Energy kind: the polynomial added to the MLP's p-derivatives, then the chain rule to σ
   /// (e = σ − 1): N and, if `hessian` is non-null, ∇²ΔΨ (from `hessian_p`, then not null).
   Vec3 energy_chain(
