@@ -78,8 +78,7 @@ int main() {
     { "softplus", K::Energy, A::Softplus, false }, { "tanh", K::Energy, A::Tanh, false },
     { "ELU", K::Energy, A::Elu, false }, { "sigmoid", K::Energy, A::Sigmoid, false },
     { "squareplus, least-squares cubic polynomial", K::Energy, A::Squareplus, false, 3, true },
-    { "squareplus, least-squares quadratic polynomial", K::Energy, A::Squareplus, false, 2,
-        true },
+    { "squareplus, least-squares quadratic polynomial", K::Energy, A::Squareplus, false, 2, true },
     { "squareplus, no polynomial", K::Energy, A::Squareplus, false, 0 } };
   const material::RbfCorrection stress_teacher = bench::teacher_rbf(false);
   const material::RbfCorrection energy_teacher = bench::teacher_rbf(true);
@@ -99,12 +98,11 @@ int main() {
     training.training.batch_norm = c.batch_norm;
     o.teacher_polynomial = c.polynomial_degree < 0;
     training.energy_polynomial_degree = std::max(c.polynomial_degree, 0);
-    const material::RbfCorrection& teacher
-        = c.kind == K::Stress ? stress_teacher : energy_teacher;
+    const material::RbfCorrection& teacher = c.kind == K::Stress ? stress_teacher : energy_teacher;
     try {
       const learn::NnDistillationResult r = learn::distill_rbf(teacher, stretches, o);
-      std::printf("| %s | %s | %d | %.1f | %.2f %% |", material::to_string(c.kind).c_str(),
-          c.label, r.training.epochs, r.training.seconds, 100 * r.relative_validation_rms());
+      std::printf("| %s | %s | %d | %.1f | %.2f %% |", material::to_string(c.kind).c_str(), c.label,
+          r.training.epochs, r.training.seconds, 100 * r.relative_validation_rms());
       for (const auto& t : tests)
         std::printf(" %.2f %% |", 100 * relative_error(r.correction, teacher, t));
       std::printf("\n");
@@ -119,8 +117,8 @@ int main() {
         std::printf("\n");
       }
     } catch (const std::exception& e) {
-      std::printf("| %s | %s | failed: %s |\n", material::to_string(c.kind).c_str(), c.label,
-          e.what());
+      std::printf(
+          "| %s | %s | failed: %s |\n", material::to_string(c.kind).c_str(), c.label, e.what());
     }
     std::fflush(stdout);
   }

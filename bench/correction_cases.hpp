@@ -48,8 +48,8 @@ inline material::RbfCorrection teacher_rbf(bool energy_kernels, int centres = 40
 
 /// The network distilled from `teacher` on 4000 training stretches (+ as many jittered):
 /// learn::distill_rbf's default kind for the teacher unless `kind` is given.
-inline learn::NnDistillationResult distilled(const material::RbfCorrection& teacher,
-    std::optional<material::NnKind> kind = std::nullopt) {
+inline learn::NnDistillationResult distilled(
+    const material::RbfCorrection& teacher, std::optional<material::NnKind> kind = std::nullopt) {
   learn::RbfDistillationOptions o;
   o.kind = kind;
   return learn::distill_rbf(teacher, training_stretches(4000, 7), o);

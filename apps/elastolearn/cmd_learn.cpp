@@ -61,8 +61,10 @@ std::shared_ptr<const elastolearn::material::Correction> distil_network(const Le
   const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&teacher);
   const bool energy = o.network_kind == "energy"
       || (o.network_kind == "auto" && rbf && rbf->parameters().energy_kernels);
-  const learn::NnDistillationOptions training
+  learn::NnDistillationOptions training
       = energy ? learn::energy_distillation_options() : o.network_training;
+  if (energy && rbf) // the teacher's tails as the energy's polynomial (docs/learning.md)
+    training.energy_polynomial = learn::rbf_energy_polynomial(*rbf);
   const learn::NnDistillationResult r = learn::distill_nn_correction(samples, training);
   std::printf("network (%s): %d + %d states (%d recorded of %ld, %d jittered; %d/%zu motions "
               "completed), %d epochs; "
@@ -70,10 +72,9 @@ std::shared_ptr<const elastolearn::material::Correction> distil_network(const Le
               "%.4g Pa); "
               "sampling %.1f s, training %.1f s\n",
       material::to_string(training.kind).c_str(), r.training_samples, r.validation_samples,
-      sampled.recorded, sampled.states_seen,
-      sampled.jittered, sampled.scenes_completed, o.network_motion_scales.size(), r.training.epochs,
-      100 * r.relative_training_rms(), 100 * r.relative_validation_rms(), r.target_rms,
-      seconds_sampling, r.training.seconds);
+      sampled.recorded, sampled.states_seen, sampled.jittered, sampled.scenes_completed,
+      o.network_motion_scales.size(), r.training.epochs, 100 * r.relative_training_rms(),
+      100 * r.relative_validation_rms(), r.target_rms, seconds_sampling, r.training.seconds);
   provenance = { { "teacher", io::correction_to_json(teacher) },
     { "network",
         { { "kind", material::to_string(training.kind) },

@@ -275,8 +275,10 @@ TEST(MaterialFile, EnergyNnRoundTripIsBitExact) {
     EXPECT_EQ(q.layers[k].bias, parameters.layers[k].bias) << "layer " << k;
   }
   expect_same_function(*original, *back);
-  EXPECT_EQ(original->elastic_energy(Vec3(1.1, 0.9, 1.05)), back->elastic_energy(Vec3(1.1, 0.9, 1.05)));
-  EXPECT_EQ(describe_correction(*back), "nn (energy, squareplus), 3-8-8-1, with damping correction");
+  EXPECT_EQ(
+      original->elastic_energy(Vec3(1.1, 0.9, 1.05)), back->elastic_energy(Vec3(1.1, 0.9, 1.05)));
+  EXPECT_EQ(
+      describe_correction(*back), "nn (energy, squareplus), 3-8-8-1, with damping correction");
 }
 
 TEST(MaterialFile, NetworkKindActivationAndPolynomialAreChecked) {

@@ -456,7 +456,8 @@ TEST(NnDistillation, TeacherTailsAreTheEnergyNetworksPolynomialExactly) {
     const Vec3 expected = tails.correction(s, Vec3::Zero());
     EXPECT_LE((net.correction(s, Vec3::Zero()) - expected).norm(), 1e-9 * expected.norm());
     EXPECT_NEAR(net.elastic_energy(s) - net.elastic_energy(rest),
-        tails.elastic_energy(s) - tails.elastic_energy(rest), 1e-9 * std::abs(tails.elastic_energy(s)));
+        tails.elastic_energy(s) - tails.elastic_energy(rest),
+        1e-9 * std::abs(tails.elastic_energy(s)));
   }
   p.neo_hookean = Eigen::Vector2d(1e3, 0);
   EXPECT_FALSE(rbf_energy_polynomial(material::RbfCorrection(p)).has_value());

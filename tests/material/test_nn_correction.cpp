@@ -429,8 +429,8 @@ TEST(NnEnergyCorrection, IsotropicWithExactlyEqualComponentsAtEqualStretches) {
     const NnCorrection n(energy_parameters(hidden));
     // Equal stretches, bit-identical components of N and of the tangent's rows, so P = U diag(P̂ +
     // N) Vᵀ does not depend on the SVD's frame there.
-    for (const Vec3& s : { Vec3(1.1, 1.1, 0.9), Vec3(0.95, 1.2, 1.2), Vec3(1.05, 0.8, 1.05),
-             Vec3(1.0, 1.0, 1.0) }) {
+    for (const Vec3& s :
+        { Vec3(1.1, 1.1, 0.9), Vec3(0.95, 1.2, 1.2), Vec3(1.05, 0.8, 1.05), Vec3(1.0, 1.0, 1.0) }) {
       Mat3 ds, dr;
       const Vec3 N = n.correction_with_gradient(s, Vec3::Zero(), ds, dr);
       for (int i = 0; i < 3; ++i)
@@ -448,7 +448,8 @@ TEST(NnEnergyCorrection, IsotropicWithExactlyEqualComponentsAtEqualStretches) {
     Mat3 ds_p, dr_p;
     const Vec3 N_p = n.correction_with_gradient(P * s, Vec3::Zero(), ds_p, dr_p);
     EXPECT_LE((N_p - P * N).cwiseAbs().maxCoeff(), 1e-12 * N.cwiseAbs().maxCoeff());
-    EXPECT_LE((ds_p - P * ds * P.transpose()).cwiseAbs().maxCoeff(), 1e-12 * ds.cwiseAbs().maxCoeff());
+    EXPECT_LE(
+        (ds_p - P * ds * P.transpose()).cwiseAbs().maxCoeff(), 1e-12 * ds.cwiseAbs().maxCoeff());
   }
 }
 
@@ -465,7 +466,8 @@ TEST(NnEnergyCorrection, PolynomialAloneIsItsAnalyticEnergy) {
   for (int i = 0; i < 3; ++i)
     expected[i] = c[0] + 2 * c[1] * p1 + 2 * c[2] * e[i] + 3 * c[3] * p1 * p1
         + c[4] * (p2 + 2 * p1 * e[i]) + 3 * c[5] * e[i] * e[i];
-  EXPECT_LE((n.correction(s, Vec3::Zero()) - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.norm());
+  EXPECT_LE(
+      (n.correction(s, Vec3::Zero()) - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.norm());
 }
 
 TEST(NnEnergyCorrection, RejectsBadParameters) {
@@ -505,8 +507,8 @@ TEST(NnCorrection, StressNetworkActivationsHaveExactGradients) {
   // The fixed-size (6-6, 8-8) and general paths with each activation, against FD.
   for (Activation a : { Activation::Elu, Activation::Sigmoid, Activation::Softplus,
            Activation::Tanh, Activation::Squareplus }) {
-    for (const auto& hidden : { std::vector<int> { 6, 6 }, std::vector<int> { 8, 8 },
-             std::vector<int> { 7, 5 } }) {
+    for (const auto& hidden :
+        { std::vector<int> { 6, 6 }, std::vector<int> { 8, 8 }, std::vector<int> { 7, 5 } }) {
       auto p = test_parameters(hidden);
       p.activation = a;
       const NnCorrection n(p);

@@ -170,8 +170,8 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
 }
 
 std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
-  o.reject_unknown_keys({ "type", "kind", "activation", "input_mean", "input_scale",
-      "output_mean", "output_scale", "polynomial", "layers", "damping" });
+  o.reject_unknown_keys({ "type", "kind", "activation", "input_mean", "input_scale", "output_mean",
+      "output_scale", "polynomial", "layers", "damping" });
   material::NnCorrection::Parameters p;
   // Absent: the stress network with ELU (files written before the energy network).
   p.kind = o.has("kind") && o.choice("kind", { "stress", "energy" }) == "energy"
@@ -241,7 +241,8 @@ std::string describe_correction(const material::Correction& correction) {
   }
   if (const auto* nn = dynamic_cast<const material::NnCorrection*>(&correction)) {
     std::string s = "nn (" + material::to_string(nn->parameters().kind) + ", "
-        + material::to_string(nn->parameters().activation) + "), " + std::to_string(nn->num_inputs());
+        + material::to_string(nn->parameters().activation) + "), "
+        + std::to_string(nn->num_inputs());
     for (const auto& layer : nn->parameters().layers) {
       s += '-';
       s += std::to_string(layer.weight.rows());

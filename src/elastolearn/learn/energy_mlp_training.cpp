@@ -50,7 +50,8 @@ void forward(const BatchNormMlp& net, ConstRef<MatX> x, std::vector<Forward>& f)
     w.d1.resize(w.z.rows(), n);
     w.d2.resize(w.z.rows(), n);
     for (Eigen::Index i = 0; i < w.z.size(); ++i) {
-      const material::ActivationValues v = material::activation_values(net.activation, w.z.data()[i]);
+      const material::ActivationValues v
+          = material::activation_values(net.activation, w.z.data()[i]);
       w.a.data()[i] = v.f;
       w.d1.data()[i] = v.d1;
       w.d2.data()[i] = v.d2;

@@ -81,8 +81,8 @@ double adam_step(const MlpTrainingOptions& o, double learning_rate, long steps) 
       / (1 - std::pow(o.beta1, double(steps)));
 }
 
-bool EarlyStopping::update(double loss, const MlpTrainingOptions& o, double& learning_rate,
-    bool& stop) {
+bool EarlyStopping::update(
+    double loss, const MlpTrainingOptions& o, double& learning_rate, bool& stop) {
   stop = false;
   if (loss < (1 - o.min_improvement) * best) {
     best = loss;
@@ -276,7 +276,8 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
           w.z = (w.z_hat.array().colwise() * l.gamma.array()).colwise() + l.beta.array();
         }
         for (Eigen::Index i = 0; i < w.z.size(); ++i) {
-          const material::ActivationValues f = material::activation_values(o.activation, w.z.data()[i]);
+          const material::ActivationValues f
+              = material::activation_values(o.activation, w.z.data()[i]);
           w.activation.data()[i] = f.f;
           w.slope.data()[i] = f.d1;
         }

@@ -281,8 +281,7 @@ NnDistillationResult measured(material::NnCorrection correction, const MlpTraini
   result.validation_samples = static_cast<int>(valid.size());
   result.training_rms = rms_error(result.correction, samples, train);
   result.validation_rms = rms_error(result.correction, samples, valid);
-  result.target_rms
-      = std::sqrt(samples.targets.squaredNorm() / double(samples.targets.rows()));
+  result.target_rms = std::sqrt(samples.targets.squaredNorm() / double(samples.targets.rows()));
   return result;
 }
 
@@ -378,9 +377,10 @@ NnDistillationResult distill_energy_network(
   if (o.energy_polynomial) {
     polynomial = *o.energy_polynomial;
   } else if (terms > 0) {
-    const VecX scaled = (basis.leftCols(terms) * column_norm.head(terms).cwiseInverse().asDiagonal())
-                            .colPivHouseholderQr()
-                            .solve(rhs);
+    const VecX scaled
+        = (basis.leftCols(terms) * column_norm.head(terms).cwiseInverse().asDiagonal())
+              .colPivHouseholderQr()
+              .solve(rhs);
     polynomial.head(terms) = scaled.cwiseQuotient(column_norm.head(terms));
   }
 
@@ -417,7 +417,8 @@ NnDistillationResult distill_energy_network(
   gradient_samples(train, train_set);
   gradient_samples(valid, valid_set);
   // Output scale: the residual's RMS over the map's, so that the MLP's input gradient is O(1).
-  const double residual_rms = std::sqrt(train_set.targets.squaredNorm() / double(train_set.targets.size()));
+  const double residual_rms
+      = std::sqrt(train_set.targets.squaredNorm() / double(train_set.targets.size()));
   const double map_rms = std::sqrt(train_set.maps.squaredNorm() / double(train_set.maps.size()));
   const double output_scale = residual_rms > 0 ? residual_rms / map_rms : 1.0;
   train_set.targets /= output_scale;
@@ -480,8 +481,8 @@ NnDistillationResult distill_rbf(const material::RbfCorrection& teacher, ConstRe
   std::mt19937_64 rng(o.seed);
   for (Eigen::Index j = 0; j < total; ++j) {
     for (int i = 0; i < 3; ++i) {
-      samples.stretches(j, i) = stretches(j % n, i)
-          + (j < n ? 0.0 : o.stretch_jitter * standard_normal(rng));
+      samples.stretches(j, i)
+          = stretches(j % n, i) + (j < n ? 0.0 : o.stretch_jitter * standard_normal(rng));
       if (kind == material::NnKind::Stress)
         samples.stretch_rates(j, i) = o.rate_sigma * standard_normal(rng);
     }

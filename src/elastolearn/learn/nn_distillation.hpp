@@ -130,8 +130,8 @@ struct NnDistillationResult {
 NnDistillationResult distill_nn_correction(
     const StressSamples& samples, const NnDistillationOptions& options);
 
-/// Train the stress network correction on `samples` (targets = the teacher's outputs): split the states
-/// into a random validation set and a training set (the three direction rows of a state stay
+/// Train the stress network correction on `samples` (targets = the teacher's outputs): split the
+/// states into a random validation set and a training set (the three direction rows of a state stay
 /// together), turn each state into three rows (material::nn_input(σ, ḟ, k), N_teacher,k),
 /// standardise inputs and the scalar output with the training rows' mean and standard deviation
 /// (a constant input gets scale 1), train (train_mlp), fold batch norm, and measure the RMS errors
@@ -145,10 +145,10 @@ NnDistillationResult distill_stress_network(
 /// Train the energy network correction (material::NnKind::Energy) on `samples` (stretches and
 /// targets N_teacher(σ); rates are ignored, as N does not depend on them): split the states as
 /// distill_stress_network; take options.energy_polynomial as the polynomial c or fit it (terms up
-/// to energy_polynomial_degree) by linear least squares to the training split's N; standardise x = energy_input(σ)
-/// with the training states' mean and standard deviation and scale the residual by its RMS over
-/// the RMS of the chain map D = ∂x̃/∂σ; train the MLP on the residual through its gradient
-/// (train_gradient_mlp; options.training.batch_norm must be off). RMS errors as
+/// to energy_polynomial_degree) by linear least squares to the training split's N; standardise x =
+/// energy_input(σ) with the training states' mean and standard deviation and scale the residual by
+/// its RMS over the RMS of the chain map D = ∂x̃/∂σ; train the MLP on the residual through its
+/// gradient (train_gradient_mlp; options.training.batch_norm must be off). RMS errors as
 /// distill_stress_network. Deterministic for a given seed. Throws InputError as it.
 NnDistillationResult distill_energy_network(
     const StressSamples& samples, const NnDistillationOptions& options);

@@ -138,8 +138,9 @@ void activate_block(Activation a, const Z& z, F& f, F& d1, F* d2) {
 /// architectures; NnCorrection::energy_correction's loops serve the others): ∇_p g and, if
 /// `hessian_p` is non-null, ∇²_p g, with the identity of energy_correction.
 template <int W>
-Vec3 energy_two_layers(const double* flat, const std::array<int, NnCorrection::max_hidden_layers + 2>& offset,
-    Activation act, const Vec3& p, Mat3* hessian_p) {
+Vec3 energy_two_layers(const double* flat,
+    const std::array<int, NnCorrection::max_hidden_layers + 2>& offset, Activation act,
+    const Vec3& p, Mat3* hessian_p) {
   using MatW3 = Eigen::Matrix<double, W, 3, Eigen::RowMajor>;
   using MatWW = Eigen::Matrix<double, W, W, Eigen::RowMajor>;
   using VecW = Eigen::Matrix<double, W, 1>;
@@ -362,8 +363,8 @@ Lanes NnCorrection::stress_lanes(const Lanes* x, Lanes* d_x) const {
       z[std::size_t(r)] = acc;
     }
     for (int r = 0; r < out; ++r)
-      activate(m_p.activation, z[std::size_t(r)], a[std::size_t(r)],
-          slope[std::size_t(k * k_max + r)]);
+      activate(
+          m_p.activation, z[std::size_t(r)], a[std::size_t(r)], slope[std::size_t(k * k_max + r)]);
     width = out;
     in = a.data();
   }
@@ -425,9 +426,8 @@ Vec3 NnCorrection::stress_correction(
     for (int i = 0; i < 6; ++i)
       xm.row(i) = x[std::size_t(i)].transpose();
     Eigen::Matrix<double, 6, 4>* d = d_stretches ? &gm : nullptr;
-    y = m_fixed_width == 6
-        ? stress_two_layers<6>(m_flat.data(), m_offset, m_p.activation, xm, d)
-        : stress_two_layers<8>(m_flat.data(), m_offset, m_p.activation, xm, d);
+    y = m_fixed_width == 6 ? stress_two_layers<6>(m_flat.data(), m_offset, m_p.activation, xm, d)
+                           : stress_two_layers<8>(m_flat.data(), m_offset, m_p.activation, xm, d);
     if (d_stretches)
       for (int i = 0; i < 6; ++i)
         g[std::size_t(i)] = gm.row(i).transpose();
@@ -455,9 +455,9 @@ Vec3 NnCorrection::stress_correction(
 }
 
 Vec3 NnCorrection::energy_correction(const Vec3& s, Mat3* hessian) const {
-  // p = energy_input(σ) here. Forward: z_k = W_k a_{k−1} + b_k, a_k = f(z_k), and the pre-activation
-  // gradients J_k = ∂z_k/∂p (J_1 = W_1, J_k = W_k diag(f'(z_{k−1})) J_{k−1}). Reverse:
-  // δ_k = ∂g/∂a_k, t_k = δ_k ⊙ f'(z_k) = ∂g/∂z_k, δ_{k−1} = W_kᵀ t_k; ∇_p g = W_1ᵀ t_1 and
+  // p = energy_input(σ) here. Forward: z_k = W_k a_{k−1} + b_k, a_k = f(z_k), and the
+  // pre-activation gradients J_k = ∂z_k/∂p (J_1 = W_1, J_k = W_k diag(f'(z_{k−1})) J_{k−1}).
+  // Reverse: δ_k = ∂g/∂a_k, t_k = δ_k ⊙ f'(z_k) = ∂g/∂z_k, δ_{k−1} = W_kᵀ t_k; ∇_p g = W_1ᵀ t_1 and
   // ∇²_p g = Σ_k Σ_r δ_k,r f''(z_k,r) J_k,r J_k,rᵀ. The value g itself is not needed.
   const Vec3 e = s - Vec3::Ones();
   const Vec3 p = power_sums(s);
