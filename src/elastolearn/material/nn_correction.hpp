@@ -64,7 +64,8 @@ enum class NnKind {
   ///   N = ∇_σ ΔΨ,  ∂N/∂σ = ∇²_σ ΔΨ (exact, symmetric).
   /// N does not depend on the rates; the network is fitted to the teacher's N (its gradient), so
   /// the MLP carries only what the polynomial leaves. Equal stretches give exactly equal N
-  /// components (N_k = Σ_j ∂ΔΨ/∂p_j · ∂p_j/∂σ_k depends on k only through e_k).
+  /// components (N_k = Σ_j ∂ΔΨ/∂p_j · ∂p_j/∂σ_k depends on k only through e_k), and the tangent
+  /// is symmetric bit for bit.
   Energy,
 };
 /// "stress", "energy".
@@ -84,9 +85,9 @@ std::string to_string(NnKind kind);
 /// exact MLP identity ∇²g = Σ_layers Σ_units (∂g/∂a_r) f''(z_r) ∇z_r ∇z_rᵀ (affine layers have no
 /// curvature), with ∇z_r by forward mode.
 /// Smoothness: N is C¹ in (σ, ḟ) for a stress network with ELU (C⁰ with ReLU); for an energy
-/// network N is C^{k−1} with f ∈ C^k, so softplus or tanh (C∞) give a continuous tangent, ELU a
-/// tangent that jumps where a unit crosses z = 0 and ReLU a tangent without the network's
-/// curvature (docs/learning.md).
+/// network N is C^{k−1} with f ∈ C^k, so squareplus (learn's default), softplus or tanh (C∞)
+/// give a continuous tangent, ELU a tangent that jumps where a unit crosses z = 0 and ReLU a
+/// tangent without the network's curvature (docs/learning.md, "Energy network").
 class NnCorrection final : public Correction {
   public:
   /// Largest hidden-layer width evaluation supports without allocating.
