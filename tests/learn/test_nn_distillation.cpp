@@ -409,7 +409,8 @@ TEST(NnDistillation, DistilRbfPicksTheKindFromTheTeacherAndCarriesItsDamping) {
   material::RbfCorrection::Parameters p = smooth_teacher().parameters();
   p.energy_kernels = true;
   const material::RbfCorrection energy_teacher(p);
-  const NnDistillationResult r = distill_rbf(energy_teacher, stretches);
+  const RbfDistillationOptions defaults; // energy network for an energy teacher
+  const NnDistillationResult r = distill_rbf(energy_teacher, stretches, defaults);
   std::cout << "distil_rbf (energy): relative RMS validation " << r.relative_validation_rms()
             << ", " << r.training.epochs << " epochs\n";
   EXPECT_EQ(r.correction.parameters().kind, material::NnKind::Energy);
@@ -427,7 +428,7 @@ TEST(NnDistillation, DistilRbfPicksTheKindFromTheTeacherAndCarriesItsDamping) {
   EXPECT_LT(rs.relative_validation_rms(), 0.05);
   EXPECT_NE(rs.correction.parameters().damping, nullptr);
 
-  EXPECT_THROW(distill_rbf(energy_teacher, MatX::Ones(5, 2)), InputError);
+  EXPECT_THROW(distill_rbf(energy_teacher, MatX::Ones(5, 2), defaults), InputError);
   NnDistillationOptions bad = energy_distillation_options();
   bad.training.batch_norm = true;
   EXPECT_THROW(distill_nn_correction(random_samples(energy_teacher, 100, 1), bad), InputError);
