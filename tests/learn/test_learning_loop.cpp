@@ -117,7 +117,7 @@ TEST(LearningLoop, EnergyKernelsDistilIntoAnEnergyNetwork) {
   // The recipe's correction (energy kernels) distilled into the energy network (distill_rbf on
   // the training motion's stretches at three amplitudes): the network must simulate the unseen
   // swing stably, well below the nominal error, and close to its teacher: stored figures
-  // (Release build) nominal 4.450 %, RBF 0.0548 %, energy network 0.0571 % (distillation error
+  // (Release build) nominal 4.450 %, RBF 0.0548 %, energy network 0.0562 % (distillation error
   // 0.04 % of the teacher's N: the teacher's tails are the network's polynomial exactly). Bounds:
   // the 2× regression margin of the test above, and within 1.5× of the teacher.
   const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
@@ -150,7 +150,7 @@ TEST(LearningLoop, EnergyKernelsDistilIntoAnEnergyNetwork) {
       r.training.epochs);
   EXPECT_LT(rbf_error, nominal_error / 5);
   EXPECT_LT(network_error, nominal_error / 5);
-  EXPECT_LT(network_error, 2 * 0.0571);
+  EXPECT_LT(network_error, 2 * 0.0562);
   EXPECT_LT(network_error, 1.5 * rbf_error);
 }
 

@@ -376,7 +376,7 @@ const std::vector<Vec3> k_energy_states { Vec3(1.12, 0.97, 0.9), Vec3(0.85, 1.2,
 
 TEST(NnEnergyCorrection, StressIsTheGradientOfTheEnergy) {
   // N = ∇ΔΨ against 4th-order central differences of elastic_energy (computed by an independent
-  // forward pass). The inputs vary on the scale ε = energy_input_epsilon = 0.01 near rest, so
+  // forward pass). The inputs vary on the scale ε = energy_input_epsilon (0.05) near rest, so
   // the O(h⁴) truncation is ~(h/ε)⁴ × the input scales' 1/s: h = 1e-6 makes it negligible;
   // round-off ~1e-16·1e4/1e-6 ≈ 1e-6 Pa against N ~ 10³–10⁴ Pa. 1e-6 relative.
   for (Activation a : { Activation::Squareplus, Activation::Softplus, Activation::Tanh,
@@ -400,7 +400,7 @@ TEST(NnEnergyCorrection, StressIsTheGradientOfTheEnergy) {
 TEST(NnEnergyCorrection, TangentIsSymmetricAndMatchesFiniteDifferences) {
   // ∂N/∂σ = ∇²ΔΨ: symmetric bit for bit, and equal to central differences of N. Smooth
   // activations only (ELU's f'' jumps at 0; a crossing inside the stencil would break the FD).
-  // The inputs' scale ε = 0.01 near rest and the third input's scale 10⁻³ make the higher
+  // The inputs' scale ε near rest and the third input's scale 10⁻³ make the higher
   // derivatives large: h = 2e-6 keeps the O(h⁴) truncation below 1e-8 relative; round-off
   // ~1e-16·1e5/2e-6 ≈ 1e-5 Pa against tangents ~1e6 Pa.
   for (Activation a : { Activation::Squareplus, Activation::Softplus, Activation::Tanh }) {

@@ -36,7 +36,7 @@ Vec3 power_sums(const Vec3& stretches);
 
 /// ε of energy_input [-]: the strain below which its second and third inputs are quadratic and
 /// cubic in e (as p₂, p₃), above which they grow linearly.
-constexpr double energy_input_epsilon = 0.01;
+constexpr double energy_input_epsilon = 0.05;
 
 /// The 3 inputs of the energy network, smooth functions of p = power_sums(σ) that all grow
 /// linearly with the strain:
