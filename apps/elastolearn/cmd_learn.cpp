@@ -19,6 +19,7 @@
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/material/nn_correction.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -41,6 +42,8 @@ struct LearnOptions {
   std::vector<double> network_motion_scales { 0.5, 1.0, 2.0 };
   elastolearn::learn::DistillationSampleOptions network_samples;
   elastolearn::learn::NnDistillationOptions network_training;
+  /// "auto": the energy network for an RBF with energy kernels, else the stress network.
+  std::string network_kind = "auto";
 };
 
 /// Distil `teacher` into the network correction on states of the training scene at several
@@ -56,19 +59,27 @@ std::shared_ptr<const elastolearn::material::Correction> distil_network(const Le
   const double seconds_sampling = seconds_since(start);
   for (const auto& m : sampled.messages)
     std::printf("network samples: %s\n", m.c_str());
-  const learn::NnDistillationResult r = learn::distill_nn_correction(samples, o.network_training);
-  std::printf("network: %d + %d states (%d recorded of %ld, %d jittered; %d/%zu motions "
+  const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&teacher);
+  const bool energy = o.network_kind == "energy"
+      || (o.network_kind == "auto" && rbf && rbf->parameters().energy_kernels);
+  learn::NnDistillationOptions training
+      = energy ? learn::energy_distillation_options() : o.network_training;
+  if (energy && rbf) // the teacher's tails as the energy's polynomial (docs/learning.md)
+    training.energy_polynomial = learn::rbf_energy_polynomial(*rbf);
+  const learn::NnDistillationResult r = learn::distill_nn_correction(samples, training);
+  std::printf("network (%s): %d + %d states (%d recorded of %ld, %d jittered; %d/%zu motions "
               "completed), %d epochs; "
               "RMS relative to the RBF teacher: training %.2f %%, validation %.2f %% (teacher RMS "
               "%.4g Pa); "
               "sampling %.1f s, training %.1f s\n",
-      r.training_samples, r.validation_samples, sampled.recorded, sampled.states_seen,
-      sampled.jittered, sampled.scenes_completed, o.network_motion_scales.size(), r.training.epochs,
-      100 * r.relative_training_rms(), 100 * r.relative_validation_rms(), r.target_rms,
-      seconds_sampling, r.training.seconds);
+      material::to_string(training.kind).c_str(), r.training_samples, r.validation_samples,
+      sampled.recorded, sampled.states_seen, sampled.jittered, sampled.scenes_completed,
+      o.network_motion_scales.size(), r.training.epochs, 100 * r.relative_training_rms(),
+      100 * r.relative_validation_rms(), r.target_rms, seconds_sampling, r.training.seconds);
   provenance = { { "teacher", io::correction_to_json(teacher) },
     { "network",
-        { { "motion_scales", o.network_motion_scales }, { "recorded_states", sampled.recorded },
+        { { "kind", material::to_string(training.kind) },
+            { "motion_scales", o.network_motion_scales }, { "recorded_states", sampled.recorded },
             { "jittered_states", sampled.jittered }, { "training_states", r.training_samples },
             { "validation_states", r.validation_samples }, { "epochs", r.training.epochs },
             { "training_rms_pa", r.training_rms }, { "validation_rms_pa", r.validation_rms },
@@ -399,6 +410,11 @@ void add_learn_command(CLI::App& root) {
   cmd->add_flag("--network", o->network,
       "distil the learned RBF into the network correction and save that (the RBF goes to "
       "training.teacher)");
+  cmd->add_option("--network-kind", o->network_kind,
+         "the network: energy (ΔΨ(σ), N its gradient), stress (N per direction), or auto (energy "
+         "for an RBF with energy kernels)")
+      ->check(CLI::IsMember({ "auto", "energy", "stress" }))
+      ->capture_default_str();
   cmd->add_option("--network-motion-scales", o->network_motion_scales,
          "motion amplitudes simulated to sample the network's training states")
       ->capture_default_str();

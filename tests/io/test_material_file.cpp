@@ -221,7 +221,96 @@ TEST(MaterialFile, NnRoundTripIsBitExact) {
     EXPECT_EQ(p.layers[k].bias, q.layers[k].bias) << "layer " << k;
   }
   expect_same_function(*original, *back);
-  EXPECT_EQ(describe_correction(*back), "nn, 6-6-6-1, with damping correction");
+  EXPECT_EQ(describe_correction(*back), "nn (stress, elu), 6-6-6-1, with damping correction");
+}
+
+/// An energy network (NnKind::Energy) 3 → 8 → 8 → 1 with squareplus and a polynomial.
+material::NnCorrection::Parameters energy_nn_parameters(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, 0.5);
+  material::NnCorrection::Parameters p;
+  p.kind = material::NnKind::Energy;
+  p.activation = material::Activation::Squareplus;
+  p.input_mean = Vec3(awkward(rng), awkward(rng), awkward(rng));
+  p.input_scale = Vec3(0.1, 0.01, 0.001) / 3;
+  p.output_scale = 2e3 / 7;
+  for (Eigen::Index i = 0; i < 6; ++i)
+    p.polynomial[i] = 1e4 * awkward(rng);
+  const int widths[] = { 3, 8, 8, 1 };
+  for (int k = 0; k + 1 < 4; ++k) {
+    material::NnCorrection::Layer l;
+    l.weight.resize(widths[k + 1], widths[k]);
+    l.bias.resize(widths[k + 1]);
+    for (Eigen::Index i = 0; i < l.weight.size(); ++i)
+      l.weight.data()[i] = g(rng);
+    for (Eigen::Index i = 0; i < l.bias.size(); ++i)
+      l.bias[i] = g(rng);
+    p.layers.push_back(std::move(l));
+  }
+  return p;
+}
+
+TEST(MaterialFile, EnergyNnRoundTripIsBitExact) {
+  ScratchDir dir;
+  MaterialFile f;
+  f.material = k_nominal;
+  material::NnCorrection::Parameters parameters = energy_nn_parameters(4);
+  parameters.damping = std::make_shared<const material::RbfCorrection>(
+      material::damping_part(material::RbfCorrection(rbf_parameters(4, 2))));
+  const auto original = std::make_shared<material::NnCorrection>(parameters);
+  f.correction = original;
+  write_material_file(dir / "energy.json", f);
+  const MaterialFile g = read_material_file(dir / "energy.json");
+  const auto* back = dynamic_cast<const material::NnCorrection*>(g.correction.get());
+  ASSERT_NE(back, nullptr);
+  const auto& q = back->parameters();
+  EXPECT_EQ(q.kind, material::NnKind::Energy);
+  EXPECT_EQ(q.activation, material::Activation::Squareplus);
+  EXPECT_EQ(q.input_mean, parameters.input_mean);
+  EXPECT_EQ(q.input_scale, parameters.input_scale);
+  EXPECT_EQ(q.polynomial, parameters.polynomial);
+  ASSERT_EQ(q.layers.size(), parameters.layers.size());
+  for (std::size_t k = 0; k < q.layers.size(); ++k) {
+    EXPECT_EQ(q.layers[k].weight, parameters.layers[k].weight) << "layer " << k;
+    EXPECT_EQ(q.layers[k].bias, parameters.layers[k].bias) << "layer " << k;
+  }
+  expect_same_function(*original, *back);
+  EXPECT_EQ(
+      original->elastic_energy(Vec3(1.1, 0.9, 1.05)), back->elastic_energy(Vec3(1.1, 0.9, 1.05)));
+  EXPECT_EQ(
+      describe_correction(*back), "nn (energy, squareplus), 3-8-8-1, with damping correction");
+}
+
+TEST(MaterialFile, NetworkKindActivationAndPolynomialAreChecked) {
+  MaterialFile nn;
+  nn.material = k_nominal;
+  nn.correction = std::make_shared<material::NnCorrection>(nn_parameters(1));
+  // A file without kind and activation (written before the energy network) is the ELU stress
+  // network.
+  Json j = material_file_to_json(nn);
+  j["correction"].erase("kind");
+  j["correction"].erase("activation");
+  const MaterialFile old = parse_material_file(j, "old.json");
+  const auto& p = dynamic_cast<const material::NnCorrection&>(*old.correction).parameters();
+  EXPECT_EQ(p.kind, material::NnKind::Stress);
+  EXPECT_EQ(p.activation, material::Activation::Elu);
+  j = material_file_to_json(nn);
+  j["correction"]["activation"] = "gelu";
+  expect_bad(j, { "bad.json: correction.activation", "\"squareplus\"" });
+  j = material_file_to_json(nn);
+  j["correction"]["polynomial"] = Json::array({ 0, 0, 0, 0, 0, 0 });
+  expect_bad(j, { "bad.json: correction.polynomial", "energy" });
+  j = material_file_to_json(nn);
+  j["correction"]["kind"] = "energy"; // 6 input statistics for a 3-input network
+  expect_bad(j, { "bad.json: correction.input_mean", "expected 3" });
+
+  nn.correction = std::make_shared<material::NnCorrection>(energy_nn_parameters(2));
+  j = material_file_to_json(nn);
+  j["correction"].erase("polynomial");
+  expect_bad(j, { "bad.json: correction.polynomial", "missing" });
+  j = material_file_to_json(nn);
+  j["correction"]["layers"][0]["weight"] = j["correction"]["layers"][1]["weight"];
+  expect_bad(j, { "bad.json: correction.layers[0].weight" });
 }
 
 TEST(MaterialFile, NominalOnlyFileGivesTheSceneMaterialModel) {

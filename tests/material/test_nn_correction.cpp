@@ -62,7 +62,7 @@ Vec3 reference_output(const NnCorrection::Parameters& p, const Vec3& s, const Ve
     for (std::size_t l = 0; l < p.layers.size(); ++l) {
       x = p.layers[l].weight * x + p.layers[l].bias;
       if (l + 1 < p.layers.size())
-        x = x.unaryExpr([](double z) { return z > 0 ? z : std::expm1(z); });
+        x = x.unaryExpr([&](double z) { return activation_values(p.activation, z).f; });
     }
     n[k] = p.output_mean + p.output_scale * x[0];
   }
@@ -325,5 +325,206 @@ TEST(NnCorrection, RejectsBadParameters) {
     auto p = test_parameters();
     p.output_mean = nan;
     expect_error(p, "nn_correction.output_mean");
+  }
+}
+
+// ---- energy network (NnKind::Energy) --------------------------------------------------------
+
+namespace {
+
+/// An energy network p → ΔΨ with random weights of unit size (hidden widths `hidden`), inputs
+/// standardised like a learning run's power sums (p₁ ~ 0.1, p₂ ~ 0.01, p₃ ~ 10⁻³), output ~10³
+/// J/m³, and a polynomial of the size of a 20 % Lamé error.
+NnCorrection::Parameters energy_parameters(
+    const std::vector<int>& hidden, Activation activation = Activation::Squareplus) {
+  std::mt19937 rng(9);
+  std::normal_distribution<double> g(0.0, 1.0);
+  NnCorrection::Parameters p;
+  p.kind = NnKind::Energy;
+  p.activation = activation;
+  p.input_mean = Vec3(0.0, 0.01, 0.0);
+  p.input_scale = Vec3(0.1, 0.01, 0.001);
+  p.output_mean = 3;
+  p.output_scale = 1e3;
+  p.polynomial << 50, -2e4, -4e4, 1e4, 2e4, -3e4;
+  int in = 3;
+  std::vector<int> widths = hidden;
+  widths.push_back(1);
+  for (int out : widths) {
+    NnCorrection::Layer l;
+    l.weight.resize(out, in);
+    l.bias.resize(out);
+    for (Eigen::Index i = 0; i < l.weight.size(); ++i)
+      l.weight.data()[i] = g(rng) / std::sqrt(in);
+    for (auto& b : l.bias)
+      b = 0.3 * g(rng);
+    p.layers.push_back(l);
+    in = out;
+  }
+  return p;
+}
+
+/// The architectures that run each evaluation path: the fixed-size kernels (8-8, 6-6), the
+/// general loops (5-7, three layers, one layer) and no hidden layer.
+const std::vector<std::vector<int>> k_energy_architectures { { 8, 8 }, { 6, 6 }, { 5, 7 },
+  { 6, 4, 3 }, { 12 }, {} };
+
+const std::vector<Vec3> k_energy_states { Vec3(1.12, 0.97, 0.9), Vec3(0.85, 1.2, 1.03),
+  Vec3(1.0, 1.0, 1.0), Vec3(1.3, 0.7, 0.95) };
+
+} // namespace
+
+TEST(NnEnergyCorrection, StressIsTheGradientOfTheEnergy) {
+  // N = ∇ΔΨ against 4th-order central differences of elastic_energy (computed by an independent
+  // forward pass). The inputs vary on the scale ε = energy_input_epsilon (0.05) near rest, so
+  // the O(h⁴) truncation is ~(h/ε)⁴ × the input scales' 1/s: h = 1e-6 makes it negligible;
+  // round-off ~1e-16·1e4/1e-6 ≈ 1e-6 Pa against N ~ 10³–10⁴ Pa. 1e-6 relative.
+  for (Activation a : { Activation::Squareplus, Activation::Softplus, Activation::Tanh,
+           Activation::Sigmoid, Activation::Elu }) {
+    for (const auto& hidden : k_energy_architectures) {
+      const NnCorrection n(energy_parameters(hidden, a));
+      for (const Vec3& s : k_energy_states) {
+        SCOPED_TRACE(testing::Message() << to_string(a) << ", " << hidden.size()
+                                        << " hidden layers, stretches " << s.transpose());
+        const Eigen::VectorXd N = n.correction(s, Vec3(0.4, -1, 2));
+        const auto psi = [&](const Eigen::VectorXd& y) { return n.elastic_energy(y); };
+        const FdFunction grad = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+          return Eigen::VectorXd::Constant(1, psi(y));
+        };
+        expect_jacobian_matches(N.transpose(), grad, s, 1e-6, 1e-6);
+      }
+    }
+  }
+}
+
+TEST(NnEnergyCorrection, TangentIsSymmetricAndMatchesFiniteDifferences) {
+  // ∂N/∂σ = ∇²ΔΨ: symmetric bit for bit, and equal to central differences of N. Smooth
+  // activations only (ELU's f'' jumps at 0; a crossing inside the stencil would break the FD).
+  // The inputs' scale ε near rest and the third input's scale 10⁻³ make the higher
+  // derivatives large: h = 2e-6 keeps the O(h⁴) truncation below 1e-8 relative; round-off
+  // ~1e-16·1e5/2e-6 ≈ 1e-5 Pa against tangents ~1e6 Pa.
+  for (Activation a : { Activation::Squareplus, Activation::Softplus, Activation::Tanh }) {
+    for (const auto& hidden : k_energy_architectures) {
+      const NnCorrection n(energy_parameters(hidden, a));
+      for (const Vec3& s : k_energy_states) {
+        SCOPED_TRACE(testing::Message() << to_string(a) << ", " << hidden.size()
+                                        << " hidden layers, stretches " << s.transpose());
+        Mat3 ds, dr;
+        const Vec3 N = n.correction_with_gradient(s, Vec3(0.4, -1, 2), ds, dr);
+        EXPECT_EQ(N, n.correction(s, Vec3::Zero())); // one function, rates ignored
+        EXPECT_EQ(ds, ds.transpose());
+        EXPECT_TRUE(dr.isZero(0));
+        const FdFunction fn = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+          return n.correction(y, Vec3::Zero());
+        };
+        expect_jacobian_matches(ds, fn, s, 1e-6, 2e-6);
+      }
+    }
+  }
+  EXPECT_FALSE(NnCorrection(energy_parameters({ 8, 8 })).depends_on_rates());
+}
+
+TEST(NnEnergyCorrection, IsotropicWithExactlyEqualComponentsAtEqualStretches) {
+  for (const auto& hidden : k_energy_architectures) {
+    const NnCorrection n(energy_parameters(hidden));
+    // Equal stretches, bit-identical components of N and of the tangent's rows, so P = U diag(P̂ +
+    // N) Vᵀ does not depend on the SVD's frame there.
+    for (const Vec3& s :
+        { Vec3(1.1, 1.1, 0.9), Vec3(0.95, 1.2, 1.2), Vec3(1.05, 0.8, 1.05), Vec3(1.0, 1.0, 1.0) }) {
+      Mat3 ds, dr;
+      const Vec3 N = n.correction_with_gradient(s, Vec3::Zero(), ds, dr);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          if (i != j && s[i] == s[j]) {
+            EXPECT_EQ(N[i], N[j]);
+            EXPECT_EQ(ds(i, i), ds(j, j));
+          }
+    }
+    // Permuting the stretches permutes N and the tangent.
+    const Vec3 s(1.12, 0.97, 0.9);
+    Mat3 ds, dr;
+    const Vec3 N = n.correction_with_gradient(s, Vec3::Zero(), ds, dr);
+    Eigen::PermutationMatrix<3> P(Eigen::Vector3i(2, 0, 1));
+    Mat3 ds_p, dr_p;
+    const Vec3 N_p = n.correction_with_gradient(P * s, Vec3::Zero(), ds_p, dr_p);
+    EXPECT_LE((N_p - P * N).cwiseAbs().maxCoeff(), 1e-12 * N.cwiseAbs().maxCoeff());
+    EXPECT_LE(
+        (ds_p - P * ds * P.transpose()).cwiseAbs().maxCoeff(), 1e-12 * ds.cwiseAbs().maxCoeff());
+  }
+}
+
+TEST(NnEnergyCorrection, PolynomialAloneIsItsAnalyticEnergy) {
+  // With the MLP's output weights zero, ΔΨ = cᵀ m(p) + b: N is the polynomial's gradient,
+  // written out here from m = (p₁, p₁², p₂, p₁³, p₁p₂, p₃).
+  NnCorrection::Parameters p = energy_parameters({ 8, 8 });
+  p.layers.back().weight.setZero();
+  const NnCorrection n(p);
+  const auto& c = p.polynomial;
+  const Vec3 s(1.12, 0.97, 0.9), e = s - Vec3::Ones();
+  const double p1 = e.sum(), p2 = e.squaredNorm();
+  Vec3 expected;
+  for (int i = 0; i < 3; ++i)
+    expected[i] = c[0] + 2 * c[1] * p1 + 2 * c[2] * e[i] + 3 * c[3] * p1 * p1
+        + c[4] * (p2 + 2 * p1 * e[i]) + 3 * c[5] * e[i] * e[i];
+  EXPECT_LE(
+      (n.correction(s, Vec3::Zero()) - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.norm());
+}
+
+TEST(NnEnergyCorrection, RejectsBadParameters) {
+  const auto expect_error = [](NnCorrection::Parameters p, const std::string& where) {
+    try {
+      NnCorrection n(std::move(p));
+      ADD_FAILURE() << "expected an error naming " << where;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where(), where) << e.what();
+    }
+  };
+  {
+    auto p = energy_parameters({ 8, 8 });
+    p.input_mean = VecX::Zero(6); // a stress network's standardisation
+    expect_error(p, "nn_correction.input_mean");
+  }
+  {
+    auto p = energy_parameters({ 8, 8 });
+    p.layers[0].weight = MatX::Ones(8, 6);
+    expect_error(p, "nn_correction.layers[0].weight");
+  }
+  {
+    auto p = test_parameters();
+    p.polynomial[2] = 1; // only an energy network has one
+    expect_error(p, "nn_correction.polynomial");
+  }
+  {
+    auto p = energy_parameters({ 8, 8 });
+    p.polynomial[0] = std::numeric_limits<double>::quiet_NaN();
+    expect_error(p, "nn_correction.polynomial");
+  }
+  EXPECT_THROW(NnCorrection(test_parameters()).elastic_energy(Vec3::Ones()), InputError);
+  EXPECT_THROW(NnCorrection(energy_parameters({ 8, 8 })).evaluate(NnInput::Zero()), InputError);
+}
+
+TEST(NnCorrection, StressNetworkActivationsHaveExactGradients) {
+  // The fixed-size (6-6, 8-8) and general paths with each activation, against FD.
+  for (Activation a : { Activation::Elu, Activation::Sigmoid, Activation::Softplus,
+           Activation::Tanh, Activation::Squareplus }) {
+    for (const auto& hidden :
+        { std::vector<int> { 6, 6 }, std::vector<int> { 8, 8 }, std::vector<int> { 7, 5 } }) {
+      auto p = test_parameters(hidden);
+      p.activation = a;
+      const NnCorrection n(p);
+      const Vec3 s(1.15, 0.97, 0.88), r(0.3, -0.5, 0.1);
+      SCOPED_TRACE(testing::Message() << to_string(a) << ", width " << hidden[0]);
+      Mat3 ds, dr;
+      const Vec3 N = n.correction_with_gradient(s, r, ds, dr);
+      EXPECT_LE((N - reference_output(p, s, r)).cwiseAbs().maxCoeff(), 1e-9 * N.norm());
+      Eigen::MatrixXd J(3, 6);
+      J << ds, dr;
+      Eigen::VectorXd in(6);
+      in << s, r;
+      const FdFunction fn = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+        return n.correction(y.head<3>(), y.tail<3>());
+      };
+      expect_jacobian_matches(J, fn, in, 1e-7, 1e-5);
+    }
   }
 }

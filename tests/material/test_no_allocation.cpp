@@ -3,6 +3,7 @@
 #include "model_zoo.hpp"
 
 #include <elastolearn/material/analytic_correction.hpp>
+#include <elastolearn/material/nn_correction.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/material/stretch_dependent_rayleigh.hpp>
 
@@ -87,6 +88,57 @@ TEST(NoAllocation, PerElementMaterialFunctionsDoNotAllocate) {
       const Mat9 Dr = first_piola_rate_derivative(frame, cs.d_stretch_rates);
       sink += P.sum() + D.sum() + Dr.sum() + model->energy(frame.stretches)
           + damping.coefficients(frame.stretches[0]).alpha1;
+    }
+  }
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0);
+  EXPECT_TRUE(std::isfinite(sink));
+#endif
+}
+
+TEST(NoAllocation, LearnedCorrectionsDoNotAllocate) {
+#if !ELASTOLEARN_COUNT_MALLOC
+  GTEST_SKIP() << "malloc cannot be interposed in this build (sanitizer or non-glibc)";
+#else
+  // The RBF (energy and stress kernels, with damping) and the network correction (energy and
+  // stress kind; the fixed-size kernels of 8-8 and the general loops of 5-7), as the element
+  // loops call them: N with its gradients, and Δα₁.
+  std::vector<std::shared_ptr<const Correction>> corrections;
+  RbfCorrection::Parameters rbf;
+  rbf.centres = RbfCorrection::Centres::Constant(5, 3, 1.0);
+  rbf.centres(1, 0) = rbf.centres(2, 1) = 1.1;
+  rbf.weights = VecX::LinSpaced(5, -1e3, 1e3);
+  rbf.damping_weights = VecX::LinSpaced(5, -1e-3, 1e-3);
+  for (bool energy : { false, true }) {
+    rbf.energy_kernels = energy;
+    corrections.push_back(std::make_shared<RbfCorrection>(rbf));
+  }
+  for (NnKind kind : { NnKind::Stress, NnKind::Energy })
+    for (int width : { 8, 5 }) {
+      NnCorrection::Parameters p;
+      p.kind = kind;
+      p.activation = kind == NnKind::Energy ? Activation::Squareplus : Activation::Elu;
+      const int inputs = kind == NnKind::Energy ? 3 : 6;
+      p.input_mean = VecX::Zero(inputs);
+      p.input_scale = VecX::Constant(inputs, 0.1);
+      int in = inputs;
+      for (int out : { width, width + 2, 1 }) {
+        p.layers.push_back({ MatX::Constant(out, in, 0.3), VecX::Constant(out, 0.1) });
+        in = out;
+      }
+      p.damping = std::make_shared<RbfCorrection>(damping_part(RbfCorrection(rbf)));
+      corrections.push_back(std::make_shared<NnCorrection>(p));
+    }
+  allocations = 0;
+  double sink = 0;
+  counting = true;
+  for (const auto& c : corrections) {
+    for (const Vec3& s : { Vec3(1.1, 0.95, 0.9), Vec3(1.0, 1.0, 1.0), Vec3(1.3, 1.3, 0.6) }) {
+      Mat3 ds, dr;
+      sink += c->correction_with_gradient(s, Vec3(0.1, -0.2, 0.3), ds, dr).sum() + ds.sum()
+          + dr.sum() + c->correction(s, Vec3::Zero()).sum() + c->stiffness_damping(s);
+      c->correction_gradient(s, Vec3::Zero(), ds, dr);
+      sink += ds.sum();
     }
   }
   counting = false;

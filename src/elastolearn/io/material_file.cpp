@@ -57,9 +57,13 @@ Json nn_to_json(const material::NnCorrection& c) {
   for (const auto& layer : p.layers)
     layers.push_back(
         Json { { "weight", rows_to_json(layer.weight) }, { "bias", vector_to_json(layer.bias) } });
-  Json out { { "type", "nn" }, { "input_mean", vector_to_json(p.input_mean) },
+  Json out { { "type", "nn" }, { "kind", material::to_string(p.kind) },
+    { "activation", material::to_string(p.activation) },
+    { "input_mean", vector_to_json(p.input_mean) },
     { "input_scale", vector_to_json(p.input_scale) }, { "output_mean", p.output_mean },
     { "output_scale", p.output_scale }, { "layers", std::move(layers) } };
+  if (p.kind == material::NnKind::Energy)
+    out["polynomial"] = vector_to_json(p.polynomial);
   if (p.damping)
     out["damping"] = rbf_to_json(*p.damping);
   return out;
@@ -166,24 +170,36 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
 }
 
 std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
-  o.reject_unknown_keys(
-      { "type", "input_mean", "input_scale", "output_mean", "output_scale", "layers", "damping" });
+  o.reject_unknown_keys({ "type", "kind", "activation", "input_mean", "input_scale", "output_mean",
+      "output_scale", "polynomial", "layers", "damping" });
   material::NnCorrection::Parameters p;
-  p.input_mean = read_vector(o, "input_mean", 6);
-  p.input_scale = read_vector(o, "input_scale", 6);
+  // Absent: the stress network with ELU (files written before the energy network).
+  p.kind = o.has("kind") && o.choice("kind", { "stress", "energy" }) == "energy"
+      ? material::NnKind::Energy
+      : material::NnKind::Stress;
+  if (o.has("activation"))
+    p.activation = *material::activation_from_string(
+        o.choice("activation", { "elu", "relu", "sigmoid", "softplus", "tanh", "squareplus" }));
+  const Eigen::Index inputs = p.kind == material::NnKind::Energy ? 3 : 6;
+  p.input_mean = read_vector(o, "input_mean", inputs);
+  p.input_scale = read_vector(o, "input_scale", inputs);
+  if (p.kind == material::NnKind::Energy)
+    p.polynomial = read_vector(o, "polynomial", 6);
+  else if (o.has("polynomial"))
+    o.fail("polynomial", "is only for \"kind\": \"energy\"");
   // Scalars: one network g shared by the three principal directions (NnCorrection).
   p.output_mean = o.number("output_mean");
   p.output_scale = o.number("output_scale");
   const auto layers = o.objects("layers");
   if (layers.empty())
     o.fail("layers", "expected at least one layer");
-  Eigen::Index inputs = 6;
+  Eigen::Index in = inputs;
   for (const JsonObject& l : layers) {
     l.reject_unknown_keys({ "weight", "bias" });
     material::NnCorrection::Layer layer;
-    layer.weight = read_rows(l, "weight", -1, inputs);
+    layer.weight = read_rows(l, "weight", -1, in);
     layer.bias = read_vector(l, "bias", layer.weight.rows());
-    inputs = layer.weight.rows();
+    in = layer.weight.rows();
     p.layers.push_back(std::move(layer));
   }
   if (o.has("damping")) {
@@ -224,7 +240,9 @@ std::string describe_correction(const material::Correction& correction) {
     return s;
   }
   if (const auto* nn = dynamic_cast<const material::NnCorrection*>(&correction)) {
-    std::string s = "nn, 6";
+    std::string s = "nn (" + material::to_string(nn->parameters().kind) + ", "
+        + material::to_string(nn->parameters().activation) + "), "
+        + std::to_string(nn->num_inputs());
     for (const auto& layer : nn->parameters().layers) {
       s += '-';
       s += std::to_string(layer.weight.rows());

@@ -14,26 +14,14 @@ namespace {
 
 constexpr FieldErrors fail("mlp_training");
 
-double elu(double z) {
-  return z > 0 ? z : std::expm1(z);
-}
-
-/// Adam moments of one parameter array.
-struct AdamMoments {
-  MatX m, v;
-  explicit AdamMoments(const MatX& like)
-      : m(MatX::Zero(like.rows(), like.cols()))
-      , v(MatX::Zero(like.rows(), like.cols())) { }
-};
-
 /// Per-layer gradients, Adam state and batch buffers, allocated once per training run.
 struct LayerWork {
   MatX d_weight, d_bias, d_gamma, d_beta; // gradients (bias etc. as column matrices)
   AdamMoments weight, bias, gamma, beta;
   MatX z; // pre-activation W a + b (out × B)
   MatX z_hat; // normalised pre-activation (batch norm only)
-  MatX slope; // ELU'(y) (hidden layers)
-  MatX activation; // ELU(y), the next layer's input (hidden layers)
+  MatX slope; // f'(y) (hidden layers)
+  MatX activation; // f(y), the next layer's input (hidden layers)
   MatX grad; // ∂L/∂(layer output) (out × B), becomes ∂L/∂z in the backward pass
   VecX inv_std; // 1/√(var + ε) of the batch (batch norm only)
   LayerWork(const BatchNormMlp::Layer& l, Eigen::Index batch)
@@ -51,15 +39,6 @@ struct LayerWork {
     grad.resize(l.weight.rows(), batch);
   }
 };
-
-/// One Adam update of `param` with gradient `grad` (step size already bias-corrected).
-template <typename P, typename G>
-void adam_update(
-    P& param, const G& grad, AdamMoments& s, const MlpTrainingOptions& o, double step) {
-  s.m = o.beta1 * s.m + (1 - o.beta1) * grad;
-  s.v = o.beta2 * s.v + (1 - o.beta2) * grad.cwiseAbs2();
-  param.array() -= step * s.m.array() / (s.v.array().sqrt() + o.adam_epsilon);
-}
 
 double mean_squared_error(const BatchNormMlp& net, ConstRef<MatX> x, ConstRef<MatX> y) {
   return (evaluate(net, x, BatchNormMode::Inference) - y).squaredNorm() / double(y.size());
@@ -95,6 +74,28 @@ void shuffle_in_place(std::vector<int>& values, std::mt19937_64& rng) {
     const auto j = std::min(static_cast<std::size_t>(uniform01(rng) * double(i)), i - 1);
     std::swap(values[i - 1], values[j]);
   }
+}
+
+double adam_step(const MlpTrainingOptions& o, double learning_rate, long steps) {
+  return learning_rate * std::sqrt(1 - std::pow(o.beta2, double(steps)))
+      / (1 - std::pow(o.beta1, double(steps)));
+}
+
+bool EarlyStopping::update(
+    double loss, const MlpTrainingOptions& o, double& learning_rate, bool& stop) {
+  stop = false;
+  if (loss < (1 - o.min_improvement) * best) {
+    best = loss;
+    since_best = since_decay = 0;
+    return true;
+  }
+  ++since_best;
+  if (++since_decay >= o.plateau_epochs) {
+    learning_rate *= 0.5;
+    since_decay = 0;
+  }
+  stop = since_best >= o.patience;
+  return false;
 }
 
 void MlpTrainingOptions::validate() const {
@@ -190,7 +191,8 @@ MatX evaluate(const BatchNormMlp& net, ConstRef<MatX> x, BatchNormMode mode) {
       const VecX scale = l.gamma.array() / (var.array() + net.batch_norm_epsilon).sqrt();
       z = ((z.colwise() - mean).array().colwise() * scale.array()).colwise() + l.beta.array();
     }
-    a = z.unaryExpr(&elu);
+    const material::Activation f = net.activation;
+    a = z.unaryExpr([f](double v) { return material::activation_values(f, v).f; });
   }
   return a; // unreachable: the last layer returns above
 }
@@ -222,6 +224,7 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
 
   BatchNormMlp net = make_batch_norm_mlp(inputs, o.hidden_widths, outputs, o.batch_norm, o.seed);
   net.batch_norm_epsilon = o.batch_norm_epsilon;
+  net.activation = o.activation;
   const Eigen::Index n = train_x.cols();
   const Eigen::Index batch = std::min<Eigen::Index>(o.batch_size, n);
   if (batch < 2)
@@ -238,10 +241,9 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
   std::mt19937_64 rng(o.seed ^ 0x9e3779b97f4a7c15ULL);
 
   MlpTrainingResult result { net, {} };
-  double best = mean_squared_error(net, valid_x, valid_y);
+  EarlyStopping stopping { mean_squared_error(net, valid_x, valid_y) };
   double learning_rate = o.learning_rate;
   long step_count = 0;
-  int since_best = 0, since_decay = 0;
   const double inv_b = 1.0 / double(batch);
   const double m = o.batch_norm_momentum;
 
@@ -274,10 +276,10 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
           w.z = (w.z_hat.array().colwise() * l.gamma.array()).colwise() + l.beta.array();
         }
         for (Eigen::Index i = 0; i < w.z.size(); ++i) {
-          const double zi = w.z.data()[i];
-          const double e = zi > 0 ? 0.0 : std::expm1(zi);
-          w.activation.data()[i] = zi > 0 ? zi : e;
-          w.slope.data()[i] = zi > 0 ? 1.0 : e + 1.0;
+          const material::ActivationValues f
+              = material::activation_values(o.activation, w.z.data()[i]);
+          w.activation.data()[i] = f.f;
+          w.slope.data()[i] = f.d1;
         }
       }
       // Backward: g = ∂(mean squared error)/∂(network output), then through the layers; each
@@ -308,8 +310,7 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
       }
       // Adam with bias-corrected moments.
       ++step_count;
-      const double step = learning_rate * std::sqrt(1 - std::pow(o.beta2, double(step_count)))
-          / (1 - std::pow(o.beta1, double(step_count)));
+      const double step = adam_step(o, learning_rate, step_count);
       for (std::size_t k = 0; k < num_layers; ++k) {
         auto& l = net.layers[k];
         auto& w = work[k];
@@ -331,24 +332,17 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
     }
     result.report.validation_history.push_back(loss);
     result.report.epochs = epoch;
-    if (loss < (1 - o.min_improvement) * best) {
-      best = loss;
+    bool stop = false;
+    if (stopping.update(loss, o, learning_rate, stop)) {
       result.network = net;
       result.report.best_epoch = epoch;
-      since_best = since_decay = 0;
-    } else {
-      ++since_best;
-      if (++since_decay >= o.plateau_epochs) {
-        learning_rate *= 0.5;
-        since_decay = 0;
-      }
-      if (since_best >= o.patience) {
-        result.report.stopped_early = epoch < o.max_epochs;
-        break;
-      }
+    }
+    if (stop) {
+      result.report.stopped_early = epoch < o.max_epochs;
+      break;
     }
   }
-  result.report.validation_loss = best;
+  result.report.validation_loss = stopping.best;
   result.report.training_loss = mean_squared_error(result.network, train_x, train_y);
   result.report.seconds = seconds_since(start);
   return result;

@@ -1,6 +1,6 @@
 #pragma once
 /// \file Training of the small multilayer perceptron of paper 000 §6.2 (Fig. 5): hidden layers
-/// Linear → batch normalisation → ELU, a linear output layer, mean-squared error, Adam on
+/// Linear → batch normalisation → activation, a linear output layer, mean-squared error, Adam on
 /// shuffled mini-batches, early stopping on a held-out set, and the folding of batch
 /// normalisation into the linear layers for inference (material::NnCorrection).
 ///
@@ -21,7 +21,9 @@ struct MlpTrainingOptions {
   /// Hidden layer widths: the paper's 6 → 6 → 6 (→ 1 for the shared per-direction network of
   /// NnCorrection); each 1..NnCorrection::max_width, at most NnCorrection::max_hidden_layers.
   std::vector<int> hidden_widths { 6, 6 };
-  bool batch_norm = true; ///< batch normalisation before each ELU (paper §6.2)
+  bool batch_norm = true; ///< batch normalisation before each activation (paper §6.2)
+  /// The hidden layers' activation: ELU (paper §6.2); Fig. 6 compares ReLU and sigmoid.
+  material::Activation activation = material::Activation::Elu;
   int batch_size = 256; ///< samples per Adam step (capped at the training-set size)
   int max_epochs = 400; ///< passes over the training set
   double learning_rate = 1e-2; ///< Adam step size α (standardised units)
@@ -42,8 +44,8 @@ struct MlpTrainingOptions {
 };
 
 /// The network in training form (before folding). Layer k maps a_k to
-///   z = W a_k + b;  hidden: a_{k+1} = ELU(γ ⊙ (z − μ) ⊘ √(v + ε) + β) with batch norm, ELU(z)
-///   without;  last layer: output z.
+///   z = W a_k + b;  hidden: a_{k+1} = f(γ ⊙ (z − μ) ⊘ √(v + ε) + β) with batch norm, f(z)
+///   without (f = `activation`);  last layer: output z.
 /// μ, v are the batch's mean and (biased) variance in training mode and the running statistics
 /// in inference mode. Hidden layers with batch norm keep b = 0 (β replaces it).
 struct BatchNormMlp {
@@ -56,6 +58,7 @@ struct BatchNormMlp {
   };
   std::vector<Layer> layers;
   double batch_norm_epsilon = 1e-5;
+  material::Activation activation = material::Activation::Elu; ///< f of the hidden layers
 
   int inputs() const { return static_cast<int>(layers.front().weight.cols()); }
   int outputs() const { return static_cast<int>(layers.back().weight.rows()); }
@@ -77,7 +80,8 @@ MatX evaluate(const BatchNormMlp& network, ConstRef<MatX> x, BatchNormMode mode)
 
 /// The inference-mode network with each batch norm folded into its linear layer:
 ///   W' = diag(s) W,  b' = s ⊙ (b − μ) + β,  s = γ ⊘ √(v + ε)   (running μ, v),
-/// so that the returned layers (ELU after all but the last) give evaluate(…, Inference).
+/// so that the returned layers (the activation after all but the last) give
+/// evaluate(…, Inference).
 std::vector<material::NnCorrection::Layer> fold_batch_norm(const BatchNormMlp& network);
 
 struct MlpTrainingReport {
@@ -105,6 +109,36 @@ struct MlpTrainingResult {
 MlpTrainingResult train_mlp(ConstRef<MatX> training_inputs, ConstRef<MatX> training_targets,
     ConstRef<MatX> validation_inputs, ConstRef<MatX> validation_targets,
     const MlpTrainingOptions& options);
+
+/// Adam moments of one parameter array (learn/energy_mlp_training.hpp trains with them too).
+struct AdamMoments {
+  MatX m, v;
+  explicit AdamMoments(const MatX& like)
+      : m(MatX::Zero(like.rows(), like.cols()))
+      , v(MatX::Zero(like.rows(), like.cols())) { }
+};
+
+/// One Adam update of `param` with gradient `grad` (step size already bias-corrected).
+template <typename P, typename G>
+void adam_update(
+    P& param, const G& grad, AdamMoments& s, const MlpTrainingOptions& o, double step) {
+  s.m = o.beta1 * s.m + (1 - o.beta1) * grad;
+  s.v = o.beta2 * s.v + (1 - o.beta2) * grad.cwiseAbs2();
+  param.array() -= step * s.m.array() / (s.v.array().sqrt() + o.adam_epsilon);
+}
+
+/// Adam's bias-corrected step size after `steps` updates.
+double adam_step(const MlpTrainingOptions& o, double learning_rate, long steps);
+
+/// Early stopping and step halving on the validation loss (MlpTrainingOptions::plateau_epochs,
+/// patience, min_improvement), shared by the trainers.
+struct EarlyStopping {
+  double best;
+  int since_best = 0, since_decay = 0;
+  /// Record an epoch's loss: true if it is a new best; halves `learning_rate` on a plateau and
+  /// sets `stop` when patience runs out.
+  bool update(double loss, const MlpTrainingOptions& o, double& learning_rate, bool& stop);
+};
 
 /// Portable random draws for the training code (the std distributions differ between standard
 /// libraries; these give the same numbers everywhere for a seed).

@@ -89,6 +89,11 @@ void DistillationSampleOptions::validate() const {
 
 void NnDistillationOptions::validate() const {
   training.validate();
+  if (energy_polynomial_degree != 0 && energy_polynomial_degree != 2
+      && energy_polynomial_degree != 3)
+    fail("energy_polynomial_degree", "must be 0, 2 or 3, got " + to_text(energy_polynomial_degree));
+  if (kind == material::NnKind::Energy && training.batch_norm)
+    fail("training.batch_norm", "must be off for an energy network (train_gradient_mlp)");
   if (!(validation_fraction > 0 && validation_fraction < 1))
     fail("validation_fraction", "must be in (0, 1), got " + to_text(validation_fraction));
 }
@@ -232,8 +237,12 @@ std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const 
   return out;
 }
 
-NnDistillationResult distill_nn_correction(
-    const StressSamples& samples, const NnDistillationOptions& o) {
+namespace {
+
+/// Checks `samples` and splits its states into a random validation set and a training set
+/// (o.validation_fraction), each sorted.
+void split_states(const StressSamples& samples, const NnDistillationOptions& o,
+    std::vector<int>& train, std::vector<int>& valid) {
   o.validate();
   const Eigen::Index n = samples.stretches.rows();
   if (samples.stretch_rates.rows() != n || samples.targets.rows() != n) {
@@ -257,11 +266,62 @@ NnDistillationResult distill_nn_correction(
         to_text(n) + " samples leave fewer than 2 in the training or validation split "
             + "(validation_fraction " + to_text(o.validation_fraction) + ")");
   }
-  std::vector<int> valid(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n_valid));
-  std::vector<int> train(order.begin() + static_cast<std::ptrdiff_t>(n_valid), order.end());
-  // Training in sample order keeps the split independent of the shuffle inside train_mlp.
+  valid.assign(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(n_valid));
+  train.assign(order.begin() + static_cast<std::ptrdiff_t>(n_valid), order.end());
+  // Training in sample order keeps the split independent of the shuffle inside the trainer.
   std::sort(valid.begin(), valid.end());
   std::sort(train.begin(), train.end());
+}
+
+/// The result's RMS errors of `correction` against the samples' targets.
+NnDistillationResult measured(material::NnCorrection correction, const MlpTrainingReport& report,
+    const StressSamples& samples, const std::vector<int>& train, const std::vector<int>& valid) {
+  NnDistillationResult result { std::move(correction), report };
+  result.training_samples = static_cast<int>(train.size());
+  result.validation_samples = static_cast<int>(valid.size());
+  result.training_rms = rms_error(result.correction, samples, train);
+  result.validation_rms = rms_error(result.correction, samples, valid);
+  result.target_rms = std::sqrt(samples.targets.squaredNorm() / double(samples.targets.rows()));
+  return result;
+}
+
+/// ∇_σ m(p) of the energy polynomial m = (p₁, p₁², p₂, p₁³, p₁p₂, p₃) (NnKind::Energy): 3 × 6.
+Eigen::Matrix<double, 3, 6> polynomial_stress_basis(const Vec3& stretches) {
+  const Vec3 e = stretches - Vec3::Ones();
+  const Vec3 p = material::power_sums(stretches);
+  Eigen::Matrix<double, 3, 6> m;
+  m.col(0).setOnes();
+  m.col(1).setConstant(2 * p[0]);
+  m.col(2) = 2 * e;
+  m.col(3).setConstant(3 * p[0] * p[0]);
+  m.col(4) = Vec3::Constant(p[1]) + 2 * p[0] * e;
+  m.col(5) = 3 * e.cwiseProduct(e);
+  return m;
+}
+
+} // namespace
+
+NnDistillationOptions energy_distillation_options() {
+  NnDistillationOptions o;
+  o.kind = material::NnKind::Energy;
+  o.training.hidden_widths = { 8, 8 };
+  o.training.activation = material::Activation::Squareplus;
+  o.training.batch_norm = false;
+  o.training.learning_rate = 5e-3;
+  o.training.patience = 40;
+  return o;
+}
+
+NnDistillationResult distill_nn_correction(
+    const StressSamples& samples, const NnDistillationOptions& o) {
+  return o.kind == material::NnKind::Energy ? distill_energy_network(samples, o)
+                                            : distill_stress_network(samples, o);
+}
+
+NnDistillationResult distill_stress_network(
+    const StressSamples& samples, const NnDistillationOptions& o) {
+  std::vector<int> train, valid;
+  split_states(samples, o, train, valid);
 
   // One row per state and direction: the shared scalar network g is fitted to all three.
   MatX train_x, train_y, valid_x, valid_y;
@@ -280,18 +340,163 @@ NnDistillationResult distill_nn_correction(
   const MlpTrainingResult trained = train_mlp(train_x, train_y, valid_x, valid_y, o.training);
 
   material::NnCorrection::Parameters p;
+  p.activation = o.training.activation;
   p.input_mean = in_mean;
   p.input_scale = in_scale;
   p.output_mean = out_mean[0];
   p.output_scale = out_scale[0];
   p.layers = fold_batch_norm(trained.network);
-  NnDistillationResult result { material::NnCorrection(std::move(p)), trained.report };
-  result.training_samples = static_cast<int>(train.size());
-  result.validation_samples = static_cast<int>(valid.size());
-  result.training_rms = rms_error(result.correction, samples, train);
-  result.validation_rms = rms_error(result.correction, samples, valid);
-  result.target_rms = std::sqrt(samples.targets.squaredNorm() / double(n));
-  return result;
+  return measured(material::NnCorrection(std::move(p)), trained.report, samples, train, valid);
+}
+
+NnDistillationResult distill_energy_network(
+    const StressSamples& samples, const NnDistillationOptions& o) {
+  if (o.training.batch_norm)
+    fail("training.batch_norm", "must be off for an energy network (train_gradient_mlp)");
+  std::vector<int> train, valid;
+  split_states(samples, o, train, valid);
+  const auto row = [&](int j) { return Vec3(samples.stretches.row(j).transpose()); };
+  const auto target = [&](int j) { return Vec3(samples.targets.row(j).transpose()); };
+
+  // The polynomial by linear least squares on the training states (columns scaled to unit norm
+  // first: p₁³ is ~10⁻³ of p₁).
+  const auto n_train = static_cast<Eigen::Index>(train.size());
+  MatX basis(3 * n_train, 6);
+  VecX rhs(3 * n_train);
+  for (Eigen::Index j = 0; j < n_train; ++j) {
+    const int s = train[std::size_t(j)];
+    basis.middleRows<3>(3 * j) = polynomial_stress_basis(row(s));
+    rhs.segment<3>(3 * j) = target(s);
+  }
+  VecX column_norm = basis.colwise().norm().transpose();
+  for (Eigen::Index c = 0; c < 6; ++c)
+    if (!(column_norm[c] > 0))
+      column_norm[c] = 1;
+  const int terms = o.energy_polynomial_degree == 3 ? 6 : o.energy_polynomial_degree == 2 ? 3 : 0;
+  Eigen::Matrix<double, 6, 1> polynomial = Eigen::Matrix<double, 6, 1>::Zero();
+  if (o.energy_polynomial) {
+    polynomial = *o.energy_polynomial;
+  } else if (terms > 0) {
+    const VecX scaled
+        = (basis.leftCols(terms) * column_norm.head(terms).cwiseInverse().asDiagonal())
+              .colPivHouseholderQr()
+              .solve(rhs);
+    polynomial.head(terms) = scaled.cwiseQuotient(column_norm.head(terms));
+  }
+
+  // Inputs x = energy_input(σ), standardised with the training states' statistics.
+  MatX p_train(3, n_train);
+  for (Eigen::Index j = 0; j < n_train; ++j)
+    p_train.col(j) = material::energy_input(row(train[std::size_t(j)]));
+  VecX in_mean, in_scale;
+  row_statistics(p_train, in_mean, in_scale);
+  // D = ∂x̃/∂σ = diag(1/s) (∂x/∂p)(∂p/∂σ), ∂p_j/∂σ_i = (1, 2e_i, 3e_i²)_j; D(c, i) at row c + 3i.
+  const auto chain = [&](const Vec3& s, auto&& map) {
+    const Vec3 e = s - Vec3::Ones();
+    Mat3 x_p;
+    material::energy_input(s, &x_p);
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 p_sigma(1, 2 * e[i], 3 * e[i] * e[i]);
+      for (int c = 0; c < 3; ++c)
+        map(c + 3 * i) = x_p.row(c).dot(p_sigma) / in_scale[c];
+    }
+  };
+  const auto gradient_samples = [&](const std::vector<int>& states, GradientSamples& g) {
+    const auto n = static_cast<Eigen::Index>(states.size());
+    g.inputs.resize(3, n);
+    g.maps.resize(9, n);
+    g.targets.resize(3, n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const Vec3 s = row(states[std::size_t(j)]);
+      g.inputs.col(j) = (material::energy_input(s) - in_mean).cwiseQuotient(in_scale);
+      chain(s, [&](int r) -> double& { return g.maps(r, j); });
+      g.targets.col(j) = target(states[std::size_t(j)]) - polynomial_stress_basis(s) * polynomial;
+    }
+  };
+  GradientSamples train_set, valid_set;
+  gradient_samples(train, train_set);
+  gradient_samples(valid, valid_set);
+  // Output scale: the residual's RMS over the map's, so that the MLP's input gradient is O(1).
+  const double residual_rms
+      = std::sqrt(train_set.targets.squaredNorm() / double(train_set.targets.size()));
+  const double map_rms = std::sqrt(train_set.maps.squaredNorm() / double(train_set.maps.size()));
+  const double output_scale = residual_rms > 0 ? residual_rms / map_rms : 1.0;
+  train_set.targets /= output_scale;
+  valid_set.targets /= output_scale;
+  const MlpTrainingResult trained = train_gradient_mlp(train_set, valid_set, o.training);
+
+  material::NnCorrection::Parameters p;
+  p.kind = material::NnKind::Energy;
+  p.activation = o.training.activation;
+  p.input_mean = in_mean;
+  p.input_scale = in_scale;
+  p.output_scale = output_scale;
+  p.polynomial = polynomial;
+  p.layers = fold_batch_norm(trained.network);
+  return measured(material::NnCorrection(std::move(p)), trained.report, samples, train, valid);
+}
+
+std::optional<Eigen::Matrix<double, 6, 1>> rbf_energy_polynomial(
+    const material::RbfCorrection& rbf) {
+  const auto& p = rbf.parameters();
+  if (!p.energy_kernels || !p.neo_hookean.isZero(0))
+    return std::nullopt;
+  // N_k = a e_k + b (p₁ − e_k) + c is the gradient of ½(a − b) p₂ + ½ b p₁² + c p₁;
+  // q = α(3, 6, 3, 0) + β(3, 2, 1, −2) + γ(3, 0, 0, 0) that of α p₁³ + β p₁p₂ + γ p₃.
+  const Eigen::Vector4d& q = p.quadratic;
+  const double beta = -0.5 * q[3], alpha = (q[2] - beta) / 3,
+               gamma = (q[0] - 3 * alpha - 3 * beta) / 3;
+  Eigen::Matrix<double, 6, 1> c;
+  c << p.constant, 0.5 * p.other_slope, 0.5 * (p.own_slope - p.other_slope), alpha, beta, gamma;
+  return c;
+}
+
+void RbfDistillationOptions::validate() const {
+  if (jitter_copies < 0)
+    fail("jitter_copies", "must be ≥ 0, got " + to_text(jitter_copies));
+  if (!std::isfinite(stretch_jitter) || stretch_jitter < 0)
+    fail("stretch_jitter", "must be finite and ≥ 0, got " + to_text(stretch_jitter));
+  if (!std::isfinite(rate_sigma) || rate_sigma < 0)
+    fail("rate_sigma", "must be finite and ≥ 0, got " + to_text(rate_sigma));
+  stress.validate();
+  energy.validate();
+}
+
+NnDistillationResult distill_rbf(const material::RbfCorrection& teacher, ConstRef<MatX> stretches,
+    const RbfDistillationOptions& o) {
+  o.validate();
+  if (stretches.cols() != 3 || stretches.rows() < 2)
+    fail("stretches",
+        "expected n × 3 principal stretches with n ≥ 2, got " + to_text(stretches.rows()) + " × "
+            + to_text(stretches.cols()));
+  if (!stretches.allFinite())
+    fail("stretches", "contain a non-finite value");
+  const material::NnKind kind = o.kind.value_or(
+      teacher.parameters().energy_kernels ? material::NnKind::Energy : material::NnKind::Stress);
+  const Eigen::Index n = stretches.rows(), total = n * (1 + o.jitter_copies);
+  StressSamples samples;
+  samples.stretches.resize(total, 3);
+  samples.stretch_rates.setZero(total, 3);
+  samples.targets.resize(total, 3);
+  std::mt19937_64 rng(o.seed);
+  for (Eigen::Index j = 0; j < total; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      samples.stretches(j, i)
+          = stretches(j % n, i) + (j < n ? 0.0 : o.stretch_jitter * standard_normal(rng));
+      if (kind == material::NnKind::Stress)
+        samples.stretch_rates(j, i) = o.rate_sigma * standard_normal(rng);
+    }
+    samples.targets.row(j)
+        = teacher.elastic_correction(samples.stretches.row(j).transpose()).transpose();
+  }
+  if (!samples.targets.allFinite())
+    fail("teacher", "the teacher correction returned a non-finite value");
+  NnDistillationOptions training = kind == material::NnKind::Energy ? o.energy : o.stress;
+  if (kind == material::NnKind::Energy && o.teacher_polynomial && !training.energy_polynomial)
+    training.energy_polynomial = rbf_energy_polynomial(teacher);
+  NnDistillationResult r = distill_nn_correction(samples, training);
+  r.correction = with_teacher_damping(r.correction, teacher);
+  return r;
 }
 
 } // namespace elastolearn::learn

@@ -158,6 +158,15 @@ RbfCorrection::RbfCorrection(Parameters p)
     for (; j < padded; ++j)
       m_energy_x[j] = m_energy_y[j] = m_energy_z[j] = 1e3;
   }
+  if (m_p.damping_weights.size() > 0) {
+    const Eigen::Index padded = (m + 3) / 4 * 4;
+    for (auto* a : { &m_damping_x, &m_damping_y, &m_damping_z, &m_damping_w })
+      a->setZero(padded);
+    m_damping_x.head(m) = m_p.centres.col(0);
+    m_damping_y.head(m) = m_p.centres.col(1);
+    m_damping_z.head(m) = m_p.centres.col(2);
+    m_damping_w.head(m) = m_p.damping_weights;
+  }
 }
 
 Vec3 RbfCorrection::energy_kernels_sum(const Vec3& stretches, Mat3* hessian) const {
@@ -297,10 +306,17 @@ double RbfCorrection::stiffness_damping(const Vec3& stretches) const {
   const Vec3 e = s - Vec3::Ones();
   double alpha
       = m_p.damping_slopes.dot(e) + m_p.damping_constant + m_p.damping_quadratic.dot(e.cwiseAbs2());
-  if (m_p.damping_weights.size() > 0) {
-    for (Eigen::Index i = 0; i < m_p.centres.rows(); ++i)
-      alpha += m_p.damping_weights[i]
-          * rbf_kernel((s - m_p.centres.row(i).transpose()).squaredNorm(), m_p.epsilon);
+  if (m_damping_w.size() > 0) {
+    // Four kernels per packed step (the padding has zero weight).
+    using Lanes = Eigen::Array4d;
+    const double eps2 = m_p.epsilon * m_p.epsilon;
+    Lanes sum = Lanes::Zero();
+    for (Eigen::Index j = 0; j < m_damping_w.size(); j += 4) {
+      const Lanes dx = s[0] - m_damping_x.segment<4>(j), dy = s[1] - m_damping_y.segment<4>(j),
+                  dz = s[2] - m_damping_z.segment<4>(j);
+      sum += m_damping_w.segment<4>(j) * (dx * dx + dy * dy + dz * dz + eps2).sqrt();
+    }
+    alpha += sum.sum();
   }
   return std::max(alpha, m_p.damping_floor);
 }

@@ -158,6 +158,9 @@ class RbfCorrection final : public Correction {
   /// permuted copies of every centre, with its weight, in structure-of-arrays form padded to a
   /// multiple of 4 (zero weight) for packed evaluation. Empty for stress kernels.
   Eigen::ArrayXd m_energy_x, m_energy_y, m_energy_z, m_energy_w;
+  /// The damping kernels likewise: centres and damping weights, padded to a multiple of 4 (zero
+  /// weight); empty without damping weights.
+  Eigen::ArrayXd m_damping_x, m_damping_y, m_damping_z, m_damping_w;
 };
 
 /// (1 − t) a + t b: one correction whose N and Δα₁ (above its floor) are that blend of a's and
