@@ -46,11 +46,11 @@ struct AnimatedRun {
 
 /// The animation of `runs` (surfaces, each frames of `mesh`) and, if `markers` is not null, the
 /// marker positions (k×3 per frame, the same dt; e.g. an observation's positions) as points
-/// labelled `markers_label`. Frames are taken
-/// every `stride`-th, the smallest stride that meets `budget`; all tracks show the frames every
-/// run (and the markers) has. Throws InputError("report animation", ...) if a run has no frames,
-/// a frame is not 3n long, or even two frames exceed the budget.
-SurfaceAnimation surface_animation(const mesh::TetMesh& mesh, double dt,
+/// labelled `markers_label`. Frames are taken every `stride`-th, the smallest stride that meets
+/// `budget`; all tracks show the frames every run (and the markers) has. Nothing (std::nullopt)
+/// when even two frames exceed the budget. Throws InputError("report animation", ...) if a run
+/// has no frames or a frame is not 3n long.
+std::optional<SurfaceAnimation> surface_animation(const mesh::TetMesh& mesh, double dt,
     const std::vector<AnimatedRun>& runs, const std::vector<Positions>* markers = nullptr,
     const std::string& markers_label = "observed", const AnimationBudget& budget = {});
 

@@ -140,8 +140,8 @@ void add_test_motion_sections(LearningReport& report, const std::string& title,
       scene.mesh, scene.dt, { { "truth", &truth }, { shown->label, shown->frames } });
   if (!report.animation)
     report.notes.push_back(too_large);
-  report.animation_caption
-      = title + ": the true motion (grey wireframe) and the " + shown->label + " one (surface).";
+  report.animation_caption = title + ": the true motion (grey) and the " + shown->label
+      + " one side by side; \"overlay\" draws the truth as a wireframe over it.";
 }
 
 void add_correction_section(LearningReport& report, const fem::MaterialModel& learned,
