@@ -46,10 +46,8 @@ std::vector<VecX> simulate_and_save(
 void run_demo(const fs::path& out, double fraction) {
   const auto start = Clock::now();
   // The demo reads no file (its scenes are built in): only its folder is checked.
-  std::vector<CommandOutput> outputs = { { out, "demo output folder (-o)", OutputKind::folder },
-    { out / "report", "demo report folder", OutputKind::folder } };
-  for (const std::string& name : io::report_file_names())
-    outputs.push_back({ out / "report" / name, "report's " + name });
+  std::vector<CommandOutput> outputs = io::report_outputs(out / "report", "demo report folder");
+  outputs.insert(outputs.begin(), { out, "demo output folder (-o)", OutputKind::folder });
   check_command_paths({}, outputs);
   fs::create_directories(out);
   const auto train

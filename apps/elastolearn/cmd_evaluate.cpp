@@ -202,10 +202,8 @@ void run_evaluate(const EvaluateOptions& opts) {
     if (!opts.truth_material.empty())
       inputs.push_back({ opts.truth_material, "true material (--truth-material)" });
     if (!opts.report.empty()) {
-      const std::filesystem::path report = opts.report;
-      outputs.push_back({ report, "--report folder", OutputKind::folder });
-      for (const std::string& name : io::report_file_names())
-        outputs.push_back({ report / name, "report's " + name });
+      for (CommandOutput& output : io::report_outputs(opts.report, "--report folder"))
+        outputs.push_back(std::move(output));
     }
     check_command_paths(inputs, outputs);
   }

@@ -195,10 +195,8 @@ void run_learn(const LearnOptions& o) {
     if (!o.truth_material.empty())
       inputs.push_back({ o.truth_material, "true material (--truth-material)" });
     if (!o.report.empty()) {
-      const std::filesystem::path report = o.report;
-      outputs.push_back({ report, "--report folder", OutputKind::folder });
-      for (const std::string& name : io::report_file_names())
-        outputs.push_back({ report / name, "report's " + name });
+      for (CommandOutput& output : io::report_outputs(o.report, "--report folder"))
+        outputs.push_back(std::move(output));
     }
     check_command_paths(inputs, outputs);
   }

@@ -87,7 +87,7 @@ void expect_page_renders(const fs::path& chromium, const fs::path& page, const f
                                                                << load.dom.substr(0, 2000) << "\n"
                                                                << load.log;
   std::smatch colours;
-  ASSERT_TRUE(std::regex_search(tag, colours, std::regex(R"(data-rendered-colours="(\d+)")")))
+  ASSERT_TRUE(std::regex_search(tag, colours, std::regex(R"re(data-rendered-colours="(\d+)")re")))
       << tag;
   EXPECT_GE(std::stoi(colours[1]), 3) << "background, and the lit surface in several shades";
   EXPECT_EQ(load.log.find(":CONSOLE("), std::string::npos)
@@ -146,6 +146,27 @@ TEST_F(ReportHtmlTest, LearnAndEvaluateReportsOpenInChromium) {
     GTEST_SKIP() << "chromium not installed (scripts/install-deps.sh installs it)";
   expect_page_renders(chromium, path("learn_report/report.html"), m_dir);
   expect_page_renders(chromium, path("evaluate_report/report.html"), m_dir);
+}
+
+TEST_F(ReportHtmlTest, AFileInThePlaceOfThePlotsFolderStopsLearnBeforeItStarts) {
+  write("scene.json", k_scene);
+  write("truth.json", k_truth);
+  ASSERT_EQ(run("simulate " + path("scene.json") + " --material " + path("truth.json") + " -o "
+                + path("truth.h5") + " -q")
+                .exit_code,
+      0);
+  ASSERT_EQ(
+      run("observe " + path("truth.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code,
+      0);
+  fs::create_directories(path("report"));
+  write("report/plots", "not a folder");
+  const auto learned = run("learn " + path("scene.json") + " --observations " + path("obs.h5")
+      + " -o " + path("learned.json") + " --report " + path("report") + " -q");
+  EXPECT_NE(learned.exit_code, 0);
+  EXPECT_NE(learned.output.find(path("report/plots")), std::string::npos) << learned.output;
+  EXPECT_EQ(learned.output.find("learning from"), std::string::npos) << "refused before learning:\n"
+                                                                     << learned.output;
+  EXPECT_FALSE(fs::exists(path("learned.json")));
 }
 
 } // namespace

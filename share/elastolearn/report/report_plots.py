@@ -130,8 +130,9 @@ def frame_errors(data, folder, size):
     fig, axes = plt.subplots(1, len(panels), figsize=(6.5 * len(panels), 4), squeeze=False)
     for ax, p in zip(axes[0], panels):
         for m in p["models"]:
-            t = [p["dt"] * i for i in range(len(m["max_m"]))]
-            y = [max(v, 1e-12) for v in percent(m["max_m"], size)]
+            # Frame 0 is the initial state, given to every model: its error is zero.
+            t = [p["dt"] * i for i in range(1, len(m["max_m"]))]
+            y = [max(v, 1e-12) for v in percent(m["max_m"][1:], size)]
             ax.plot(t, y, label=m["label"] + ("" if m["completed"] else " (stopped early)"))
         ax.set_yscale("log")
         ax.set_xlabel("time [s]")

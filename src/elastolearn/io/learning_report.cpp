@@ -96,12 +96,16 @@ std::string draw_plots(const std::filesystem::path& resources, const std::filesy
 
 } // namespace
 
-std::vector<std::string> report_file_names() {
-  std::vector<std::string> names
-      = { "convergence.csv", "report.json", "summary.json", "report_data.json", "report.html" };
+std::vector<CommandOutput> report_outputs(
+    const std::filesystem::path& dir, const std::string& role) {
+  std::vector<CommandOutput> outputs = { { dir, role, OutputKind::folder },
+    { dir / "plots", role + ": its plots folder", OutputKind::folder } };
+  for (const char* name :
+      { "convergence.csv", "report.json", "summary.json", "report_data.json", "report.html" })
+    outputs.push_back({ dir / name, role + ": its " + name });
   for (const PlotFile& p : plot_files)
-    names.push_back((std::filesystem::path("plots") / p.file).string());
-  return names;
+    outputs.push_back({ dir / "plots" / p.file, role + ": its plots/" + p.file });
+  return outputs;
 }
 
 ReportOutcome write_learning_report(

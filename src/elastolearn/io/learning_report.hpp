@@ -10,6 +10,7 @@
 ///     motion, every script and data inlined: it opens offline).
 /// Every file is written atomically (core/atomic_file.hpp). Without Python or matplotlib the
 /// plots are missing, the page says why, and everything else is still written.
+#include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/io/report_animation.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
 
@@ -51,8 +52,10 @@ struct ReportOutcome {
   std::string plots_problem;
 };
 
-/// The files of `dir` a report writes (for check_command_paths): the fixed names above.
-std::vector<std::string> report_file_names();
+/// The folder `dir` and every file a report writes there, for the command's
+/// check_command_paths (`role` names the option, e.g. "--report folder").
+std::vector<CommandOutput> report_outputs(
+    const std::filesystem::path& dir, const std::string& role);
 
 /// Write the report into `dir` (created if missing). The plots are drawn by running
 /// report_python() on report_plots.py from report_resource_dir(); if that fails, the outcome says
