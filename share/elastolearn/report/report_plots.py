@@ -63,7 +63,7 @@ def convergence(data, folder, size):
     it = c["iteration"]
     loop = [i for i, f in enumerate(c["forward_fit"]) if not f]
     fit = [i for i, f in enumerate(c["forward_fit"]) if f]
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 3.8))
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 3.8), layout="constrained")
     for key, style, name in (("forward_rms_m", "o-", "rms"), ("forward_max_m", "s--", "max")):
         y = masked(percent(c[key], size))
         a.plot([it[i] for i in loop], [y[i] for i in loop], style, color="tab:blue", label=name + " (loop)")
@@ -129,11 +129,16 @@ def frame_errors(data, folder, size):
     panels = data["frame_errors"]
     fig, axes = plt.subplots(1, len(panels), figsize=(6.5 * len(panels), 4), squeeze=False)
     for ax, p in zip(axes[0], panels):
+        largest = 1e-12
         for m in p["models"]:
             # Frame 0 is the initial state, given to every model: its error is zero.
             t = [p["dt"] * i for i in range(1, len(m["max_m"]))]
             y = [max(v, 1e-12) for v in percent(m["max_m"][1:], size)]
             ax.plot(t, y, label=m["label"] + ("" if m["completed"] else " (stopped early)"))
+            largest = max([largest] + y)
+        # A motion that starts at rest has near-zero errors in its first frames: the axis shows
+        # six decades below the largest error, not down to those.
+        ax.set_ylim(bottom=1e-6 * largest)
         ax.set_yscale("log")
         ax.set_xlabel("time [s]")
         ax.set_ylabel("max vertex error [% of size]")
