@@ -189,6 +189,8 @@ void write_report(const EvaluateOptions& opts, const io::MaterialFile& file,
 }
 
 void run_evaluate(const EvaluateOptions& opts) {
+  if (!opts.truth_material.empty() && opts.report.empty())
+    throw InputError("--truth-material", "is used by the report only: give --report DIR too");
   io::SceneFile file = io::read_scene_file(opts.scene);
   {
     std::vector<CommandInput> inputs = file.inputs;

@@ -183,6 +183,8 @@ void run_learn(const LearnOptions& o) {
   if (training_set && !o.observations.empty())
     throw InputError("--observations",
         "not with a training set, which names its observation files (" + o.scene + ")");
+  if (!o.truth_material.empty() && o.report.empty())
+    throw InputError("--truth-material", "is used by the report only: give --report DIR too");
   const io::TrainingSet set = training_set ? io::read_training_set(o.scene)
                                            : io::read_training_motion(o.scene, o.observations);
   const std::filesystem::path checkpoint

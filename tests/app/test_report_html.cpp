@@ -169,4 +169,14 @@ TEST_F(ReportHtmlTest, AFileInThePlaceOfThePlotsFolderStopsLearnBeforeItStarts) 
   EXPECT_FALSE(fs::exists(path("learned.json")));
 }
 
+TEST_F(ReportHtmlTest, ATrueMaterialWithoutAReportIsRefused) {
+  for (const char* command : { "learn s.json --observations o.h5 -o l.json --truth-material t.json",
+           "evaluate s.json --material l.json --truth t.h5 --truth-material t.json" }) {
+    const auto r = run(command);
+    EXPECT_NE(r.exit_code, 0) << command;
+    EXPECT_NE(r.output.find("--truth-material: is used by the report only"), std::string::npos)
+        << r.output;
+  }
+}
+
 } // namespace
