@@ -34,8 +34,10 @@ async function main() {
   const pivot = new THREE.Group();
   scene.add(pivot);
 
-  const colours = [0x9a9a9a, 0xe0701a, 0x2a7bd6, 0x3aa04a];
+  // Grey for the truth (the first of several surfaces), orange for the learned model, then more.
+  const palette = [0x9a9a9a, 0xe0701a, 0x2a7bd6, 0x3aa04a];
   const surfaces = data.tracks.filter((u) => !u.points).length;
+  const colours = surfaces > 1 ? palette : palette.slice(1);
   const tracks = data.tracks.map((t, i) => {
     const values = decodeFloats(t.positions);
     const geometry = new THREE.BufferGeometry();

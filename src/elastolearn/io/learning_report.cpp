@@ -45,7 +45,8 @@ constexpr PlotFile plot_files[] = {
       "the chosen one is marked." },
   { "histograms.png",
       "Histogram of the vertex position errors of every (frame, observed vertex) per candidate, "
-      "as paper 000 Fig. 18." },
+      "as paper 000 Fig. 18; errors below the first bin (the initial state's zeros among them) "
+      "are counted in it." },
   { "frame_errors.png",
       "Error per frame (largest over the compared vertices) of the nominal, the fitted-parameter "
       "baseline and the learned model(s)." },
