@@ -12,6 +12,7 @@
 #include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/report_builder.hpp>
+#include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/scene_output.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
@@ -49,6 +50,7 @@ void run_demo(const fs::path& out, double fraction) {
   std::vector<CommandOutput> outputs = io::report_outputs(out / "report", "demo report folder");
   outputs.insert(outputs.begin(), { out, "demo output folder (-o)", OutputKind::folder });
   check_command_paths({}, outputs);
+  io::report_resource_dir(); // throws now, not after the work, if the report cannot be made
   fs::create_directories(out);
   const auto train
       = io::parse_scene(nlohmann::json::parse(app::kDemoTrainScene), "built-in bar_train.json", out)

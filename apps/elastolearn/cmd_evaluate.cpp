@@ -9,6 +9,7 @@
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/report_builder.hpp>
+#include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
@@ -206,6 +207,7 @@ void run_evaluate(const EvaluateOptions& opts) {
     if (!opts.report.empty()) {
       for (CommandOutput& output : io::report_outputs(opts.report, "--report folder"))
         outputs.push_back(std::move(output));
+      io::report_resource_dir(); // throws now, not after the work, if the report cannot be made
     }
     check_command_paths(inputs, outputs);
   }

@@ -14,6 +14,7 @@
 #include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/report_builder.hpp>
+#include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/training_set.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
@@ -199,6 +200,7 @@ void run_learn(const LearnOptions& o) {
     if (!o.report.empty()) {
       for (CommandOutput& output : io::report_outputs(o.report, "--report folder"))
         outputs.push_back(std::move(output));
+      io::report_resource_dir(); // throws now, not after the work, if the report cannot be made
     }
     check_command_paths(inputs, outputs);
   }
