@@ -17,6 +17,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   tetgen                   # external tetrahedralizer (AGPL: run as a program, never linked)
   clang-format             # scripts/check-format.sh (Debian 12's is version 14, the reference)
+  python3-matplotlib       # the learning report's plots (report_plots.py, run by /usr/bin/python3)
+  chromium                 # the report test opens report.html headless (WebGL); large, but CI needs it
 )
 # Real surface meshes for examples and benchmarks (optional; tests never need them).
 if [[ "${ELASTOLEARN_WITH_CGAL_DATA:-1}" == 1 ]]; then packages+=(libcgal-demo); fi

@@ -11,6 +11,8 @@
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
+#include <elastolearn/io/report_builder.hpp>
+#include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/scene_output.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
@@ -45,7 +47,10 @@ std::vector<VecX> simulate_and_save(
 void run_demo(const fs::path& out, double fraction) {
   const auto start = Clock::now();
   // The demo reads no file (its scenes are built in): only its folder is checked.
-  check_command_paths({}, { { out, "demo output folder (-o)", OutputKind::folder } });
+  std::vector<CommandOutput> outputs = io::report_outputs(out / "report", "demo report folder");
+  outputs.insert(outputs.begin(), { out, "demo output folder (-o)", OutputKind::folder });
+  check_command_paths({}, outputs);
+  io::report_resource_dir(); // throws now, not after the work, if the report cannot be made
   fs::create_directories(out);
   const auto train
       = io::parse_scene(nlohmann::json::parse(app::kDemoTrainScene), "built-in bar_train.json", out)
@@ -140,9 +145,39 @@ void run_demo(const fs::path& out, double fraction) {
       coverage.add_frame(x);
     std::fputs(learn::coverage_report(coverage, "   ").c_str(), stdout);
   }
-  std::printf("   err_L %.0fx lower than the nominal's and %.1fx lower than the fitted nominal's; "
-              "demo took %.0f s\n",
-      e_nominal.max / e_learned.max, e_fitted.max / e_learned.max, seconds_since(start));
+  std::printf("   err_L %.0fx lower than the nominal's and %.1fx lower than the fitted nominal's\n",
+      e_nominal.max / e_learned.max, e_fitted.max / e_learned.max);
+
+  std::printf("5. report (plots, animation of the true and learned test motions)\n");
+  std::fflush(stdout);
+  const auto report_start = Clock::now();
+  io::LearningReport report;
+  report.title = "elastolearn demo: a bar's material learned from "
+      + std::to_string(observed.num_observed()) + " observed vertices";
+  io::add_recipe_sections(report, motions, result);
+  io::add_test_motion_sections(report, "test motion (thrown upward)", test, test_truth,
+      { { "nominal", &test_nominal }, { "fitted nominal (parameter fit)", &test_fitted },
+          { "learned", &test_learned } },
+      "learned");
+  const fem::MaterialModel learned_model = result.material(train.material);
+  io::add_correction_section(report, learned_model, &truth,
+      learned.training_stretches ? &*learned.training_stretches : nullptr);
+  auto percent_json = [](const learn::ErrorSummary& e) {
+    return nlohmann::json { { "err_L_percent", e.max }, { "mean_percent", e.mean },
+      { "rms_percent", e.rms } };
+  };
+  report.summary = { { "command", "demo" }, { "truth", io::describe_material_model(truth) },
+    { "nominal", io::describe_material_model(train.material) },
+    { "observed_vertices", observed.num_observed() }, { "size_m", size },
+    { "chosen", learn::to_string(chosen.kind) },
+    { "test_motion",
+        { { "nominal", percent_json(e_nominal) }, { "fitted_nominal", percent_json(e_fitted) },
+            { "learned", percent_json(e_learned) } } },
+    { "learning_seconds", result.seconds } };
+  const io::ReportOutcome outcome = io::write_learning_report(out / "report", report);
+  std::printf("   %s, %.1f s\n", io::describe_report(out / "report", outcome).c_str(),
+      seconds_since(report_start));
+  std::printf("   demo took %.0f s\n", seconds_since(start));
 }
 
 void add_demo_command(CLI::App& root) {

@@ -8,6 +8,8 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/report_builder.hpp>
+#include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
@@ -30,6 +32,8 @@ struct EvaluateOptions {
   std::string json;
   std::string output;
   std::string solver;
+  std::string report;
+  std::string truth_material;
   bool quiet = false;
 };
 
@@ -119,7 +123,75 @@ std::optional<double> ratio(double nominal, double learned) {
   return nominal / learned;
 }
 
+/// The comparison's numbers: each model's errors and the improvement.
+nlohmann::json report_json(const ModelRun& nominal, const ModelRun& learned, double size) {
+  const auto max_ratio = ratio(nominal.error.max, learned.error.max);
+  const auto mean_ratio = ratio(nominal.error.mean, learned.error.mean);
+  return { { "size", size }, { "nominal", run_to_json(nominal) },
+    { "learned", run_to_json(learned) },
+    { "improvement",
+        { { "err_L", max_ratio ? nlohmann::json(*max_ratio) : nlohmann::json(nullptr) },
+            { "mean", mean_ratio ? nlohmann::json(*mean_ratio) : nlohmann::json(nullptr) } } } };
+}
+
+/// The --report folder: error per frame of the nominal, the fitted-parameter baseline (the
+/// learned file's nominal without its correction), the learned material and, for a network, its
+/// RBF teacher; the animation of the true and learned motions; the learned correction's curves.
+void write_report(const EvaluateOptions& opts, const io::MaterialFile& file,
+    const sim::Scene& learned_scene, const std::vector<VecX>& truth, const ModelRun& nominal,
+    const ModelRun& learned, const fem::MaterialModel* true_material, nlohmann::json summary) {
+  std::vector<ModelRun> extra;
+  if (file.correction) {
+    sim::Scene fitted = learned_scene;
+    fitted.material.correction = nullptr;
+    extra.push_back(
+        { "fitted nominal", "the learned file's nominal without its correction", {}, {}, {}, {} });
+    simulate(fitted, opts.quiet, "", extra.back());
+  }
+  if (file.training.contains("teacher")) {
+    sim::Scene teacher = learned_scene;
+    teacher.material.correction = io::correction_from_json(
+        io::JsonObject(file.training.at("teacher"), opts.material, "training.teacher"));
+    extra.push_back({ "learned RBF (the network's teacher)",
+        io::describe_material_model(teacher.material), {}, {}, {}, {} });
+    simulate(teacher, opts.quiet, "", extra.back());
+  }
+  std::vector<io::LabelledRun> runs = { { "nominal", &nominal.frames, nominal.report.completed } };
+  for (const ModelRun& r : extra)
+    runs.push_back({ r.label, &r.frames, r.report.completed });
+  const std::string learned_label
+      = "learned" + (file.correction ? " (" + io::describe_correction(*file.correction) + ")" : "");
+  runs.push_back({ learned_label, &learned.frames, learned.report.completed });
+
+  io::LearningReport report;
+  report.title = "elastolearn evaluate " + opts.scene + " --material " + opts.material;
+  report.size = learned_scene.mesh.bounding_box_diagonal();
+  io::add_test_motion_sections(
+      report, "test motion " + opts.scene, learned_scene, truth, runs, learned_label);
+  const material::StretchRange* trained
+      = file.training_stretches ? &*file.training_stretches : nullptr;
+  if (file.correction || true_material)
+    io::add_correction_section(report, learned_scene.material, true_material, trained);
+  if (!true_material)
+    report.notes.push_back("No true material given (--truth-material): the correction is shown "
+                           "without the truth's.");
+  summary["command"] = "evaluate";
+  summary["scene"] = opts.scene;
+  summary["material"] = opts.material;
+  summary["truth"] = opts.truth;
+  for (ModelRun& r : extra) {
+    r.error = learn::position_error(r.frames, truth);
+    r.percent = learn::as_percent_of(r.error, report.size);
+    summary["others"][r.label] = run_to_json(r);
+  }
+  report.summary = summary;
+  std::printf("%s\n",
+      io::describe_report(opts.report, io::write_learning_report(opts.report, report)).c_str());
+}
+
 void run_evaluate(const EvaluateOptions& opts) {
+  if (!opts.truth_material.empty() && opts.report.empty())
+    throw InputError("--truth-material", "is used by the report only: give --report DIR too");
   io::SceneFile file = io::read_scene_file(opts.scene);
   {
     std::vector<CommandInput> inputs = file.inputs;
@@ -130,6 +202,13 @@ void run_evaluate(const EvaluateOptions& opts) {
       outputs.push_back({ opts.output, "learned trajectory output (-o)" });
     if (!opts.json.empty())
       outputs.push_back({ opts.json, "JSON report (--json)" });
+    if (!opts.truth_material.empty())
+      inputs.push_back({ opts.truth_material, "true material (--truth-material)" });
+    if (!opts.report.empty()) {
+      for (CommandOutput& output : io::report_outputs(opts.report, "--report folder"))
+        outputs.push_back(std::move(output));
+      io::report_resource_dir(); // throws now, not after the work, if the report cannot be made
+    }
     check_command_paths(inputs, outputs);
   }
   if (!opts.solver.empty())
@@ -139,6 +218,11 @@ void run_evaluate(const EvaluateOptions& opts) {
   const io::MaterialFile material_file = io::read_material_file(opts.material);
   learned_scene.material = io::material_model(material_file, opts.material);
   const std::vector<VecX> truth = read_truth(opts.truth, nominal_scene);
+  std::optional<fem::MaterialModel> true_material;
+  if (!opts.truth_material.empty()) {
+    true_material
+        = io::material_model(io::read_material_file(opts.truth_material), opts.truth_material);
+  }
   const double size = nominal_scene.mesh.bounding_box_diagonal();
 
   std::printf("scene %s: %d vertices, %d tets, %d frames of dt = %g s, size (rest bounding-box "
@@ -192,11 +276,8 @@ void run_evaluate(const EvaluateOptions& opts) {
     nlohmann::json report = { { "format", "elastolearn-evaluation/1" }, { "scene", opts.scene },
       { "material", opts.material }, { "truth", opts.truth },
       { "vertices", nominal_scene.mesh.num_vertices() }, { "tets", nominal_scene.mesh.num_tets() },
-      { "frames", truth.size() }, { "dt", nominal_scene.dt }, { "size", size },
-      { "nominal", run_to_json(nominal) }, { "learned", run_to_json(learned) },
-      { "improvement",
-          { { "err_L", max_ratio ? nlohmann::json(*max_ratio) : nlohmann::json(nullptr) },
-              { "mean", mean_ratio ? nlohmann::json(*mean_ratio) : nlohmann::json(nullptr) } } } };
+      { "frames", truth.size() }, { "dt", nominal_scene.dt }, { "size", size } };
+    report.update(report_json(nominal, learned, size));
     if (coverage) {
       report["stretches"] = { { "visited", io::stretch_range_to_json(coverage->visited()) },
         { "trained", io::stretch_range_to_json(*coverage->trained()) },
@@ -204,6 +285,10 @@ void run_evaluate(const EvaluateOptions& opts) {
     }
     io::write_json_file(opts.json, report);
     std::printf("report: %s\n", opts.json.c_str());
+  }
+  if (!opts.report.empty()) {
+    write_report(opts, material_file, learned_scene, truth, nominal, learned,
+        true_material ? &*true_material : nullptr, report_json(nominal, learned, size));
   }
   for (const ModelRun* run : { &nominal, &learned }) {
     if (!run->report.completed) {
@@ -233,6 +318,12 @@ void add_evaluate_command(CLI::App& root) {
   cmd->add_option("-o,--output", opts->output, "write the learned material's trajectory (HDF5)");
   cmd->add_option(
       "--solver", opts->solver, "linear solver: cholmod | cg | eigen-ldlt (overrides the scene)");
+  cmd->add_option("--report", opts->report,
+      "folder for a report: report.html with the error per frame, the learned correction and an "
+      "animation of the true and learned motions (docs/report.md)");
+  cmd->add_option("--truth-material", opts->truth_material,
+      "the true material (elastolearn-material/1 JSON), when known: the report plots the learned "
+      "correction and damping against it");
   cmd->add_flag("-q,--quiet", opts->quiet, "no progress line");
   cmd->callback([opts] { run_evaluate(*opts); });
 }

@@ -13,6 +13,8 @@
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
+#include <elastolearn/io/report_builder.hpp>
+#include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/training_set.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
@@ -29,7 +31,7 @@
 namespace {
 
 struct LearnOptions {
-  std::string scene, observations, output, report, checkpoint;
+  std::string scene, observations, output, report, checkpoint, truth_material;
   bool resume = false;
   bool quiet = false;
   std::string reconstruction = "normal_equations";
@@ -155,6 +157,40 @@ nlohmann::json recipe_json(const elastolearn::learn::RecipeResult& r) {
     { "chosen_kind", learn::to_string(r.choice().kind) } };
 }
 
+/// The --report folder: the recipe's run on the first motion, the written material's correction
+/// (against the truth if given), the learned file's provenance.
+void write_report(const LearnOptions& o, std::span<const elastolearn::learn::Motion> motions,
+    const elastolearn::learn::RecipeResult& result, const elastolearn::io::MaterialFile& learned,
+    const elastolearn::fem::MaterialModel* truth) {
+  using namespace elastolearn;
+  std::printf("report: simulating the candidates on %s for the plots\n", motions[0].name.c_str());
+  std::fflush(stdout);
+  io::LearningReport report;
+  report.title = "elastolearn learn " + o.scene;
+  const fem::MaterialModel written = io::material_model(learned, o.output);
+  std::vector<io::LabelledModel> extra;
+  if (learned.training.contains("network"))
+    extra.push_back({ "network (distilled from the chosen RBF)", written });
+  io::add_recipe_sections(report, motions, result, extra);
+  const material::StretchRange* trained
+      = learned.training_stretches ? &*learned.training_stretches : nullptr;
+  if (written.correction || truth)
+    io::add_correction_section(report, written, truth, trained);
+  if (!truth)
+    report.notes.push_back("No true material given (--truth-material): the correction is shown "
+                           "without the truth's.");
+  report.summary = { { "command", "learn" }, { "scene", o.scene }, { "learned", o.output },
+    { "truth_material",
+        o.truth_material.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.truth_material) },
+    { "size_m", report.size }, { "recipe", learned.training.at("recipe") },
+    { "best_iteration", result.loop.best_iteration }, { "seconds", result.seconds } };
+  if (learned.training.contains("network"))
+    report.summary["network"] = learned.training.at("network");
+  report.provenance = learned.training;
+  std::printf(
+      "%s\n", io::describe_report(o.report, io::write_learning_report(o.report, report)).c_str());
+}
+
 void run_learn(const LearnOptions& o) {
   using namespace elastolearn;
   const bool training_set = io::is_training_set_file(o.scene);
@@ -165,6 +201,8 @@ void run_learn(const LearnOptions& o) {
   if (training_set && !o.observations.empty())
     throw InputError("--observations",
         "not with a training set, which names its observation files (" + o.scene + ")");
+  if (!o.truth_material.empty() && o.report.empty())
+    throw InputError("--truth-material", "is used by the report only: give --report DIR too");
   const io::TrainingSet set = training_set ? io::read_training_set(o.scene)
                                            : io::read_training_motion(o.scene, o.observations);
   const std::filesystem::path checkpoint
@@ -173,19 +211,25 @@ void run_learn(const LearnOptions& o) {
     // With --resume the checkpoint is read and then rewritten on purpose: it is an output only.
     std::vector<CommandOutput> outputs
         = { { o.output, "learned material output (-o)" }, { checkpoint, "checkpoint" } };
+    std::vector<CommandInput> inputs = set.inputs;
+    if (!o.truth_material.empty())
+      inputs.push_back({ o.truth_material, "true material (--truth-material)" });
     if (!o.report.empty()) {
-      const std::filesystem::path report = o.report;
-      outputs.push_back({ report, "--report folder", OutputKind::folder });
-      outputs.push_back({ report / "convergence.csv", "report's convergence.csv" });
-      outputs.push_back({ report / "report.json", "report's report.json" });
+      for (CommandOutput& output : io::report_outputs(o.report, "--report folder"))
+        outputs.push_back(std::move(output));
+      io::report_resource_dir(); // throws now, not after the work, if the report cannot be made
     }
-    check_command_paths(set.inputs, outputs);
+    check_command_paths(inputs, outputs);
   }
   // The nominal must have parameters to fit: said here with the scene file's field.
   material::ElasticModelType nominal_type {};
   io::nominal_parameters_from_json(
       io::JsonObject(set.nominal_material, set.files.front().paths.scene.string(), "material"),
       nominal_type);
+  // Read before learning, so that a bad file stops the command before it does any work.
+  std::optional<fem::MaterialModel> truth;
+  if (!o.truth_material.empty())
+    truth = io::material_model(io::read_material_file(o.truth_material), o.truth_material);
   const std::vector<learn::Motion>& motions = set.motions;
   const sim::Scene& scene = motions.front().scene;
 
@@ -281,8 +325,6 @@ void run_learn(const LearnOptions& o) {
     learned.training["network"] = provenance["network"];
   }
   io::write_material_file(o.output, learned);
-  if (!o.report.empty())
-    io::write_learning_report(o.report, result.loop.history, learned.training);
 
   std::printf("validation on %s (error rms, %% of the size %.4g m):\n",
       result.validation_data.c_str(), diagonal);
@@ -315,7 +357,7 @@ void run_learn(const LearnOptions& o) {
     std::printf("training stretches: %s (simulate and evaluate note where a motion leaves them)\n",
         learn::describe(*learned.training_stretches).c_str());
   if (!o.report.empty())
-    std::printf("report: %s/convergence.csv, report.json\n", o.report.c_str());
+    write_report(o, motions, result, learned, truth ? &*truth : nullptr);
 }
 
 void add_learn_command(CLI::App& root) {
@@ -330,7 +372,12 @@ void add_learn_command(CLI::App& root) {
       "observation HDF5 of the scene's motion (from observe, or your capture); not with a "
       "training set");
   cmd->add_option("-o,--output", o->output, "learned material JSON to write")->required();
-  cmd->add_option("--report", o->report, "folder for convergence.csv and report.json");
+  cmd->add_option("--report", o->report,
+      "folder for the report: report.html (plots, animation; opens offline), summary.json, "
+      "convergence.csv, report.json (docs/report.md)");
+  cmd->add_option("--truth-material", o->truth_material,
+      "the true material (elastolearn-material/1 JSON), when known: the report plots the learned "
+      "correction and damping against it");
   cmd->add_option(
       "--checkpoint", o->checkpoint, "checkpoint file (default: OUTPUT.checkpoint.json)");
   cmd->add_flag("--resume", o->resume, "continue from the checkpoint");

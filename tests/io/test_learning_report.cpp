@@ -1,15 +1,20 @@
-// The report of a learning run (`learn --report DIR`): a small made-up history and summary are
-// written to convergence.csv and report.json and read back, with no temporary file left behind.
+// The report of a learning run (`learn --report DIR`, docs/report.md): a small made-up report is
+// written and its files read back — the tables and JSON exactly, the plots drawn when
+// matplotlib is there (and the rest written when Python is not), the page self-contained.
 #include "io_test_util.hpp"
 
 #include <elastolearn/core/atomic_file.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/learning_report.hpp>
+#include <elastolearn/io/report_data.hpp>
+#include <elastolearn/io/report_html.hpp>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -51,11 +56,42 @@ std::vector<std::string> lines(const std::string& text) {
   return out;
 }
 
-TEST(LearningReport, WritesConvergenceTableAndSummary) {
+/// A report with the made-up history and every field a page shows.
+LearningReport fake_report() {
+  LearningReport r;
+  r.title = "a <made-up> report";
+  r.size = 0.5;
+  r.history = fake_history();
+  r.data["convergence"] = convergence_json(r.history);
+  r.summary = { { "best_iteration", 1 }, { "seconds", 30.0 } };
+  r.provenance = nlohmann::json { { "history", { { "iteration", 0 } } } };
+  r.notes = { "a note" };
+  return r;
+}
+
+bool matplotlib_available() {
+  return std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0;
+}
+
+/// Sets an environment variable for the scope of a test.
+class ScopedEnv {
+  public:
+  ScopedEnv(const char* name, const char* value)
+      : m_name(name) {
+    ::setenv(name, value, 1);
+  }
+  ~ScopedEnv() { ::unsetenv(m_name); }
+
+  private:
+  const char* m_name;
+};
+
+TEST(LearningReport, WritesEveryFile) {
+  if (std::getenv("ELASTOLEARN_PYTHON"))
+    GTEST_SKIP() << "ELASTOLEARN_PYTHON is set: this test checks the default interpreter";
   const test::ScratchDir dir;
-  const nlohmann::json summary
-      = { { "best_iteration", 1 }, { "seconds", 30.0 }, { "history", { { "iteration", 0 } } } };
-  write_learning_report(dir.path(), fake_history(), summary);
+  const LearningReport report = fake_report();
+  const ReportOutcome outcome = write_learning_report(dir.path(), report);
 
   const std::vector<std::string> csv = lines(read_text_file(dir / "convergence.csv"));
   ASSERT_EQ(csv.size(), 3u);
@@ -66,12 +102,86 @@ TEST(LearningReport, WritesConvergenceTableAndSummary) {
       "seconds_space_time,seconds_reconstruction");
   EXPECT_EQ(csv[1], "0,0.25,0.5,0.125,3,10,2.5,4,8,12,0.75,1.5,1,2,3,4,5");
   EXPECT_EQ(csv[2], "1,0.333333,0.5,0.125,3,10,2.5,4,8,12,0.75,1.5,1,2,3,4,5");
-  EXPECT_EQ(convergence_csv(fake_history()), read_text_file(dir / "convergence.csv"));
+  EXPECT_EQ(read_json_file(dir / "report.json"), *report.provenance);
+  EXPECT_EQ(read_json_file(dir / "summary.json"), report.summary);
+  const nlohmann::json data = read_json_file(dir / "report_data.json");
+  EXPECT_EQ(data.at("format"), "elastolearn-report-data/1");
+  EXPECT_EQ(data.at("convergence"), report.data.at("convergence"));
+  EXPECT_EQ(data.at("size_m"), 0.5);
 
-  EXPECT_EQ(read_json_file(dir / "report.json"), summary);
+  if (matplotlib_available()) {
+    EXPECT_EQ(outcome.plots_problem, "");
+    EXPECT_EQ(outcome.plots, std::vector<std::string> { "plots/convergence.png" })
+        << "only the convergence has data";
+    const std::string png = read_text_file(dir / "plots" / "convergence.png");
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+  } else {
+    EXPECT_NE(outcome.plots_problem, "");
+  }
+  const std::string html = read_text_file(dir / "report.html");
+  EXPECT_NE(html.find("<h1>a &lt;made-up&gt; report</h1>"), std::string::npos);
+  EXPECT_NE(html.find("a note"), std::string::npos);
+  EXPECT_EQ(html.find("@BODY@"), std::string::npos);
+  EXPECT_EQ(html.find("@THREE@"), std::string::npos);
+  EXPECT_NE(html.find("Copyright 2010-2024 Three.js Authors"), std::string::npos)
+      << "three.js is inlined";
+  if (outcome.plots_problem.empty()) {
+    EXPECT_NE(html.find("src=\"data:image/png;base64,iVBOR"), std::string::npos);
+  }
+
   std::vector<std::string> files = dir.files();
   std::sort(files.begin(), files.end());
-  EXPECT_EQ(files, (std::vector<std::string> { "convergence.csv", "report.json" }));
+  EXPECT_EQ(files,
+      (std::vector<std::string> { "convergence.csv", "plots", "report.html", "report.json",
+          "report_data.json", "summary.json" }))
+      << "no temporary file is left behind";
+}
+
+TEST(LearningReport, ThePageNeedsNoNetwork) {
+  const test::ScratchDir dir;
+  const ScopedEnv python("ELASTOLEARN_PYTHON", "/bin/true"); // no plots needed: faster
+  write_learning_report(dir.path(), fake_report());
+  const std::string html = read_text_file(dir / "report.html");
+  // Nothing is fetched: no external script, style sheet, image or frame.
+  const std::regex external(R"((src|href)\s*=\s*["']?\s*(https?:|//))", std::regex::icase);
+  EXPECT_FALSE(std::regex_search(html, external));
+  EXPECT_EQ(html.find("<link"), std::string::npos);
+  EXPECT_EQ(html.find("<script src"), std::string::npos);
+  EXPECT_EQ(html.find("@import"), std::string::npos);
+}
+
+TEST(LearningReport, WithoutPythonTheRestIsWrittenAndThePageSaysWhy) {
+  const test::ScratchDir dir;
+  const ScopedEnv python("ELASTOLEARN_PYTHON", "/nonexistent/python3");
+  const ReportOutcome outcome = write_learning_report(dir.path(), fake_report());
+  EXPECT_NE(outcome.plots_problem.find("/nonexistent/python3 not found"), std::string::npos)
+      << outcome.plots_problem;
+  EXPECT_TRUE(outcome.plots.empty());
+  EXPECT_TRUE(std::filesystem::exists(dir / "summary.json"));
+  const std::string html = read_text_file(dir / "report.html");
+  EXPECT_NE(html.find("No plots: /nonexistent/python3 not found"), std::string::npos);
+  EXPECT_NE(describe_report(dir.path(), outcome).find("no plots"), std::string::npos);
+}
+
+TEST(LearningReport, AFailingScriptIsReportedWithItsLastLine) {
+  const test::ScratchDir dir;
+  // /bin/false as the interpreter: it fails without a word.
+  const ScopedEnv python("ELASTOLEARN_PYTHON", "/bin/false");
+  const ReportOutcome outcome = write_learning_report(dir.path(), fake_report());
+  EXPECT_NE(outcome.plots_problem.find("report_plots.py failed (exit code 1)"), std::string::npos)
+      << outcome.plots_problem;
+  EXPECT_TRUE(std::filesystem::exists(dir / "report.html"));
+}
+
+TEST(LearningReport, StalePlotsOfAnEarlierReportAreRemoved) {
+  if (!matplotlib_available())
+    GTEST_SKIP() << "needs python3-matplotlib";
+  const test::ScratchDir dir;
+  std::filesystem::create_directories(dir / "plots");
+  write_text_file_atomic(dir / "plots" / "damping.png", "an old plot");
+  const ReportOutcome outcome = write_learning_report(dir.path(), fake_report());
+  EXPECT_FALSE(std::filesystem::exists(dir / "plots" / "damping.png"));
+  EXPECT_EQ(outcome.plots.size(), 1u);
 }
 
 TEST(LearningReport, EmptyHistoryHasTheHeaderOnly) {
@@ -80,18 +190,25 @@ TEST(LearningReport, EmptyHistoryHasTheHeaderOnly) {
 
 TEST(LearningReport, CreatesAMissingFolder) {
   const test::ScratchDir dir;
-  write_learning_report(dir / "new" / "report", fake_history(), nlohmann::json::object());
+  const ScopedEnv python("ELASTOLEARN_PYTHON", "/bin/true"); // no plots needed: faster
+  write_learning_report(dir / "new" / "report", fake_report());
   EXPECT_EQ(
       read_text_file(dir / "new" / "report" / "convergence.csv"), convergence_csv(fake_history()));
-  EXPECT_EQ(read_json_file(dir / "new" / "report" / "report.json"), nlohmann::json::object());
+}
+
+TEST(LearningReport, ScriptTextCannotCloseItsScriptElement) {
+  EXPECT_EQ(script_safe("a</script>b"), "a<\\/script>b");
+  EXPECT_EQ(script_safe("x < y"), "x < y");
+  EXPECT_EQ(nlohmann::json::parse(script_safe(nlohmann::json("</script>").dump())), "</script>")
+      << "still the same JSON string";
+  EXPECT_EQ(html_escape("<a href=\"x\">&'"), "&lt;a href=&quot;x&quot;&gt;&amp;&#39;");
 }
 
 TEST(LearningReport, AFolderInTheWayIsAnInputErrorNamingTheFile) {
   const test::ScratchDir dir;
   std::filesystem::create_directories(dir / "convergence.csv");
   test::expect_input_error(
-      [&] { write_learning_report(dir.path(), fake_history(), nlohmann::json::object()); },
-      { "convergence.csv" });
+      [&] { write_learning_report(dir.path(), fake_report()); }, { "convergence.csv" });
 }
 
 } // namespace
