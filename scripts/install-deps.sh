@@ -16,6 +16,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   tetgen                   # external tetrahedralizer (AGPL: run as a program, never linked)
   clang-format             # scripts/check-format.sh (Debian 12's is version 14, the reference)
+  pybind11-dev python3-dev # the Python module (python/, docs/python.md)
+  python3-numpy python3-pytest # its arrays and its tests (tests/python)
 )
 # Real surface meshes for examples and benchmarks (optional; tests never need them).
 if [[ "${ELASTOLEARN_WITH_CGAL_DATA:-1}" == 1 ]]; then packages+=(libcgal-demo); fi
