@@ -117,3 +117,22 @@ def test_errors_name_the_file_and_field(small_scene, tmp_path):
     # An output that is an input is refused before anything runs.
     with pytest.raises(el.InputError, match="bar.json"):
         el.simulate(small_scene, output=small_scene)
+
+
+def test_a_diverging_simulation_keeps_its_frames_and_warns(tmp_path):
+    # One Newton iteration to 1e-12 cannot converge once the bar moves (the CLI test's case).
+    from conftest import SMALL_SCENE
+    scene = el.Scene.from_json(dict(SMALL_SCENE, solver={"max_newton_iterations": 1,
+                                                         "newton_tolerance": 1e-12}))
+    with pytest.warns(RuntimeWarning, match="diverged at frame"):
+        sim = el.simulate(scene)
+    assert not sim.completed and "diverged at frame" in sim.message
+    assert 1 <= sim.positions.shape[0] < 21
+    assert sim.trajectory.metadata["status"].startswith("stopped: ")
+
+
+def test_arguments_of_the_wrong_kind_raise_type_errors(small_scene):
+    with pytest.raises(TypeError, match="scene: expected an elastolearn.Scene"):
+        el.simulate(42)
+    with pytest.raises(TypeError, match="material: expected an elastolearn.Material"):
+        el.simulate(small_scene, material=3.5)
