@@ -164,8 +164,9 @@ void bind_scene(py::module_& m) {
             return make_material(io::parse_material_file(to_json(json), name), name);
           },
           py::arg("json"), py::arg("name") = "material",
-          "A material from a material-file dict (format elastolearn-material/1) or a scene-format "
-          "material object wrapped as {\"format\": ..., \"material\": {...}}.")
+          "A material from a material file's JSON as a dict: {\"format\": "
+          "\"elastolearn-material/1\", \"material\": {scene-format material}, \"correction\": "
+          "None or {...}}; messages name `name`.")
       .def(
           "to_json", [](const Material& m) { return to_python(io::material_file_to_json(m.file)); },
           "The material file's JSON as a dict.")
