@@ -18,7 +18,7 @@ fi
 if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
   list_sources() { git ls-files -z -- '*.cpp' '*.hpp'; }
 else # an exported tree: the same folders git tracks
-  list_sources() { find apps bench src tests -type f \( -name '*.cpp' -o -name '*.hpp' \) -print0; }
+  list_sources() { find apps bench python src tests -type f \( -name '*.cpp' -o -name '*.hpp' \) -print0; }
 fi
 # Batches over ${JOBS:-2} processes; clang-format prints each offending line and fails.
 if ! list_sources | xargs -0 -n 32 -P "${JOBS:-2}" clang-format --dry-run -Werror; then

@@ -19,6 +19,8 @@ packages=(
   clang-format             # scripts/check-format.sh (Debian 12's is version 14, the reference)
   python3-matplotlib       # the learning report's plots (report_plots.py, run by /usr/bin/python3)
   chromium                 # the report test opens report.html headless (WebGL); large, but CI needs it
+  pybind11-dev python3-dev # the Python module (python/, docs/python.md)
+  python3-numpy python3-pytest # its arrays and its tests (tests/python)
 )
 # Real surface meshes for examples and benchmarks (optional; tests never need them).
 if [[ "${ELASTOLEARN_WITH_CGAL_DATA:-1}" == 1 ]]; then packages+=(libcgal-demo); fi

@@ -7,19 +7,14 @@
 #include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/io/material_evaluation.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/report_builder.hpp>
 #include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
-#include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
-#include <elastolearn/learn/trajectory_error.hpp>
-#include <elastolearn/observe/observation.hpp>
-#include <elastolearn/sim/run_simulation.hpp>
 
-#include <cmath>
 #include <cstdio>
-#include <optional>
 
 namespace {
 
@@ -37,116 +32,24 @@ struct EvaluateOptions {
   bool quiet = false;
 };
 
-/// One simulated model and its error against the truth.
-struct ModelRun {
-  std::string label;
-  std::string description;
-  std::vector<VecX> frames; ///< flat 3n, frame 0 = initial state
-  sim::SimulationReport report;
-  learn::ErrorSummary error; ///< [m]
-  learn::ErrorSummary percent; ///< [% of the rest bounding-box diagonal]
-};
-
-/// The truth as flat frames, after checking that it belongs to `scene` (same vertex count and
-/// rest shape, scene.frames + 1 frames spaced scene.dt). Throws InputError naming the file.
-std::vector<VecX> read_truth(const std::string& path, const sim::Scene& scene) {
-  const io::TrajectoryData truth = io::read_trajectory_h5(path);
-  const int n = scene.mesh.num_vertices();
-  if (truth.rest_positions.rows() != n) {
-    throw InputError(path + ": /rest_positions",
-        "has " + std::to_string(truth.rest_positions.rows()) + " vertices but the scene's mesh has "
-            + std::to_string(n) + " (a trajectory of a different mesh?)");
-  }
-  const double tolerance = 1e-9 * scene.mesh.bounding_box_diagonal();
-  const double offset
-      = (truth.rest_positions - scene.mesh.rest_positions()).rowwise().norm().maxCoeff();
-  if (!(offset <= tolerance)) {
-    throw InputError(path + ": /rest_positions",
-        "differ from the scene's mesh by up to " + std::to_string(offset)
-            + " m (a trajectory of a different mesh?)");
-  }
-  const int expected = scene.frames + 1;
-  if (int(truth.positions.size()) != expected) {
-    throw InputError(path + ": /positions",
-        "has " + std::to_string(truth.positions.size()) + " frames but the scene simulates "
-            + std::to_string(expected) + " (" + std::to_string(scene.frames)
-            + " steps + the initial state)");
-  }
-  const double dt = observe::uniform_time_step(truth.time, path + ": /time");
-  if (std::abs(dt - scene.dt) > 1e-6 * scene.dt) {
-    throw InputError(path + ": /time",
-        "frames are " + std::to_string(dt) + " s apart but the scene's time step is "
-            + std::to_string(scene.dt) + " s");
-  }
-  std::vector<VecX> frames;
-  frames.reserve(truth.positions.size());
-  for (const Positions& p : truth.positions)
-    frames.emplace_back(flatten(p));
-  return frames;
-}
-
-/// Simulate `scene`, keeping every frame in memory and, if `output` is given, writing them.
-void simulate(const sim::Scene& scene, bool quiet, const std::string& output, ModelRun& run) {
-  std::optional<io::TrajectoryWriter> writer;
-  if (!output.empty())
-    writer.emplace(output, scene.mesh.rest_positions(), scene.mesh.tets(), Edges(),
-        scene.mesh.surface_faces());
-  auto sink = [&](int, double time, const VecX& x, const VecX& v) {
-    run.frames.push_back(x);
-    if (writer)
-      writer->append(time, unflatten(x), unflatten(v));
-  };
-  run.report = sim::run_simulation(
-      scene, sink, quiet ? ProgressCallback {} : terminal_progress(run.label));
-  if (writer && writer->frames() > 0) {
-    const std::map<std::string, std::string> metadata = { { "scene", scene.name },
-      { "material", run.description }, { "dt", std::to_string(scene.dt) },
-      { "status", run.report.completed ? "completed" : "stopped: " + run.report.message } };
-    writer->finish(metadata);
-  }
-}
-
-nlohmann::json run_to_json(const ModelRun& run) {
-  const auto& e = run.error;
-  const auto& p = run.percent;
-  return { { "material", run.description }, { "err_L_percent", p.max }, { "mean_percent", p.mean },
-    { "rms_percent", p.rms }, { "max_error", e.max }, { "mean_error", e.mean },
-    { "rms_error", e.rms }, { "worst_frame", e.worst_frame }, { "worst_vertex", e.worst_vertex },
-    { "frames_compared", run.frames.size() }, { "completed", run.report.completed },
-    { "message", run.report.message }, { "seconds", run.report.seconds } };
-}
-
-/// nominal / learned, or null (JSON) / "exact" (text) when the learned error is zero.
-std::optional<double> ratio(double nominal, double learned) {
-  if (!(learned > 0))
-    return std::nullopt;
-  return nominal / learned;
-}
-
-/// The comparison's numbers: each model's errors and the improvement.
-nlohmann::json report_json(const ModelRun& nominal, const ModelRun& learned, double size) {
-  const auto max_ratio = ratio(nominal.error.max, learned.error.max);
-  const auto mean_ratio = ratio(nominal.error.mean, learned.error.mean);
-  return { { "size", size }, { "nominal", run_to_json(nominal) },
-    { "learned", run_to_json(learned) },
-    { "improvement",
-        { { "err_L", max_ratio ? nlohmann::json(*max_ratio) : nlohmann::json(nullptr) },
-            { "mean", mean_ratio ? nlohmann::json(*mean_ratio) : nlohmann::json(nullptr) } } } };
+/// The progress display of a run labelled `label` (none with --quiet).
+ProgressCallback progress(const EvaluateOptions& opts, const std::string& label) {
+  return opts.quiet ? ProgressCallback {} : terminal_progress(label);
 }
 
 /// The --report folder: error per frame of the nominal, the fitted-parameter baseline (the
 /// learned file's nominal without its correction), the learned material and, for a network, its
 /// RBF teacher; the animation of the true and learned motions; the learned correction's curves.
 void write_report(const EvaluateOptions& opts, const io::MaterialFile& file,
-    const sim::Scene& learned_scene, const std::vector<VecX>& truth, const ModelRun& nominal,
-    const ModelRun& learned, const fem::MaterialModel* true_material, nlohmann::json summary) {
-  std::vector<ModelRun> extra;
+    const sim::Scene& learned_scene, const std::vector<VecX>& truth, const io::ModelRun& nominal,
+    const io::ModelRun& learned, const fem::MaterialModel* true_material, nlohmann::json summary) {
+  std::vector<io::ModelRun> extra;
   if (file.correction) {
     sim::Scene fitted = learned_scene;
     fitted.material.correction = nullptr;
     extra.push_back(
         { "fitted nominal", "the learned file's nominal without its correction", {}, {}, {}, {} });
-    simulate(fitted, opts.quiet, "", extra.back());
+    io::simulate_model(fitted, progress(opts, extra.back().label), "", extra.back());
   }
   if (file.training.contains("teacher")) {
     sim::Scene teacher = learned_scene;
@@ -154,10 +57,10 @@ void write_report(const EvaluateOptions& opts, const io::MaterialFile& file,
         io::JsonObject(file.training.at("teacher"), opts.material, "training.teacher"));
     extra.push_back({ "learned RBF (the network's teacher)",
         io::describe_material_model(teacher.material), {}, {}, {}, {} });
-    simulate(teacher, opts.quiet, "", extra.back());
+    io::simulate_model(teacher, progress(opts, extra.back().label), "", extra.back());
   }
   std::vector<io::LabelledRun> runs = { { "nominal", &nominal.frames, nominal.report.completed } };
-  for (const ModelRun& r : extra)
+  for (const io::ModelRun& r : extra)
     runs.push_back({ r.label, &r.frames, r.report.completed });
   const std::string learned_label
       = "learned" + (file.correction ? " (" + io::describe_correction(*file.correction) + ")" : "");
@@ -179,10 +82,10 @@ void write_report(const EvaluateOptions& opts, const io::MaterialFile& file,
   summary["scene"] = opts.scene;
   summary["material"] = opts.material;
   summary["truth"] = opts.truth;
-  for (ModelRun& r : extra) {
+  for (io::ModelRun& r : extra) {
     r.error = learn::position_error(r.frames, truth);
     r.percent = learn::as_percent_of(r.error, report.size);
-    summary["others"][r.label] = run_to_json(r);
+    summary["others"][r.label] = io::model_run_to_json(r);
   }
   report.summary = summary;
   std::printf("%s\n",
@@ -213,84 +116,66 @@ void run_evaluate(const EvaluateOptions& opts) {
   }
   if (!opts.solver.empty())
     file.scene.linear_solver = sim::linear_solver_type_from_string(opts.solver);
-  const sim::Scene& nominal_scene = file.scene;
-  sim::Scene learned_scene = file.scene;
+  const sim::Scene& scene = file.scene;
   const io::MaterialFile material_file = io::read_material_file(opts.material);
+  const std::vector<VecX> truth = io::read_truth_trajectory(opts.truth, scene);
+  sim::Scene learned_scene = scene;
   learned_scene.material = io::material_model(material_file, opts.material);
-  const std::vector<VecX> truth = read_truth(opts.truth, nominal_scene);
   std::optional<fem::MaterialModel> true_material;
   if (!opts.truth_material.empty()) {
     true_material
         = io::material_model(io::read_material_file(opts.truth_material), opts.truth_material);
   }
-  const double size = nominal_scene.mesh.bounding_box_diagonal();
 
-  std::printf("scene %s: %d vertices, %d tets, %d frames of dt = %g s, size (rest bounding-box "
-              "diagonal) %g m\n",
-      nominal_scene.name.c_str(), nominal_scene.mesh.num_vertices(), nominal_scene.mesh.num_tets(),
-      nominal_scene.frames, nominal_scene.dt, size);
-  ModelRun nominal { "nominal",
-    io::describe_material_model(nominal_scene.material) + " (the scene's)", {}, {}, {}, {} };
-  ModelRun learned { "learned",
-    io::describe_material_model(learned_scene.material) + " (" + opts.material + ")", {}, {}, {},
-    {} };
-  std::printf("truth:   %s (%zu frames)\nnominal: %s\nlearned: %s\n", opts.truth.c_str(),
-      truth.size(), nominal.description.c_str(), learned.description.c_str());
-  std::fflush(stdout);
-
-  simulate(nominal_scene, opts.quiet, "", nominal);
-  simulate(learned_scene, opts.quiet, opts.output, learned);
-  for (ModelRun* run : { &nominal, &learned }) {
-    run->error = learn::position_error(run->frames, truth);
-    run->percent = learn::as_percent_of(run->error, size);
-  }
+  io::EvaluationOptions options;
+  options.learned_trajectory = opts.output;
+  if (!opts.quiet)
+    options.progress = [](const std::string& label) { return terminal_progress(label); };
+  options.started = [&](const io::MaterialEvaluation& e) {
+    std::printf("scene %s: %d vertices, %d tets, %d frames of dt = %g s, size (rest bounding-box "
+                "diagonal) %g m\n",
+        scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(), scene.frames,
+        scene.dt, e.size);
+    std::printf("truth:   %s (%zu frames)\nnominal: %s\nlearned: %s\n", opts.truth.c_str(),
+        truth.size(), e.nominal.description.c_str(), e.learned.description.c_str());
+    std::fflush(stdout);
+  };
+  const io::MaterialEvaluation e
+      = io::evaluate_material(scene, material_file, opts.material, truth, options);
 
   std::printf("\n%-9s %12s %12s %12s %12s %11s\n", "model", "err_L [%]", "mean [%]", "rms [%]",
       "max [m]", "worst frame");
-  for (const ModelRun* run : { &nominal, &learned }) {
+  for (const io::ModelRun* run : { &e.nominal, &e.learned }) {
     std::printf("%-9s %12.4g %12.4g %12.4g %12.4g %11d%s\n", run->label.c_str(), run->percent.max,
         run->percent.mean, run->percent.rms, run->error.max, run->error.worst_frame,
         run->report.completed ? "" : "  (stopped early)");
   }
-  const auto max_ratio = ratio(nominal.error.max, learned.error.max);
-  const auto mean_ratio = ratio(nominal.error.mean, learned.error.mean);
-  if (!nominal.report.completed || !learned.report.completed)
+  const auto max_ratio = e.max_ratio();
+  const auto mean_ratio = e.mean_ratio();
+  if (!e.completed())
     std::printf("improvement: not measured (a simulation stopped early; see below)\n");
   else if (max_ratio && mean_ratio)
     std::printf(
         "improvement: err_L %.3gx lower, mean error %.3gx lower\n", *max_ratio, *mean_ratio);
   else
     std::printf("improvement: the learned material reproduces the truth exactly\n");
-  if (!opts.output.empty() && !learned.frames.empty())
+  if (!opts.output.empty() && !e.learned.frames.empty())
     std::printf("learned trajectory: %s\n", opts.output.c_str());
   // Where the test motion leaves the correction's training range (files that record it).
-  std::optional<learn::StretchCoverage> coverage;
-  if (material_file.training_stretches && material_file.correction) {
-    coverage.emplace(nominal_scene.mesh, material_file.training_stretches);
-    for (const VecX& x : learned.frames)
-      coverage->add_frame(x);
-    std::fputs(learn::coverage_report(*coverage).c_str(), stdout);
-  }
+  if (e.coverage)
+    std::fputs(learn::coverage_report(*e.coverage).c_str(), stdout);
 
   if (!opts.json.empty()) {
-    nlohmann::json report = { { "format", "elastolearn-evaluation/1" }, { "scene", opts.scene },
-      { "material", opts.material }, { "truth", opts.truth },
-      { "vertices", nominal_scene.mesh.num_vertices() }, { "tets", nominal_scene.mesh.num_tets() },
-      { "frames", truth.size() }, { "dt", nominal_scene.dt }, { "size", size } };
-    report.update(report_json(nominal, learned, size));
-    if (coverage) {
-      report["stretches"] = { { "visited", io::stretch_range_to_json(coverage->visited()) },
-        { "trained", io::stretch_range_to_json(*coverage->trained()) },
-        { "fraction_outside", coverage->fraction_outside() } };
-    }
-    io::write_json_file(opts.json, report);
+    io::write_json_file(
+        opts.json, io::evaluation_to_json(e, scene, opts.scene, opts.material, opts.truth));
     std::printf("report: %s\n", opts.json.c_str());
   }
   if (!opts.report.empty()) {
-    write_report(opts, material_file, learned_scene, truth, nominal, learned,
-        true_material ? &*true_material : nullptr, report_json(nominal, learned, size));
+    write_report(opts, material_file, learned_scene, truth, e.nominal, e.learned,
+        true_material ? &*true_material : nullptr,
+        io::evaluation_to_json(e, scene, opts.scene, opts.material, opts.truth));
   }
-  for (const ModelRun* run : { &nominal, &learned }) {
+  for (const io::ModelRun* run : { &e.nominal, &e.learned }) {
     if (!run->report.completed) {
       std::fprintf(stderr,
           "elastolearn: error: the %s simulation %s (errors above cover frames 0..%zu)\n",

@@ -7,21 +7,16 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
 #include <elastolearn/core/interrupt.hpp>
-#include <elastolearn/core/timing.hpp>
+#include <elastolearn/io/learned_material.hpp>
 #include <elastolearn/io/learning_checkpoint.hpp>
 #include <elastolearn/io/learning_report.hpp>
 #include <elastolearn/io/material_file.hpp>
-#include <elastolearn/io/nominal_parameters.hpp>
-#include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/report_builder.hpp>
 #include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/training_set.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
-#include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
-#include <elastolearn/material/nn_correction.hpp>
-#include <elastolearn/material/rbf_correction.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -40,56 +35,8 @@ struct LearnOptions {
   bool no_parameter_fit = false;
   elastolearn::learn::RecipeOptions recipe;
   // --network: distil the best RBF into the network correction (docs/learning.md).
-  bool network = false;
-  std::vector<double> network_motion_scales { 0.5, 1.0, 2.0 };
-  elastolearn::learn::DistillationSampleOptions network_samples;
-  elastolearn::learn::NnDistillationOptions network_training;
-  /// "auto": the energy network for an RBF with energy kernels, else the stress network.
-  std::string network_kind = "auto";
+  elastolearn::io::NetworkDistillation network;
 };
-
-/// Distil `teacher` into the network correction on states of the training scene at several
-/// motion amplitudes; print the fit; the network's provenance as JSON.
-std::shared_ptr<const elastolearn::material::Correction> distil_network(const LearnOptions& o,
-    const elastolearn::sim::Scene& scene, const elastolearn::material::Correction& teacher,
-    nlohmann::json& provenance) {
-  using namespace elastolearn;
-  const auto start = Clock::now();
-  learn::DistillationSampleReport sampled;
-  const learn::StressSamples samples = learn::distillation_samples(
-      scene, o.network_motion_scales, teacher, o.network_samples, &sampled);
-  const double seconds_sampling = seconds_since(start);
-  for (const auto& m : sampled.messages)
-    std::printf("network samples: %s\n", m.c_str());
-  const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&teacher);
-  const bool energy = o.network_kind == "energy"
-      || (o.network_kind == "auto" && rbf && rbf->parameters().energy_kernels);
-  learn::NnDistillationOptions training
-      = energy ? learn::energy_distillation_options() : o.network_training;
-  if (energy && rbf) // the teacher's tails as the energy's polynomial (docs/learning.md)
-    training.energy_polynomial = learn::rbf_energy_polynomial(*rbf);
-  const learn::NnDistillationResult r = learn::distill_nn_correction(samples, training);
-  std::printf("network (%s): %d + %d states (%d recorded of %ld, %d jittered; %d/%zu motions "
-              "completed), %d epochs; "
-              "RMS relative to the RBF teacher: training %.2f %%, validation %.2f %% (teacher RMS "
-              "%.4g Pa); "
-              "sampling %.1f s, training %.1f s\n",
-      material::to_string(training.kind).c_str(), r.training_samples, r.validation_samples,
-      sampled.recorded, sampled.states_seen, sampled.jittered, sampled.scenes_completed,
-      o.network_motion_scales.size(), r.training.epochs, 100 * r.relative_training_rms(),
-      100 * r.relative_validation_rms(), r.target_rms, seconds_sampling, r.training.seconds);
-  provenance = { { "teacher", io::correction_to_json(teacher) },
-    { "network",
-        { { "kind", material::to_string(training.kind) },
-            { "motion_scales", o.network_motion_scales }, { "recorded_states", sampled.recorded },
-            { "jittered_states", sampled.jittered }, { "training_states", r.training_samples },
-            { "validation_states", r.validation_samples }, { "epochs", r.training.epochs },
-            { "training_rms_pa", r.training_rms }, { "validation_rms_pa", r.validation_rms },
-            { "teacher_rms_pa", r.target_rms }, { "seconds_sampling", seconds_sampling },
-            { "seconds_training", r.training.seconds } } } };
-  return std::make_shared<const material::NnCorrection>(
-      learn::with_teacher_damping(r.correction, teacher));
-}
 
 /// One line per loop iteration (the learning's progress table).
 void print_iteration(const elastolearn::learn::IterationRecord& r, double diagonal) {
@@ -128,35 +75,6 @@ void print_iteration(const elastolearn::learn::IterationRecord& r, double diagon
   std::fflush(stdout);
 }
 
-/// What the recipe decided, for the learned file's "training" provenance.
-nlohmann::json recipe_json(const elastolearn::learn::RecipeResult& r) {
-  using namespace elastolearn;
-  nlohmann::json candidates = nlohmann::json::array();
-  for (const auto& c : r.candidates)
-    candidates.push_back({ { "kind", learn::to_string(c.kind) }, { "iteration", c.iteration },
-        { "completed", c.completed }, { "training_rms_error_m", c.training.rms },
-        { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
-        { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr },
-        { "extrapolation_unstable_samples", c.extrapolation.unstable_samples },
-        { "extrapolation_samples", c.extrapolation.samples }, { "eligible", c.eligible() },
-        // null: infinite (noise σ = 0 and it is better than the reference)
-        { "significance",
-            std::isfinite(c.significance) ? nlohmann::json(c.significance) : nullptr } });
-  return { { "noise_sigma_m", r.noise.sigma }, { "noise_estimated", r.noise.estimated },
-    { "smoothing_rms_change_m", r.noise.smoothing_residual },
-    { "training_frames", r.training_frames }, { "validation_frames", r.validation_frames },
-    { "validation_data", r.validation_data },
-    { "parameter_fit",
-        { { "initial", io::to_json(r.parameter_fit.initial) },
-            { "fitted", io::to_json(r.parameter_fit.fitted) },
-            { "initial_rms_error_m", r.parameter_fit.initial_rms },
-            { "final_rms_error_m", r.parameter_fit.final_rms },
-            { "iterations", r.parameter_fit.iterations },
-            { "seconds", r.parameter_fit.seconds } } },
-    { "candidates", candidates }, { "chosen", r.chosen },
-    { "chosen_kind", learn::to_string(r.choice().kind) } };
-}
-
 /// The --report folder: the recipe's run on the first motion, the written material's correction
 /// (against the truth if given), the learned file's provenance.
 void write_report(const LearnOptions& o, std::span<const elastolearn::learn::Motion> motions,
@@ -193,18 +111,9 @@ void write_report(const LearnOptions& o, std::span<const elastolearn::learn::Mot
 
 void run_learn(const LearnOptions& o) {
   using namespace elastolearn;
-  const bool training_set = io::is_training_set_file(o.scene);
-  if (!training_set && o.observations.empty())
-    throw InputError("--observations",
-        "is required with a scene file (or give a training-set file instead of the scene: "
-        "docs/observations.md, \"Training sets\")");
-  if (training_set && !o.observations.empty())
-    throw InputError("--observations",
-        "not with a training set, which names its observation files (" + o.scene + ")");
   if (!o.truth_material.empty() && o.report.empty())
     throw InputError("--truth-material", "is used by the report only: give --report DIR too");
-  const io::TrainingSet set = training_set ? io::read_training_set(o.scene)
-                                           : io::read_training_motion(o.scene, o.observations);
+  const io::TrainingSet set = io::read_learning_data(o.scene, o.observations, "--observations");
   const std::filesystem::path checkpoint
       = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
   {
@@ -221,11 +130,6 @@ void run_learn(const LearnOptions& o) {
     }
     check_command_paths(inputs, outputs);
   }
-  // The nominal must have parameters to fit: said here with the scene file's field.
-  material::ElasticModelType nominal_type {};
-  io::nominal_parameters_from_json(
-      io::JsonObject(set.nominal_material, set.files.front().paths.scene.string(), "material"),
-      nominal_type);
   // Read before learning, so that a bad file stops the command before it does any work.
   std::optional<fem::MaterialModel> truth;
   if (!o.truth_material.empty())
@@ -292,38 +196,8 @@ void run_learn(const LearnOptions& o) {
   }
 
   const learn::Candidate& chosen = result.choice();
-  double loop_seconds = 0;
-  nlohmann::json history = nlohmann::json::array();
-  for (const auto& r : result.loop.history) {
-    loop_seconds += r.seconds_total();
-    history.push_back(io::iteration_record_to_json(r));
-  }
-  io::MaterialFile learned;
-  learned.material = chosen.kind == learn::CandidateKind::Nominal
-      ? set.nominal_material
-      : io::with_nominal_parameters(
-          set.nominal_material, result.parameter_fit.fitted, options.fit_parameters);
-  learned.correction = chosen.correction;
-  sim::Scene training_scene = scene;
-  training_scene.material = result.material(scene.material);
-  training_scene.material.correction = nullptr;
-  learned.training_stretches = learn::training_stretch_range(training_scene, chosen.correction);
-  nlohmann::json motion_names = nlohmann::json::array();
-  for (const auto& f : set.files)
-    motion_names.push_back(
-        { { "scene", f.paths.scene.string() }, { "observations", f.paths.observations.string() } });
-  learned.training = { { training_set ? "training_set" : "scene", o.scene },
-    { "motions", motion_names }, { "observed_vertices", motions[0].observed.num_observed() },
-    { "best_iteration", result.loop.best_iteration },
-    { "best_rms_error_m", result.loop.best_error }, { "options", inputs.options },
-    { "recipe", recipe_json(result) }, { "seconds", result.seconds },
-    { "loop_seconds", loop_seconds }, { "history", history } };
-  if (o.network && chosen.correction) {
-    nlohmann::json provenance;
-    learned.correction = distil_network(o, training_scene, *chosen.correction, provenance);
-    learned.training["teacher"] = provenance["teacher"]; // the RBF, so that nothing is lost
-    learned.training["network"] = provenance["network"];
-  }
+  const io::MaterialFile learned = io::learned_material_file(set, o.scene, result, options,
+      o.network, [](const std::string& line) { std::printf("%s\n", line.c_str()); });
   io::write_material_file(o.output, learned);
 
   std::printf("validation on %s (error rms, %% of the size %.4g m):\n",
@@ -454,21 +328,21 @@ void add_learn_command(CLI::App& root) {
       "stretches)");
   cmd->add_flag("!--allow-rest-stress", l.rbf.stress_free_rest,
       "let the correction carry a stress at rest (default: N(1, 1, 1) = 0)");
-  cmd->add_flag("--network", o->network,
+  cmd->add_flag("--network", o->network.enabled,
       "distil the learned RBF into the network correction and save that (the RBF goes to "
       "training.teacher)");
-  cmd->add_option("--network-kind", o->network_kind,
+  cmd->add_option("--network-kind", o->network.kind,
          "the network: energy (ΔΨ(σ), N its gradient), stress (N per direction), or auto (energy "
          "for an RBF with energy kernels)")
       ->check(CLI::IsMember({ "auto", "energy", "stress" }))
       ->capture_default_str();
-  cmd->add_option("--network-motion-scales", o->network_motion_scales,
+  cmd->add_option("--network-motion-scales", o->network.motion_scales,
          "motion amplitudes simulated to sample the network's training states")
       ->capture_default_str();
-  cmd->add_option("--network-samples", o->network_samples.recorded_samples,
+  cmd->add_option("--network-samples", o->network.samples.recorded_samples,
          "element states recorded for the network")
       ->capture_default_str();
-  cmd->add_option("--network-rate-jitter", o->network_samples.rate_jitter,
+  cmd->add_option("--network-rate-jitter", o->network.samples.rate_jitter,
          "stretch-rate jitter of the network's samples, relative to the RMS recorded rate")
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "no progress line");

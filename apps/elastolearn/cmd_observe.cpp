@@ -8,11 +8,10 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
-#include <elastolearn/mesh/tet_mesh.hpp>
-#include <elastolearn/observe/marker_dropout.hpp>
-#include <elastolearn/observe/visible_vertices.hpp>
+#include <elastolearn/io/trajectory_observation.hpp>
+#include <elastolearn/observe/observation.hpp>
 
-#include <charconv>
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <map>
@@ -30,63 +29,34 @@ struct ObserveOptions {
   std::uint64_t seed = 1;
 };
 
-/// Shortest text that reads back as `v` (the file's metadata are strings).
-std::string exact(double v) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
-  return std::string(buffer, result.ptr);
-}
-
 void run_observe(const ObserveOptions& opts) {
   using namespace elastolearn;
   std::vector<CommandInput> inputs = { { opts.trajectory, "trajectory" } };
   if (!opts.vertices.empty())
     inputs.push_back({ opts.vertices, "vertex list (--vertices)" });
   check_command_paths(inputs, { { opts.output, "observation output (-o)" } });
-  const io::TrajectoryData traj = io::read_trajectory_h5(opts.trajectory);
-  if (traj.tets.rows() == 0) {
-    throw InputError(opts.trajectory + ": /tets",
-        "missing: observing needs the tet mesh to know the surface (simulate a scene to get one)");
-  }
-  const mesh::TetMesh mesh(traj.rest_positions, traj.tets, opts.trajectory);
-  const double dt = observe::uniform_time_step(traj.time, opts.trajectory + ": /time");
-
-  std::vector<int> ids;
+  io::ObservationRequest request;
   if (!opts.vertices.empty()) {
-    ids = io::read_vertex_id_list(opts.vertices);
-    for (int id : ids) {
-      if (id >= mesh.num_vertices()) {
-        throw InputError(opts.vertices,
-            "vertex id " + std::to_string(id) + " is out of range [0, "
-                + std::to_string(mesh.num_vertices()) + ") of the mesh in " + opts.trajectory);
-      }
-    }
-  } else {
-    ids = observe::select_visible_vertices(mesh, opts.fraction, opts.seed);
+    request.vertices = io::read_vertex_id_list(opts.vertices);
+    request.vertices_source = opts.vertices;
   }
-  observe::Observation obs = observe::observe_vertices(
-      traj.positions, dt, ids, opts.noise, opts.seed, traj.time.front());
-  // The dropout draws from its own stream (seed + 1), so adding it leaves the noise unchanged.
-  observe::drop_markers(obs, opts.dropout, opts.dropout_burst, opts.seed + 1);
-  const std::string selection = opts.vertices.empty()
-      ? "visible fraction " + exact(opts.fraction) + " (farthest-point sampling)"
-      : "vertex list " + opts.vertices;
-  std::map<std::string, std::string> metadata { { "source", opts.trajectory },
-    { "selection", selection }, { "noise_sigma", exact(opts.noise) },
-    { "seed", std::to_string(opts.seed) } };
-  if (opts.dropout > 0) {
-    metadata["dropout"] = exact(opts.dropout);
-    metadata["dropout_burst"] = exact(opts.dropout_burst);
-  }
-  io::write_observation_h5(opts.output, obs, metadata);
+  request.visible_fraction = opts.fraction;
+  request.noise = opts.noise;
+  request.seed = opts.seed;
+  request.dropout = opts.dropout;
+  request.dropout_burst = opts.dropout_burst;
+  const io::TrajectoryObservation observed
+      = io::observe_trajectory(io::read_trajectory_h5(opts.trajectory), opts.trajectory, request);
+  const observe::Observation& obs = observed.observation;
+  io::write_observation_h5(opts.output, obs, observed.metadata);
 
-  const int surface = static_cast<int>(mesh.surface_vertices().size());
   std::printf("observed %d vertices (%d surface vertices, %.1f %%) over %d frames, dt = %g s",
-      obs.num_observed(), surface, 100.0 * obs.num_observed() / std::max(1, surface),
-      obs.num_frames(), dt);
+      obs.num_observed(), observed.surface_vertices,
+      100.0 * obs.num_observed() / std::max(1, observed.surface_vertices), obs.num_frames(),
+      obs.dt);
   if (opts.noise > 0)
-    std::printf(", noise sigma = %g m (%.3g %% of the size)", opts.noise,
-        100 * opts.noise / mesh.bounding_box_diagonal());
+    std::printf(
+        ", noise sigma = %g m (%.3g %% of the size)", opts.noise, 100 * opts.noise / observed.size);
   if (opts.dropout > 0)
     std::printf(", %s in bursts of mean %g frames", observe::describe_lost_entries(obs).c_str(),
         opts.dropout_burst);

@@ -3,6 +3,32 @@
 
 namespace elastolearn::io {
 
+std::map<std::string, std::string> simulation_metadata(
+    const sim::Scene& scene, int every, const sim::SimulationReport& report) {
+  return { { "scene", scene.name }, { "material", scene.material.elastic->name() },
+    { "dt", std::to_string(scene.dt * std::max(1, every)) },
+    { "status", report.completed ? "completed" : "stopped: " + report.message } };
+}
+
+TrajectoryData simulate_trajectory(const sim::Scene& scene, int every,
+    const ProgressCallback& progress, sim::SimulationReport& report) {
+  TrajectoryData data;
+  data.rest_positions = scene.mesh.rest_positions();
+  data.tets = scene.mesh.tets();
+  data.faces = scene.mesh.surface_faces();
+  every = std::max(1, every);
+  auto sink = [&](int frame, double time, const VecX& x, const VecX& v) {
+    if (frame % every != 0)
+      return;
+    data.positions.emplace_back(unflatten(x));
+    data.velocities.emplace_back(unflatten(v));
+    data.time.push_back(time);
+  };
+  report = sim::run_simulation(scene, sink, progress);
+  data.metadata = simulation_metadata(scene, every, report);
+  return data;
+}
+
 sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutputOptions& options,
     const ProgressCallback& progress, std::filesystem::path* pvd,
     learn::StretchCoverage* coverage) {
@@ -29,9 +55,7 @@ sim::SimulationReport simulate_to_files(const sim::Scene& scene, const SceneOutp
     }
   };
   sim::SimulationReport report = sim::run_simulation(scene, sink, progress);
-  std::map<std::string, std::string> metadata = { { "scene", scene.name },
-    { "material", scene.material.elastic->name() }, { "dt", std::to_string(scene.dt * every) },
-    { "status", report.completed ? "completed" : "stopped: " + report.message } };
+  const std::map<std::string, std::string> metadata = simulation_metadata(scene, every, report);
   if (writer.frames() > 0)
     writer.finish(metadata);
   if (options.vtu_directory && !series.positions.empty()) {

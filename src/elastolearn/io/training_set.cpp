@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/json_fields.hpp>
+#include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/training_set.hpp>
 
@@ -89,6 +90,27 @@ TrainingSet read_training_motion(
     const std::filesystem::path& scene, const std::filesystem::path& observations) {
   TrainingSet set;
   add_motion(set, { scene, observations }, scene.string(), observations.string());
+  return set;
+}
+
+TrainingSet read_learning_data(const std::filesystem::path& scene_or_set,
+    const std::filesystem::path& observations, const std::string& observations_name) {
+  const bool training_set = is_training_set_file(scene_or_set);
+  if (!training_set && observations.empty())
+    throw InputError(observations_name,
+        "is required with a scene file (or give a training-set file instead of the scene: "
+        "docs/observations.md, \"Training sets\")");
+  if (training_set && !observations.empty())
+    throw InputError(observations_name,
+        "not with a training set, which names its observation files (" + scene_or_set.string()
+            + ")");
+  TrainingSet set = training_set ? read_training_set(scene_or_set)
+                                 : read_training_motion(scene_or_set, observations);
+  // The nominal must have parameters to fit: said here with the scene file's field.
+  material::ElasticModelType nominal_type {};
+  nominal_parameters_from_json(
+      JsonObject(set.nominal_material, set.files.front().paths.scene.string(), "material"),
+      nominal_type);
   return set;
 }
 

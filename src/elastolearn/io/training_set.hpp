@@ -60,6 +60,15 @@ TrainingSet read_training_set(const std::filesystem::path& path);
 TrainingSet read_training_motion(
     const std::filesystem::path& scene, const std::filesystem::path& observations);
 
+/// What `learn` learns from: the training-set file `scene_or_set` (then `observations` must be
+/// empty) or a scene file and its observation file (then `observations` is required);
+/// `observations_name` names that argument in messages ("--observations"). Also checks that the
+/// shared nominal material has parameters to fit (E, ν, constant Rayleigh damping), naming the
+/// first scene file's field. Throws InputError as read_training_set / read_training_motion, or
+/// naming `observations_name` for a missing or superfluous observation file.
+TrainingSet read_learning_data(const std::filesystem::path& scene_or_set,
+    const std::filesystem::path& observations, const std::string& observations_name);
+
 /// True if `path` is a JSON file whose root "format" names a training set (any version); false
 /// for anything else, including files that cannot be read, so that a caller can tell a training
 /// set from a scene file and report the matching reader's errors.

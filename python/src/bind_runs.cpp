@@ -1,0 +1,371 @@
+// The commands as functions: simulate, observe, learn, evaluate. Each calls the library function
+// its CLI command calls (io::simulate_to_files / io::simulate_trajectory, io::observe_trajectory,
+// learn::learn_material + io::learned_material_file, io::evaluate_material) with the GIL
+// released while it computes.
+#include "arrays.hpp"
+#include "objects.hpp"
+
+#include <elastolearn/core/command_paths.hpp>
+#include <elastolearn/core/error.hpp>
+#include <elastolearn/io/learned_material.hpp>
+#include <elastolearn/io/material_evaluation.hpp>
+#include <elastolearn/io/observation_file.hpp>
+#include <elastolearn/io/scene_output.hpp>
+#include <elastolearn/io/training_set.hpp>
+#include <elastolearn/io/trajectory_observation.hpp>
+#include <elastolearn/learn/learning_recipe.hpp>
+#include <elastolearn/learn/stress_reconstruction.hpp>
+#include <elastolearn/sim/linear_solver.hpp>
+
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <functional>
+#include <optional>
+
+namespace elastolearn::python {
+
+namespace {
+
+/// What simulate returns: the recorded trajectory and the run's report.
+struct Simulation {
+  io::TrajectoryData trajectory;
+  sim::SimulationReport report;
+};
+
+Simulation simulate(const py::handle& scene_arg, std::optional<int> frames,
+    const py::handle& material, std::optional<std::string> solver,
+    std::optional<std::filesystem::path> output, int every, bool progress) {
+  io::SceneFile file = scene_argument(scene_arg);
+  sim::Scene& scene = file.scene;
+  if (solver)
+    scene.linear_solver = sim::linear_solver_type_from_string(*solver);
+  if (frames) {
+    if (*frames < 1)
+      throw InputError("frames", "must be at least 1, got " + std::to_string(*frames));
+    scene.frames = *frames;
+  }
+  if (every < 1)
+    throw InputError("every", "must be at least 1, got " + std::to_string(every));
+  if (!material.is_none())
+    scene.material = material_argument(material).model;
+  const ProgressCallback callback = progress ? terminal_progress("simulate") : ProgressCallback {};
+  Simulation result;
+  if (output) {
+    std::vector<CommandInput> inputs = file.inputs;
+    if (!material.is_none()) {
+      std::string path;
+      if (is_path(material, path))
+        inputs.push_back({ path, "material" });
+    }
+    check_command_paths(inputs, { { *output, "trajectory output" } });
+    {
+      py::gil_scoped_release release;
+      io::SceneOutputOptions out;
+      out.trajectory = *output;
+      out.every = every;
+      result.report = io::simulate_to_files(scene, out, callback);
+    }
+    if (result.report.frames_written > 0)
+      result.trajectory = io::read_trajectory_h5(*output);
+  } else {
+    py::gil_scoped_release release;
+    result.trajectory = io::simulate_trajectory(scene, every, callback, result.report);
+  }
+  if (!result.report.completed) {
+    const std::string warning
+        = "elastolearn.simulate: " + result.report.message + " (the frames before it are kept)";
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) < 0)
+      throw py::error_already_set(); // warnings configured as errors
+  }
+  return result;
+}
+
+Observation observe(const py::handle& trajectory, std::optional<double> visible_fraction,
+    std::optional<IntArray> vertices, double noise, std::uint64_t seed,
+    std::optional<std::filesystem::path> output) {
+  if (visible_fraction.has_value() == vertices.has_value())
+    throw InputError("observe", "give exactly one of visible_fraction and vertices");
+  io::ObservationRequest request;
+  if (vertices)
+    request.vertices = to_ints(*vertices, "vertices");
+  request.visible_fraction = visible_fraction.value_or(0);
+  request.noise = noise;
+  request.seed = seed;
+  std::string source;
+  const io::TrajectoryData data = trajectory_argument(trajectory, source);
+  if (output) {
+    std::vector<CommandInput> inputs;
+    if (source != "trajectory")
+      inputs.push_back({ source, "trajectory" });
+    check_command_paths(inputs, { { *output, "observation output" } });
+  }
+  Observation result;
+  {
+    py::gil_scoped_release release;
+    io::TrajectoryObservation observed = io::observe_trajectory(data, source, request);
+    result.observation = std::move(observed.observation);
+    result.metadata = std::move(observed.metadata);
+    if (output)
+      io::write_observation_h5(*output, result.observation, result.metadata);
+  }
+  return result;
+}
+
+/// learn's keyword options: name → how it sets the recipe's options (the CLI flags' names with
+/// underscores; docs/python.md lists them).
+struct LearnSettings {
+  learn::RecipeOptions recipe;
+  io::NetworkDistillation network;
+};
+
+using Setter = std::function<void(LearnSettings&, const py::handle&)>;
+
+template <typename T> T value(const py::handle& v, const std::string& name) {
+  try {
+    return v.cast<T>();
+  } catch (const py::cast_error&) {
+    throw InputError(name, "has the wrong type (" + std::string(py::str(py::type::of(v))) + ")");
+  }
+}
+
+const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
+  using S = LearnSettings;
+  using H = const py::handle&;
+  static const std::vector<std::pair<std::string, Setter>> table = {
+    { "noise", [](S& s, H v) { s.recipe.noise = v.is_none() ? -1.0 : value<double>(v, "noise"); } },
+    { "validation_fraction",
+        [](S& s, H v) { s.recipe.validation_fraction = value<double>(v, "validation_fraction"); } },
+    { "fit_parameters",
+        [](S& s, H v) { s.recipe.fit_parameters = value<bool>(v, "fit_parameters"); } },
+    { "parameter_fit_iterations",
+        [](S& s, H v) {
+          s.recipe.parameter_fit.max_iterations = value<int>(v, "parameter_fit_iterations");
+        } },
+    { "max_iterations",
+        [](S& s, H v) { s.recipe.loop.max_iterations = value<int>(v, "max_iterations"); } },
+    { "patience", [](S& s, H v) { s.recipe.loop.patience = value<int>(v, "patience"); } },
+    { "free_halvings",
+        [](S& s, H v) { s.recipe.loop.free_halvings = value<int>(v, "free_halvings"); } },
+    { "modes", [](S& s, H v) { s.recipe.loop.pod.max_modes = value<int>(v, "modes"); } },
+    { "pod_stride",
+        [](S& s, H v) { s.recipe.loop.pod.frame_stride = value<int>(v, "pod_stride"); } },
+    { "full_space", [](S& s, H v) { s.recipe.loop.full_space = value<bool>(v, "full_space"); } },
+    { "kernels", [](S& s, H v) { s.recipe.loop.centres = value<int>(v, "kernels"); } },
+    { "position_weight",
+        [](S& s, H v) {
+          s.recipe.loop.space_time.position_weight = value<double>(v, "position_weight");
+        } },
+    { "space_time_iterations",
+        [](S& s, H v) {
+          s.recipe.loop.space_time.max_iterations = value<int>(v, "space_time_iterations");
+        } },
+    { "regularization",
+        [](S& s, H v) { s.recipe.loop.rbf.regularization = value<double>(v, "regularization"); } },
+    { "reconstruction",
+        [](S& s, H v) {
+          s.recipe.loop.reconstruction.method = learn::reconstruction_method_from_name(
+              value<std::string>(v, "reconstruction"), "reconstruction");
+        } },
+    { "frame_stride",
+        [](S& s, H v) {
+          s.recipe.loop.reconstruction.frame_stride = value<int>(v, "frame_stride");
+        } },
+    { "fit_damping",
+        [](S& s, H v) { s.recipe.loop.rbf.fit_damping = value<bool>(v, "fit_damping"); } },
+    { "quadratic_tail",
+        [](S& s, H v) { s.recipe.loop.rbf.quadratic_tail = value<bool>(v, "quadratic_tail"); } },
+    { "damping_regularization",
+        [](S& s, H v) {
+          s.recipe.loop.rbf.damping_regularization = value<double>(v, "damping_regularization");
+        } },
+    { "seed", [](S& s, H v) { s.recipe.loop.seed = value<std::uint64_t>(v, "seed"); } },
+    { "forward_fit",
+        [](S& s, H v) {
+          s.recipe.loop.forward_fit.max_iterations = value<int>(v, "forward_fit");
+        } },
+    { "damping_prior",
+        [](S& s, H v) {
+          s.recipe.loop.forward_fit.damping_prior = value<double>(v, "damping_prior");
+        } },
+    { "elastic_prior",
+        [](S& s, H v) {
+          s.recipe.loop.forward_fit.elastic_prior = value<double>(v, "elastic_prior");
+        } },
+    { "kernel_smoothing",
+        [](S& s, H v) { s.recipe.loop.rbf.epsilon = value<double>(v, "kernel_smoothing"); } },
+    { "energy_kernels",
+        [](S& s, H v) { s.recipe.loop.rbf.energy_kernels = value<bool>(v, "energy_kernels"); } },
+    { "network", [](S& s, H v) { s.network.enabled = value<bool>(v, "network"); } },
+    { "network_motion_scales",
+        [](S& s, H v) {
+          s.network.motion_scales = value<std::vector<double>>(v, "network_motion_scales");
+        } },
+    { "network_samples",
+        [](S& s, H v) { s.network.samples.recorded_samples = value<int>(v, "network_samples"); } },
+  };
+  return table;
+}
+
+LearnSettings learn_settings(const py::kwargs& options) {
+  LearnSettings s;
+  const auto& table = learn_option_table();
+  for (const auto& [key, v] : options) {
+    const std::string name = py::str(key);
+    const auto it = std::find_if(
+        table.begin(), table.end(), [&](const auto& entry) { return entry.first == name; });
+    if (it == table.end()) {
+      std::string known;
+      for (const auto& entry : table)
+        known += (known.empty() ? "" : ", ") + entry.first;
+      throw py::type_error("learn() got an unknown option '" + name + "' (options: " + known + ")");
+    }
+    it->second(s, v);
+  }
+  s.recipe.validate();
+  s.network.samples.validate();
+  return s;
+}
+
+/// One line per loop iteration for `verbose` (the CLI prints a fuller table).
+std::string iteration_line(const learn::IterationRecord& r, double size) {
+  char line[256];
+  if (!r.forward_completed)
+    std::snprintf(line, sizeof line, "iteration %d: forward simulation diverged (%s)", r.iteration,
+        r.forward_message.c_str());
+  else
+    std::snprintf(line, sizeof line,
+        "iteration %d%s: error rms %.4f %%, max %.4f %% of the size; %.1f s", r.iteration,
+        r.forward_fit ? " (forward fit)" : "", 100 * r.forward_error.rms / size,
+        100 * r.forward_error.max / size, r.seconds_total());
+  return line;
+}
+
+Material learn(const std::filesystem::path& scene,
+    std::optional<std::filesystem::path> observations, std::optional<std::filesystem::path> output,
+    bool verbose, const py::kwargs& options) {
+  const LearnSettings settings = learn_settings(options);
+  const io::TrainingSet set
+      = io::read_learning_data(scene, observations.value_or(""), "observations");
+  if (output)
+    check_command_paths(set.inputs, { { *output, "learned material output" } });
+  const double size = set.motions.front().scene.mesh.bounding_box_diagonal();
+  const auto say = [verbose](const std::string& line) {
+    if (verbose) {
+      py::gil_scoped_acquire acquire;
+      py::print(line, py::arg("flush") = true);
+    }
+  };
+  learn::RecipeCallbacks callbacks;
+  callbacks.message = say;
+  callbacks.loop.iteration = [&](const learn::IterationRecord& r) { say(iteration_line(r, size)); };
+  bool interrupted = false;
+  callbacks.loop.interrupted = [&interrupted] {
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) {
+      PyErr_Clear();
+      interrupted = true;
+    }
+    return interrupted;
+  };
+  io::MaterialFile learned;
+  {
+    py::gil_scoped_release release;
+    const learn::RecipeResult result
+        = learn::learn_material(set.motions, settings.recipe, callbacks);
+    if (!result.interrupted) {
+      learned = io::learned_material_file(
+          set, scene.string(), result, settings.recipe, settings.network, say);
+      if (output)
+        io::write_material_file(*output, learned);
+    }
+  }
+  if (interrupted) {
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+  return make_material(std::move(learned), output ? output->string() : std::string("learned"));
+}
+
+py::object evaluate(const py::handle& scene_arg, const py::handle& material_arg,
+    const py::handle& truth_arg, std::optional<std::filesystem::path> output, bool progress) {
+  const io::SceneFile file = scene_argument(scene_arg);
+  const Material material = material_argument(material_arg);
+  std::string truth_source;
+  const io::TrajectoryData truth_data = trajectory_argument(truth_arg, truth_source);
+  const std::vector<VecX> truth = io::truth_frames(truth_data, truth_source, file.scene);
+  io::EvaluationOptions options;
+  if (output) {
+    std::vector<CommandInput> inputs = file.inputs;
+    for (const py::handle& h : { material_arg, truth_arg }) {
+      std::string path;
+      if (is_path(h, path))
+        inputs.push_back({ path, "input" });
+    }
+    check_command_paths(inputs, { { *output, "learned trajectory output" } });
+    options.learned_trajectory = *output;
+  }
+  if (progress)
+    options.progress = [](const std::string& label) { return terminal_progress(label); };
+  nlohmann::json report;
+  {
+    py::gil_scoped_release release;
+    const io::MaterialEvaluation e
+        = io::evaluate_material(file.scene, material.file, material.source, truth, options);
+    report = io::evaluation_to_json(e, file.scene,
+        file.path.empty() ? std::string("scene") : file.path.string(), material.source,
+        truth_source);
+  }
+  return to_python(report);
+}
+
+} // namespace
+
+void bind_runs(py::module_& m) {
+  py::class_<Simulation>(m, "Simulation",
+      "What simulate returns: the trajectory and the run's report (completed, message, seconds, "
+      "newton_iterations).")
+      .def_readonly("trajectory", &Simulation::trajectory)
+      .def_property_readonly(
+          "positions",
+          [](const Simulation& s) {
+            return to_array(s.trajectory.positions, s.trajectory.rest_positions.rows());
+          },
+          "(T, n, 3) float64 [m]")
+      .def_property_readonly(
+          "velocities",
+          [](const Simulation& s) {
+            return to_array(s.trajectory.velocities, s.trajectory.rest_positions.rows());
+          },
+          "(T, n, 3) float64 [m/s]")
+      .def_property_readonly(
+          "time", [](const Simulation& s) { return to_array(s.trajectory.time); })
+      .def_property_readonly("completed", [](const Simulation& s) { return s.report.completed; })
+      .def_property_readonly("message", [](const Simulation& s) { return s.report.message; })
+      .def_property_readonly("seconds", [](const Simulation& s) { return s.report.seconds; })
+      .def_property_readonly(
+          "newton_iterations", [](const Simulation& s) { return s.report.newton_iterations; })
+      .def("__repr__", [](const Simulation& s) {
+        return "<elastolearn.Simulation: " + std::to_string(s.trajectory.positions.size())
+            + " frames, " + (s.report.completed ? "completed" : "stopped: " + s.report.message)
+            + ">";
+      });
+  m.def("simulate", &simulate, py::arg("scene"), py::kw_only(), py::arg("frames") = py::none(),
+      py::arg("material") = py::none(), py::arg("solver") = py::none(),
+      py::arg("output") = py::none(), py::arg("every") = 1, py::arg("progress") = false);
+  m.def("observe", &observe, py::arg("trajectory"), py::kw_only(),
+      py::arg("visible_fraction") = py::none(), py::arg("vertices") = py::none(),
+      py::arg("noise") = 0.0, py::arg("seed") = 1, py::arg("output") = py::none());
+  m.def("learn", &learn, py::arg("scene"), py::arg("observations") = py::none(), py::kw_only(),
+      py::arg("output") = py::none(), py::arg("verbose") = false);
+  m.def("learn_options", [] {
+    std::vector<std::string> names;
+    for (const auto& entry : learn_option_table())
+      names.push_back(entry.first);
+    return names;
+  });
+  m.def("evaluate", &evaluate, py::arg("scene"), py::arg("material"), py::arg("truth"),
+      py::kw_only(), py::arg("output") = py::none(), py::arg("progress") = false);
+}
+
+} // namespace elastolearn::python

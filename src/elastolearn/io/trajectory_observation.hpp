@@ -1,0 +1,50 @@
+#pragma once
+/// \file Observations of a recorded trajectory (paper 000 §7, docs/observations.md): some surface
+/// vertices of the trajectory's tet mesh, chosen by the caller or spread over the surface, with
+/// optional Gaussian noise. What `elastolearn observe` and the Python `observe` run.
+#include <elastolearn/io/trajectory_file.hpp>
+#include <elastolearn/observe/observation.hpp>
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace elastolearn::io {
+
+/// Which vertices to observe and how.
+struct ObservationRequest {
+  /// Vertex ids to observe, or nothing: `visible_fraction` of the surface vertices by
+  /// farthest-point sampling.
+  std::optional<std::vector<int>> vertices;
+  /// Where `vertices` came from (a file name; names them in messages and the metadata).
+  std::string vertices_source = "vertices";
+  double visible_fraction = 0; ///< (0, 1], used when `vertices` is empty
+  double noise = 0; ///< Gaussian noise standard deviation per coordinate [m], ≥ 0
+  std::uint64_t seed = 1; ///< seed of the vertex choice and the noise
+  /// Occlusion bursts (observe::drop_markers): the fraction of (frame, vertex) entries lost, in
+  /// bursts of this mean length [frames]; drawn from the stream seed + 1, so adding it leaves the
+  /// noise unchanged. 0: none.
+  double dropout = 0;
+  double dropout_burst = 5;
+};
+
+/// An observation with what a user is told about it.
+struct TrajectoryObservation {
+  observe::Observation observation;
+  /// The observation file's metadata: source, selection, noise_sigma, seed (and dropout,
+  /// dropout_burst when entries were dropped).
+  std::map<std::string, std::string> metadata;
+  int surface_vertices = 0; ///< of the trajectory's mesh
+  double size = 0; ///< rest bounding-box diagonal [m]
+};
+
+/// Observe `trajectory` (read from `source`, which names it in messages and the metadata).
+/// Throws InputError naming `source` (no /tets, uneven /time, an invalid mesh) or
+/// `request.vertices_source` (an id out of the mesh's range), and for a fraction outside (0, 1]
+/// or a negative noise.
+TrajectoryObservation observe_trajectory(
+    const TrajectoryData& trajectory, const std::string& source, const ObservationRequest& request);
+
+} // namespace elastolearn::io
