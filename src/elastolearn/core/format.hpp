@@ -18,4 +18,8 @@ template <typename T> std::string to_text(const T& v) {
 /// compares (a time step that differs from another by round-off must not print equal).
 std::string to_text_exact(double v);
 
+/// `text` with &, <, >, " and ' replaced by entities: safe as HTML or XML text and as a quoted
+/// attribute value (the report's page, VTU/PVD files).
+std::string html_escape(const std::string& text);
+
 } // namespace elastolearn

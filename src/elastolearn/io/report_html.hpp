@@ -2,6 +2,7 @@
 /// \file report.html of a learning report: the template share/elastolearn/report/report.html
 /// filled with the report's text, tables, plots (PNG, base64) and animation data, three.js and
 /// the viewer script inlined, so that the page is one file that opens offline.
+#include <elastolearn/core/format.hpp> // html_escape
 #include <elastolearn/io/learning_report.hpp>
 
 #include <filesystem>
@@ -15,9 +16,6 @@ struct ReportPlot {
   std::string caption;
   std::string png; ///< the PNG file's bytes
 };
-
-/// `text` with &, <, >, " and ' replaced by entities.
-std::string html_escape(const std::string& text);
 
 /// `text` made safe to inline between <script> tags: every "</" becomes "<\/" (the same string
 /// in JSON and in JavaScript string, regex and template literals).

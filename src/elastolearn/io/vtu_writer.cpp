@@ -1,5 +1,6 @@
 #include <elastolearn/core/atomic_file.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/io/vtu_writer.hpp>
 
 #include <algorithm>
@@ -19,30 +20,6 @@ const char* byte_order() {
   return std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian";
 }
 
-std::string xml_escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-    case '&':
-      out += "&amp;";
-      break;
-    case '<':
-      out += "&lt;";
-      break;
-    case '>':
-      out += "&gt;";
-      break;
-    case '"':
-      out += "&quot;";
-      break;
-    default:
-      out += c;
-    }
-  }
-  return out;
-}
-
 /// One inline binary DataArray: base64 of the UInt64 byte count followed by the raw values, as a
 /// single stream (8 header bytes + the first data byte make 9 = 3×3 bytes, so the two parts can
 /// be encoded separately without padding in between).
@@ -50,7 +27,7 @@ void append_data_array(std::string& out, const char* type, const std::string& na
     const void* values, std::size_t bytes) {
   out += "        <DataArray type=\"";
   out += type;
-  out += "\" Name=\"" + xml_escape(name) + "\"";
+  out += "\" Name=\"" + html_escape(name) + "\"";
   if (components > 1)
     out += " NumberOfComponents=\"" + std::to_string(components) + "\"";
   out += " format=\"binary\">\n          ";
@@ -179,7 +156,7 @@ void write_vtu(const std::filesystem::path& path, ConstRef<Positions> positions,
       + std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(cells.size()) + "\">\n";
   Positions scratch;
   if (!point_data.empty()) {
-    out += "      <PointData Vectors=\"" + xml_escape(point_data.front().name) + "\">\n";
+    out += "      <PointData Vectors=\"" + html_escape(point_data.front().name) + "\">\n";
     for (const VtuField& field : point_data)
       append_positions(out, field.name, field.values, scratch);
     out += "      </PointData>\n";
@@ -208,7 +185,7 @@ void write_pvd(const std::filesystem::path& path, const std::vector<double>& tim
     const std::string file
         = f.parent_path() == base ? f.filename().generic_string() : f.generic_string();
     out += "    <DataSet timestep=\"" + shortest(times[i]) + "\" group=\"\" part=\"0\" file=\""
-        + xml_escape(file) + "\"/>\n";
+        + html_escape(file) + "\"/>\n";
   }
   out += "  </Collection>\n</VTKFile>\n";
   write_text_file_atomic(path, out);
