@@ -8,6 +8,7 @@
 #include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
+#include <elastolearn/io/learned_material.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
@@ -118,6 +119,7 @@ void run_demo(const fs::path& out, double fraction) {
         : io::with_nominal_parameters(nominal_json, result.parameter_fit.fitted, true),
     chosen.correction, { { "demo", true }, { "chosen", learn::to_string(chosen.kind) } },
     learn::training_stretch_range(fitted, chosen.correction) };
+  io::add_network_provenance(learned.training, result);
   io::write_material_file(out / "learned.json", learned);
   std::printf("   chose %s by its error on %s; learned material: %s\n",
       learn::to_string(chosen.kind).c_str(), result.validation_data.c_str(),

@@ -33,9 +33,8 @@ struct LearnOptions {
   bool no_damping = false;
   bool linear_tail = false;
   bool no_parameter_fit = false;
+  std::string network_kind = "auto";
   elastolearn::learn::RecipeOptions recipe;
-  // --network: distil the best RBF into the network correction (docs/learning.md).
-  elastolearn::io::NetworkDistillation network;
 };
 
 /// One line per loop iteration (the learning's progress table).
@@ -86,10 +85,7 @@ void write_report(const LearnOptions& o, std::span<const elastolearn::learn::Mot
   io::LearningReport report;
   report.title = "elastolearn learn " + o.scene;
   const fem::MaterialModel written = io::material_model(learned, o.output);
-  std::vector<io::LabelledModel> extra;
-  if (learned.training.contains("network"))
-    extra.push_back({ "network (distilled from the chosen RBF)", written });
-  io::add_recipe_sections(report, motions, result, extra);
+  io::add_recipe_sections(report, motions, result);
   const material::StretchRange* trained
       = learned.training_stretches ? &*learned.training_stretches : nullptr;
   if (written.correction || truth)
@@ -144,6 +140,7 @@ void run_learn(const LearnOptions& o) {
   loop.rbf.fit_damping = !o.no_damping;
   loop.rbf.quadratic_tail = !o.linear_tail;
   options.fit_parameters = !o.no_parameter_fit;
+  options.network.kind = learn::network_kind_from_name(o.network_kind, "--network-kind");
   options.validate();
 
   const io::LearningInputs inputs { o.scene, o.observations, io::recipe_options_to_json(options) };
@@ -196,8 +193,7 @@ void run_learn(const LearnOptions& o) {
   }
 
   const learn::Candidate& chosen = result.choice();
-  const io::MaterialFile learned = io::learned_material_file(set, o.scene, result, options,
-      o.network, [](const std::string& line) { std::printf("%s\n", line.c_str()); });
+  const io::MaterialFile learned = io::learned_material_file(set, o.scene, result, options);
   io::write_material_file(o.output, learned);
 
   std::printf("validation on %s (error rms, %% of the size %.4g m):\n",
@@ -205,14 +201,22 @@ void run_learn(const LearnOptions& o) {
   for (size_t i = 0; i < result.candidates.size(); ++i) {
     const auto& c = result.candidates[i];
     const std::string name = learn::to_string(c.kind)
-        + (c.iteration >= 0 ? " (iteration " + std::to_string(c.iteration) + ")" : "");
+        + (c.iteration < 0
+                ? ""
+                : (c.kind == learn::CandidateKind::Network ? " (from iteration " : " (iteration ")
+                    + std::to_string(c.iteration) + ")");
     const bool reference = c.kind == learn::CandidateKind::FittedNominal
-        || (c.kind == learn::CandidateKind::Nominal && !o.recipe.fit_parameters);
+        || (c.kind == learn::CandidateKind::Nominal && !options.fit_parameters);
     std::string note;
     if (static_cast<int>(i) == result.chosen)
       note = "   <- chosen";
     else if (c.completed && !c.eligible())
       note = "   (unstable in a larger motion: not eligible)";
+    else if (c.completed && c.kind == learn::CandidateKind::Network && c.teacher == result.chosen)
+      note = "   (" + elastolearn::to_text(-c.gain_over_teacher) + " noise deviations and "
+          + elastolearn::to_text(
+              100 * (c.validation.rms / result.candidates[c.teacher].validation.rms - 1))
+          + " % worse than its teacher: the RBF is kept)";
     else if (c.completed && !reference && c.significance < learn::kSignificance)
       note = "   (" + std::string(c.significance > 0 ? "better" : "no better")
           + " than the fitted nominal by " + elastolearn::to_text(c.significance)
@@ -328,21 +332,22 @@ void add_learn_command(CLI::App& root) {
       "stretches)");
   cmd->add_flag("!--allow-rest-stress", l.rbf.stress_free_rest,
       "let the correction carry a stress at rest (default: N(1, 1, 1) = 0)");
-  cmd->add_flag("--network", o->network.enabled,
-      "distil the learned RBF into the network correction and save that (the RBF goes to "
-      "training.teacher)");
-  cmd->add_option("--network-kind", o->network.kind,
+  auto& n = o->recipe.network;
+  cmd->add_flag("!--no-network", n.enabled,
+      "keep the chosen RBF (default: distil it into the network correction, which replaces it "
+      "when it validates as well; the RBF then goes to training.teacher)");
+  cmd->add_option("--network-kind", o->network_kind,
          "the network: energy (ΔΨ(σ), N its gradient), stress (N per direction), or auto (energy "
          "for an RBF with energy kernels)")
       ->check(CLI::IsMember({ "auto", "energy", "stress" }))
       ->capture_default_str();
-  cmd->add_option("--network-motion-scales", o->network.motion_scales,
+  cmd->add_option("--network-motion-scales", n.motion_scales,
          "motion amplitudes simulated to sample the network's training states")
       ->capture_default_str();
-  cmd->add_option("--network-samples", o->network.samples.recorded_samples,
-         "element states recorded for the network")
+  cmd->add_option(
+         "--network-samples", n.samples.recorded_samples, "element states recorded for the network")
       ->capture_default_str();
-  cmd->add_option("--network-rate-jitter", o->network.samples.rate_jitter,
+  cmd->add_option("--network-rate-jitter", n.samples.rate_jitter,
          "stretch-rate jitter of the network's samples, relative to the RMS recorded rate")
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "no progress line");

@@ -87,7 +87,8 @@ def learn(scene, observations=None, *, output=None, verbose=False, **options):
     full_space, kernels, position_weight, space_time_iterations, regularization,
     reconstruction ("normal_equations" | "lsqr"), frame_stride, fit_damping, quadratic_tail,
     damping_regularization, seed, forward_fit, damping_prior, elastic_prior, kernel_smoothing,
-    energy_kernels, network, network_motion_scales, network_samples.
+    energy_kernels, network (default True: stage 5), network_kind, network_motion_scales,
+    network_samples.
 
     Returns the learned ``Material``; ``material.training["recipe"]`` holds what the recipe
     decided (noise, parameter fit, candidates and their validation errors, the choice).

@@ -116,7 +116,6 @@ Observation observe(const py::handle& trajectory, std::optional<double> visible_
 /// underscores; docs/python.md lists them).
 struct LearnSettings {
   learn::RecipeOptions recipe;
-  io::NetworkDistillation network;
 };
 
 using Setter = std::function<void(LearnSettings&, const py::handle&)>;
@@ -196,13 +195,20 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
         [](S& s, H v) { s.recipe.loop.rbf.epsilon = value<double>(v, "kernel_smoothing"); } },
     { "energy_kernels",
         [](S& s, H v) { s.recipe.loop.rbf.energy_kernels = value<bool>(v, "energy_kernels"); } },
-    { "network", [](S& s, H v) { s.network.enabled = value<bool>(v, "network"); } },
+    { "network", [](S& s, H v) { s.recipe.network.enabled = value<bool>(v, "network"); } },
+    { "network_kind",
+        [](S& s, H v) {
+          s.recipe.network.kind = learn::network_kind_from_name(
+              value<std::string>(v, "network_kind"), "network_kind");
+        } },
     { "network_motion_scales",
         [](S& s, H v) {
-          s.network.motion_scales = value<std::vector<double>>(v, "network_motion_scales");
+          s.recipe.network.motion_scales = value<std::vector<double>>(v, "network_motion_scales");
         } },
     { "network_samples",
-        [](S& s, H v) { s.network.samples.recorded_samples = value<int>(v, "network_samples"); } },
+        [](S& s, H v) {
+          s.recipe.network.samples.recorded_samples = value<int>(v, "network_samples");
+        } },
   };
   return table;
 }
@@ -223,7 +229,6 @@ LearnSettings learn_settings(const py::kwargs& options) {
     it->second(s, v);
   }
   s.recipe.validate();
-  s.network.samples.validate();
   return s;
 }
 
@@ -274,8 +279,7 @@ Material learn(const std::filesystem::path& scene,
     const learn::RecipeResult result
         = learn::learn_material(set.motions, settings.recipe, callbacks);
     if (!result.interrupted) {
-      learned = io::learned_material_file(
-          set, scene.string(), result, settings.recipe, settings.network, say);
+      learned = io::learned_material_file(set, scene.string(), result, settings.recipe);
       if (output)
         io::write_material_file(*output, learned);
     }

@@ -2,7 +2,9 @@
 // learn from a wrong nominal, evaluate on the training scene; bad observations are refused.
 #include <support/cli_runner.hpp>
 
+#include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
+#include <elastolearn/learn/learning_recipe.hpp>
 
 #include <gtest/gtest.h>
 
@@ -58,7 +60,8 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
       run("observe " + path("truth.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code,
       0);
   const auto learned = run("learn " + path("scene.json") + " --observations " + path("obs.h5")
-      + " -o " + path("learned.json") + " --max-iterations 3 --kernels 15 --modes 10 --report "
+      + " -o " + path("learned.json")
+      + " --max-iterations 3 --kernels 15 --modes 10 --network-samples 4000 --report "
       + path("report") + " -q");
   ASSERT_EQ(learned.exit_code, 0) << learned.output;
   EXPECT_NE(learned.output.find("learned material:"), std::string::npos) << learned.output;
@@ -80,12 +83,21 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   ASSERT_GE(candidates.size(), 3u) << recipe.dump(); // nominal, fitted nominal, corrections
   EXPECT_EQ(candidates.at(1).at("kind"), "fitted nominal");
   const auto chosen = recipe.at("chosen").get<size_t>();
+  // The network of the chosen RBF is the last candidate; on these exact data it reproduces its
+  // teacher and replaces it (within kNetworkTolerance of its validation error).
+  const auto& network = candidates.back();
+  ASSERT_EQ(network.at("kind"), "network") << recipe.dump();
+  ASSERT_EQ(chosen, candidates.size() - 1) << recipe.dump();
+  const auto teacher = network.at("teacher").get<size_t>();
+  EXPECT_EQ(candidates.at(teacher).at("iteration"), network.at("iteration"));
   for (const auto& c : candidates) {
     if (c.at("completed").get<bool>()) {
       EXPECT_LE(candidates.at(chosen).at("validation_rms_error_m").get<double>(),
-          c.at("validation_rms_error_m").get<double>());
+          (1 + elastolearn::learn::kNetworkTolerance)
+              * c.at("validation_rms_error_m").get<double>());
     }
   }
+  EXPECT_TRUE(file.training.at("network").at("chosen").get<bool>());
   EXPECT_NE(learned.output.find("<- chosen"), std::string::npos) << learned.output;
   ASSERT_TRUE(file.training_stretches.has_value())
       << "learn records the training motion's stretches";
@@ -93,8 +105,12 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   EXPECT_LT(file.training_stretches->min[2], 1.0) << "and compresses it";
   const auto described = run("info " + path("learned.json"));
   ASSERT_EQ(described.exit_code, 0) << described.output;
-  EXPECT_NE(described.output.find("correction (rbf, 15 centres"), std::string::npos)
-      << described.output;
+  EXPECT_NE(described.output.find("correction (nn (energy"), std::string::npos) << described.output;
+  // The RBF it was distilled from is kept in the file.
+  const auto rbf = elastolearn::io::correction_from_json(
+      elastolearn::io::JsonObject(file.training.at("teacher"), "learned.json", "training.teacher"));
+  EXPECT_NE(elastolearn::io::describe_correction(*rbf).find("rbf, 15 centres"), std::string::npos)
+      << elastolearn::io::describe_correction(*rbf);
   EXPECT_NE(described.output.find("training stretches: s₁ 1.0"), std::string::npos)
       << described.output;
 
@@ -132,7 +148,7 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   // --resume of a finished run changes nothing and says where it resumed.
   const auto resumed = run("learn " + path("scene.json") + " --observations " + path("obs.h5")
       + " -o " + path("learned2.json") + " --checkpoint " + path("learned.json.checkpoint.json")
-      + " --max-iterations 3 --kernels 15 --modes 10 --resume -q");
+      + " --max-iterations 3 --kernels 15 --modes 10 --network-samples 4000 --resume -q");
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
   EXPECT_NE(resumed.output.find("resuming"), std::string::npos);
   const auto again = elastolearn::io::read_material_file(path("learned2.json"));
@@ -164,9 +180,11 @@ TEST_F(CliLearnTest, LearnsOneCorrectionFromATrainingSetOfSeveralMotions) {
     {"scene": "../up.json", "observations": "../up_obs.h5"},
     {"scene": "../down.json", "observations": "../down_obs.h5"}]})");
   const auto learned = run("learn " + path("sets/three.json") + " -o " + path("set.json")
-      + " --max-iterations 2 --kernels 15 --modes 10 -q");
+      + " --max-iterations 2 --kernels 15 --modes 10 --no-network -q");
   ASSERT_EQ(learned.exit_code, 0) << learned.output;
   EXPECT_NE(learned.output.find("validation on motion"), std::string::npos) << learned.output;
+  EXPECT_EQ(learned.output.find("network"), std::string::npos) << "--no-network:\n"
+                                                               << learned.output;
   EXPECT_NE(learned.output.find("down_obs.h5"), std::string::npos) << learned.output;
   const auto file = elastolearn::io::read_material_file(path("set.json"));
   EXPECT_EQ(file.training.at("motions").size(), 3u);

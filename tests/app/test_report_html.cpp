@@ -113,7 +113,8 @@ TEST_F(ReportHtmlTest, LearnAndEvaluateReportsOpenInChromium) {
       run("observe " + path("truth.h5") + " --visible-fraction 0.3 -o " + path("obs.h5")).exit_code,
       0);
   const auto learned = run("learn " + path("scene.json") + " --observations " + path("obs.h5")
-      + " -o " + path("learned.json") + " --max-iterations 2 --kernels 10 --modes 8 --report "
+      + " -o " + path("learned.json")
+      + " --max-iterations 2 --kernels 10 --modes 8 --network-samples 4000 --report "
       + path("learn_report") + " --truth-material " + path("truth.json") + " -q");
   ASSERT_EQ(learned.exit_code, 0) << learned.output;
   EXPECT_NE(
@@ -127,9 +128,15 @@ TEST_F(ReportHtmlTest, LearnAndEvaluateReportsOpenInChromium) {
     EXPECT_TRUE(data.contains(section)) << section;
   EXPECT_TRUE(data.at("correction").at("has_truth").get<bool>());
   const auto& models = data.at("frame_errors")[0].at("models");
-  ASSERT_EQ(models.size(), 3u) << models.dump();
+  // Nominal, fitted nominal, the learned (chosen) and the other of the RBF and its network.
+  ASSERT_EQ(models.size(), 4u) << models.dump();
   EXPECT_EQ(models[0].at("label"), "nominal");
   EXPECT_EQ(models[1].at("label"), "fitted nominal (parameter fit)");
+  const std::string chosen = models[2].at("label"), other = models[3].at("label");
+  EXPECT_EQ(chosen.rfind("learned (chosen: ", 0), 0u) << chosen;
+  EXPECT_TRUE(
+      (chosen.find("network") != std::string::npos) != (other.find("network") != std::string::npos))
+      << chosen << " / " << other;
   EXPECT_TRUE(fs::exists(path("learn_report/summary.json")));
   EXPECT_TRUE(fs::exists(path("learn_report/report.json")));
 

@@ -10,6 +10,7 @@
 #include <support/bar_scene.hpp>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -52,6 +53,7 @@ RecipeOptions small_recipe() {
   o.loop.centres = 15;
   o.loop.pod.max_modes = 10;
   o.loop.forward_fit.max_iterations = 2;
+  o.network.samples.recorded_samples = 4000;
   return o;
 }
 
@@ -139,6 +141,42 @@ TEST(LearningRecipe, ACandidateReplacesTheFittedNominalOnlyBeyondNoise) {
   }
 }
 
+TEST(LearningRecipe, ANetworkReplacesItsTeacherOnlyWhenItValidatesAsWell) {
+  Candidate teacher;
+  teacher.kind = CandidateKind::Loop;
+  teacher.completed = true;
+  teacher.validation.rms = 1e-3;
+  Candidate network;
+  network.kind = CandidateKind::Network;
+  network.teacher = 2;
+  network.completed = true;
+  network.significance = 5;
+  network.validation.rms = 1.05e-3; // 5 % worse than its teacher
+  network.gain_over_teacher = -1; // but within noise
+  EXPECT_TRUE(network_replaces_teacher(network, teacher, true));
+  network.gain_over_teacher = -3; // beyond noise
+  EXPECT_FALSE(network_replaces_teacher(network, teacher, true));
+  // Exact data: the paired test calls any loss significant; within 1 % is as good.
+  network.gain_over_teacher = -std::numeric_limits<double>::infinity();
+  network.validation.rms = 1.005e-3;
+  EXPECT_TRUE(network_replaces_teacher(network, teacher, true));
+  network.validation.rms = 1.02e-3;
+  EXPECT_FALSE(network_replaces_teacher(network, teacher, true));
+  network.validation.rms = 0.9e-3;
+  network.gain_over_teacher = 10;
+  EXPECT_TRUE(network_replaces_teacher(network, teacher, true));
+  // It must beat the fitted nominal like any candidate, and be eligible.
+  network.significance = 1;
+  EXPECT_FALSE(network_replaces_teacher(network, teacher, true));
+  EXPECT_TRUE(network_replaces_teacher(network, teacher, false)) << "no reference to beat";
+  network.significance = 5;
+  network.extrapolation.unstable_samples = 1;
+  EXPECT_FALSE(network_replaces_teacher(network, teacher, true));
+  network.extrapolation.unstable_samples = 0;
+  network.completed = false;
+  EXPECT_FALSE(network_replaces_teacher(network, teacher, true));
+}
+
 TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTheFittedNominal) {
   const Case c;
   const auto motions = c.motions(0);
@@ -151,10 +189,12 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
   // The choice is the lowest validation error among the eligible candidates (completed and
   // stable where a larger motion goes); the nominals are always eligible.
   EXPECT_TRUE(r.choice().eligible());
+  // A network replaces its teacher within kNetworkTolerance of its validation error.
+  const double slack = r.choice().kind == CandidateKind::Network ? 1 + kNetworkTolerance : 1;
   for (const Candidate& k : r.candidates) {
     if (k.eligible()
         && (k.kind == CandidateKind::FittedNominal || k.significance >= kSignificance)) {
-      EXPECT_LE(r.choice().validation.rms, k.validation.rms);
+      EXPECT_LE(r.choice().validation.rms, slack * k.validation.rms);
     }
     if (!k.correction) {
       EXPECT_EQ(k.extrapolation.samples, 0) << "the nominals are not checked";
@@ -163,6 +203,18 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);
+  // Stage 5 distilled the chosen RBF and validated the network as the last candidate; on this
+  // noise-free case it predicts the held-out data as well as its teacher and replaces it.
+  ASSERT_TRUE(r.network.has_value());
+  const Candidate& network = r.candidates.back();
+  EXPECT_EQ(network.kind, CandidateKind::Network);
+  ASSERT_GE(network.teacher, 2);
+  const Candidate& teacher = r.candidates[static_cast<size_t>(network.teacher)];
+  EXPECT_NE(dynamic_cast<const material::RbfCorrection*>(teacher.correction.get()), nullptr);
+  EXPECT_EQ(network.iteration, teacher.iteration);
+  EXPECT_LT(r.network->validation_rms, 0.05 * r.network->teacher_rms) << "distillation error";
+  EXPECT_EQ(r.choice().kind, CandidateKind::Network);
+  EXPECT_LE(network.validation.rms, (1 + kNetworkTolerance) * teacher.validation.rms);
   // 60 frames: the last 12 held out, 48 trained on.
   EXPECT_EQ(r.training_frames, 48);
   EXPECT_EQ(r.validation_frames, 12);

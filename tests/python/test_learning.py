@@ -75,7 +75,9 @@ def test_learn_fits_the_material_and_evaluate_measures_it(small_scene, truth, tm
     errors = [c["validation_rms_error_m"] for c in recipe["candidates"] if contends(c)]
     chosen = recipe["candidates"][recipe["chosen"]]
     assert chosen["eligible"]
-    assert chosen["validation_rms_error_m"] == min(errors)
+    # A network replaces its teacher within 1 % of its validation error (stage 5).
+    slack = 1.01 if chosen["kind"] == "network" else 1.0
+    assert chosen["validation_rms_error_m"] <= slack * min(errors)
     assert learned.training["options"]["loop"]["max_iterations"] == 1
     # What was written is what was returned.
     assert el.load_material(tmp_path / "learned.json").to_json() == learned.to_json()

@@ -13,66 +13,39 @@ namespace elastolearn::io {
 
 namespace {
 
-/// Distil `teacher` into the network correction on states of the training scene at several
-/// motion amplitudes; report the fit through `message`; the network's provenance as JSON.
-std::shared_ptr<const material::Correction> distil_network(const NetworkDistillation& o,
-    const sim::Scene& scene, const material::Correction& teacher,
-    const std::function<void(const std::string&)>& message, nlohmann::json& provenance) {
-  const auto start = Clock::now();
-  learn::DistillationSampleReport sampled;
-  const learn::StressSamples samples
-      = learn::distillation_samples(scene, o.motion_scales, teacher, o.samples, &sampled);
-  const double seconds_sampling = seconds_since(start);
-  if (message)
-    for (const auto& m : sampled.messages)
-      message("network samples: " + m);
-  const auto* rbf = dynamic_cast<const material::RbfCorrection*>(&teacher);
-  const bool energy
-      = o.kind == "energy" || (o.kind == "auto" && rbf && rbf->parameters().energy_kernels);
-  learn::NnDistillationOptions training
-      = energy ? learn::energy_distillation_options() : o.training;
-  if (energy && rbf) // the teacher's tails as the energy's polynomial (docs/learning.md)
-    training.energy_polynomial = learn::rbf_energy_polynomial(*rbf);
-  const learn::NnDistillationResult r = learn::distill_nn_correction(samples, training);
-  if (message) {
-    char line[512];
-    std::snprintf(line, sizeof line,
-        "network (%s): %d + %d states (%d recorded of %ld, %d jittered; %d/%zu motions "
-        "completed), %d epochs; RMS relative to the RBF teacher: training %.2f %%, validation "
-        "%.2f %% (teacher RMS %.4g Pa); sampling %.1f s, training %.1f s",
-        material::to_string(training.kind).c_str(), r.training_samples, r.validation_samples,
-        sampled.recorded, sampled.states_seen, sampled.jittered, sampled.scenes_completed,
-        o.motion_scales.size(), r.training.epochs, 100 * r.relative_training_rms(),
-        100 * r.relative_validation_rms(), r.target_rms, seconds_sampling, r.training.seconds);
-    message(line);
-  }
-  provenance = { { "teacher", correction_to_json(teacher) },
-    { "network",
-        { { "kind", material::to_string(training.kind) }, { "motion_scales", o.motion_scales },
-            { "recorded_states", sampled.recorded }, { "jittered_states", sampled.jittered },
-            { "training_states", r.training_samples },
-            { "validation_states", r.validation_samples }, { "epochs", r.training.epochs },
-            { "training_rms_pa", r.training_rms }, { "validation_rms_pa", r.validation_rms },
-            { "teacher_rms_pa", r.target_rms }, { "seconds_sampling", seconds_sampling },
-            { "seconds_training", r.training.seconds } } } };
-  return std::make_shared<const material::NnCorrection>(
-      learn::with_teacher_damping(r.correction, teacher));
+nlohmann::json finite_or_null(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nullptr;
+}
+
+/// Stage 5's distillation, as the learned file's training.network.
+nlohmann::json network_to_json(const learn::NetworkDistillation& d, bool chosen) {
+  return { { "kind", material::to_string(d.kind) }, { "chosen", chosen },
+    { "motion_amplitudes", d.motions }, { "recorded_states", d.sampled.recorded },
+    { "jittered_states", d.sampled.jittered }, { "training_states", d.training_states },
+    { "validation_states", d.validation_states }, { "epochs", d.epochs },
+    { "training_rms_pa", d.training_rms }, { "validation_rms_pa", d.validation_rms },
+    { "teacher_rms_pa", d.teacher_rms }, { "seconds_sampling", d.seconds_sampling },
+    { "seconds_training", d.seconds_training } };
 }
 
 } // namespace
 
 nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
   nlohmann::json candidates = nlohmann::json::array();
-  for (const auto& c : r.candidates)
+  for (const auto& c : r.candidates) {
     candidates.push_back({ { "kind", learn::to_string(c.kind) }, { "iteration", c.iteration },
-        { "completed", c.completed }, { "training_rms_error_m", c.training.rms },
+        { "completed", c.completed }, { "training_rms_error_m", finite_or_null(c.training.rms) },
         { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
         { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr },
         { "extrapolation_unstable_samples", c.extrapolation.unstable_samples },
         { "extrapolation_samples", c.extrapolation.samples }, { "eligible", c.eligible() },
-        // null: infinite (noise σ = 0 and it is better than the reference)
-        { "significance",
-            std::isfinite(c.significance) ? nlohmann::json(c.significance) : nullptr } });
+        // null: infinite (noise σ = 0), its sign that of the validation errors' difference
+        { "significance", finite_or_null(c.significance) } });
+    if (c.kind == learn::CandidateKind::Network) {
+      candidates.back()["teacher"] = c.teacher;
+      candidates.back()["gain_over_teacher"] = finite_or_null(c.gain_over_teacher);
+    }
+  }
   return { { "noise_sigma_m", r.noise.sigma }, { "noise_estimated", r.noise.estimated },
     { "smoothing_rms_change_m", r.noise.smoothing_residual },
     { "training_frames", r.training_frames }, { "validation_frames", r.validation_frames },
@@ -88,9 +61,19 @@ nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
     { "chosen_kind", learn::to_string(r.choice().kind) } };
 }
 
+void add_network_provenance(nlohmann::json& training, const learn::RecipeResult& result) {
+  if (!result.network)
+    return;
+  const learn::Candidate& chosen = result.choice();
+  const bool network = chosen.kind == learn::CandidateKind::Network;
+  training["network"] = network_to_json(*result.network, network);
+  if (network) // the RBF, so that nothing is lost
+    training["teacher"]
+        = correction_to_json(*result.candidates.at(static_cast<size_t>(chosen.teacher)).correction);
+}
+
 MaterialFile learned_material_file(const TrainingSet& set, const std::string& source,
-    const learn::RecipeResult& result, const learn::RecipeOptions& options,
-    const NetworkDistillation& network, const std::function<void(const std::string&)>& message) {
+    const learn::RecipeResult& result, const learn::RecipeOptions& options) {
   const learn::Candidate& chosen = result.choice();
   const sim::Scene& scene = set.motions.front().scene;
   double loop_seconds = 0;
@@ -119,13 +102,7 @@ MaterialFile learned_material_file(const TrainingSet& set, const std::string& so
     { "best_rms_error_m", result.loop.best_error }, { "options", recipe_options_to_json(options) },
     { "recipe", recipe_result_to_json(result) }, { "seconds", result.seconds },
     { "loop_seconds", loop_seconds }, { "history", history } };
-  if (network.enabled && chosen.correction) {
-    nlohmann::json provenance;
-    learned.correction
-        = distil_network(network, training_scene, *chosen.correction, message, provenance);
-    learned.training["teacher"] = provenance["teacher"]; // the RBF, so that nothing is lost
-    learned.training["network"] = provenance["network"];
-  }
+  add_network_provenance(learned.training, result);
   return learned;
 }
 

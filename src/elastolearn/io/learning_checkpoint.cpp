@@ -137,7 +137,13 @@ nlohmann::json recipe_options_to_json(const learn::RecipeOptions& o) {
     { "parameter_fit",
         { { "parameters", fitted }, { "max_iterations", o.parameter_fit.max_iterations },
             { "frames", o.parameter_fit.frames }, { "tolerance", o.parameter_fit.tolerance } } },
-    { "loop", learning_options_to_json(o.loop) } };
+    { "loop", learning_options_to_json(o.loop) },
+    { "network",
+        { { "enabled", o.network.enabled },
+            { "kind", o.network.kind ? material::to_string(*o.network.kind) : "auto" },
+            { "motion_scales", o.network.motion_scales },
+            { "recorded_samples", o.network.samples.recorded_samples },
+            { "seed", o.network.samples.seed } } } };
 }
 
 namespace {

@@ -95,6 +95,17 @@ void add_recipe_sections(LearningReport& report, std::span<const learn::Motion> 
     const auto& chosen = candidates[static_cast<std::size_t>(result.chosen)];
     add_model("learned (chosen: " + chosen.label + ")", chosen);
   }
+  // The RBF and its distilled network both, whichever was chosen.
+  for (std::size_t i = 0; i < result.candidates.size(); ++i) {
+    const learn::Candidate& c = result.candidates[i];
+    if (c.kind != learn::CandidateKind::Network || c.teacher < 0)
+      continue;
+    const auto teacher = static_cast<std::size_t>(c.teacher);
+    if (static_cast<int>(teacher) != result.chosen)
+      add_model("RBF (" + candidates[teacher].label + ")", candidates[teacher]);
+    if (static_cast<int>(i) != result.chosen)
+      add_model(candidates[i].label, candidates[i]);
+  }
   for (const ObservedRun& r : extras)
     add_model(r.label, r);
   if (!report.data.contains("frame_errors"))

@@ -62,6 +62,8 @@ std::string candidate_label(const learn::Candidate& c) {
     return "loop " + std::to_string(c.iteration);
   case learn::CandidateKind::ForwardFit:
     return "forward fit " + std::to_string(c.iteration);
+  case learn::CandidateKind::Network:
+    return "network of iteration " + std::to_string(c.iteration);
   }
   return learn::to_string(c.kind);
 }

@@ -27,6 +27,8 @@ std::string to_string(CandidateKind kind) {
     return "fitted nominal";
   case CandidateKind::Loop:
     return "loop";
+  case CandidateKind::Network:
+    return "network";
   case CandidateKind::ForwardFit:
     return "forward fit";
   }
@@ -47,6 +49,7 @@ void RecipeOptions::validate() const {
     throw InputError("learn.validation_fraction", "must be in (0, 0.5)");
   parameter_fit.validate();
   loop.validate();
+  network.validate();
 }
 
 fem::MaterialModel RecipeResult::material(const fem::MaterialModel& given_nominal) const {
@@ -225,6 +228,25 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0, do
 
 } // namespace
 
+double paired_significance(const VecX& r, const VecX& c, const VecX& o, double sigma) {
+  const double gain = (r - o).squaredNorm() - (c - o).squaredNorm();
+  const double spread = 2 * sigma * (c - r).norm();
+  if (spread > 0)
+    return gain / spread;
+  if (gain == 0)
+    return 0;
+  return gain > 0 ? std::numeric_limits<double>::infinity()
+                  : -std::numeric_limits<double>::infinity();
+}
+
+bool network_replaces_teacher(
+    const Candidate& network, const Candidate& teacher, bool has_reference) {
+  const bool as_good = network.gain_over_teacher > -kSignificance
+      || network.validation.rms <= (1 + kNetworkTolerance) * teacher.validation.rms;
+  return network.kind == CandidateKind::Network && network.eligible() && teacher.completed
+      && (!has_reference || network.significance >= kSignificance) && as_good;
+}
+
 int choose_candidate(std::vector<Candidate>& candidates, std::span<const VecX> predictions,
     const VecX& observed, int reference, double sigma) {
   int chosen = -1;
@@ -235,15 +257,9 @@ int choose_candidate(std::vector<Candidate>& candidates, std::span<const VecX> p
     Candidate& c = candidates[i];
     if (!c.completed)
       continue;
-    if (ref && static_cast<int>(i) != reference) {
-      const VecX& r = predictions[static_cast<size_t>(reference)];
-      const VecX& p = predictions[i];
-      const double gain = (r - observed).squaredNorm() - (p - observed).squaredNorm();
-      const double spread = 2 * sigma * (p - r).norm();
-      c.significance = spread > 0 ? gain / spread
-          : gain > 0              ? std::numeric_limits<double>::infinity()
-                                  : 0;
-    }
+    if (ref && static_cast<int>(i) != reference)
+      c.significance = paired_significance(
+          predictions[static_cast<size_t>(reference)], predictions[i], observed, sigma);
     const bool passes = !ref || static_cast<int>(i) == reference || c.significance >= kSignificance;
     if (c.eligible() && passes
         && (chosen < 0
@@ -367,7 +383,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // Stage 4: every candidate on the held-out data.
   std::vector<VecX> predictions; // per candidate, at_observed_vertices
   auto add = [&](CandidateKind kind, int iteration,
-                 std::shared_ptr<const material::RbfCorrection> correction, double training) {
+                 std::shared_ptr<const material::Correction> correction, double training) {
     Candidate c;
     c.kind = kind;
     c.iteration = iteration;
@@ -416,12 +432,38 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // A resumed run knows the earlier iterations only through the best one.
   if (result.loop.best && tried.find(result.loop.best_iteration) == tried.end())
     add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best, result.loop.best_error);
+  const int reference = options.fit_parameters ? 1 : 0;
+  const VecX observed = flat_positions(split.validation.observed);
   result.chosen
-      = choose_candidate(result.candidates, predictions, flat_positions(split.validation.observed),
-          options.fit_parameters ? 1 : 0, result.noise.sigma);
+      = choose_candidate(result.candidates, predictions, observed, reference, result.noise.sigma);
   if (result.chosen < 0)
     throw InputError(split.validation.name,
         "no candidate, not even the nominal material, simulates the held-out data");
+
+  // Stage 5: the chosen RBF distilled into the network, on the first training motion (its
+  // material is the fitted nominal), validated like the others.
+  const auto* teacher
+      = dynamic_cast<const material::RbfCorrection*>(result.choice().correction.get());
+  if (options.network.enabled && teacher) {
+    const int t = result.chosen;
+    result.network = distil_network(split.training.front().scene, *teacher, options.network);
+    say(callbacks, result.network->describe());
+    add(CandidateKind::Network, result.candidates[static_cast<size_t>(t)].iteration,
+        result.network->correction, std::numeric_limits<double>::quiet_NaN());
+    Candidate& network = result.candidates.back();
+    network.teacher = t;
+    if (network.completed) {
+      const bool has_reference = result.candidates[static_cast<size_t>(reference)].completed;
+      if (has_reference)
+        network.significance = paired_significance(predictions[static_cast<size_t>(reference)],
+            predictions.back(), observed, result.noise.sigma);
+      network.gain_over_teacher = paired_significance(
+          predictions[static_cast<size_t>(t)], predictions.back(), observed, result.noise.sigma);
+      if (network_replaces_teacher(
+              network, result.candidates[static_cast<size_t>(t)], has_reference))
+        result.chosen = static_cast<int>(result.candidates.size()) - 1;
+    }
+  }
   result.seconds = seconds_since(start);
   return result;
 }

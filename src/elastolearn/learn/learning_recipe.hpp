@@ -12,12 +12,17 @@
 ///      correction of the loop and of the forward fit) simulates the held-out data; among those
 ///      whose material stays stable where a larger motion goes and that beat the fitted nominal
 ///      by more than noise could (z ≥ kSignificance), the one with the smallest RMS error there
-///      is the result; the fitted nominal if none.
+///      is the result; the fitted nominal if none;
+///   5. network: a chosen correction is distilled into the network correction
+///      (network_distillation.hpp), validated the same way, and replaces its teacher when it is
+///      eligible, beats the fitted nominal by kSignificance, and is as good as its teacher
+///      (network_replaces_teacher); it is several times cheaper to evaluate.
 /// The validation choice is what makes the result never worse than fitting parameters on data
 /// nobody tuned the recipe for: the fitted nominal is always a candidate.
 #include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/motion.hpp>
+#include <elastolearn/learn/network_distillation.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/observe/observation.hpp>
@@ -40,6 +45,8 @@ struct RecipeOptions {
   ParameterFitOptions parameter_fit;
   /// Stage 3 (the loop's forward_fit.max_iterations steps follow it).
   LearningOptions loop;
+  /// Stage 5.
+  NetworkOptions network;
   /// The recipe's defaults: a parameter fit of ≤ 10 Levenberg–Marquardt iterations and 3
   /// forward-fit steps after the loop.
   RecipeOptions();
@@ -55,22 +62,30 @@ struct NoiseLevel {
 };
 
 /// What the validation compares.
-enum class CandidateKind { Nominal, FittedNominal, Loop, ForwardFit };
+enum class CandidateKind { Nominal, FittedNominal, Loop, ForwardFit, Network };
 std::string to_string(CandidateKind kind);
 
 struct Candidate {
   CandidateKind kind = CandidateKind::Nominal;
-  int iteration = -1; ///< the loop's (or forward fit's) iteration; −1 for the nominals
-  /// The material's correction (null for the nominals); its elastic model is the fitted nominal's
-  /// except for CandidateKind::Nominal.
-  std::shared_ptr<const material::RbfCorrection> correction;
+  /// The loop's (or forward fit's) iteration, a network's teacher's; −1 for the nominals.
+  int iteration = -1;
+  /// The material's correction (null for the nominals; an RBF, or for CandidateKind::Network the
+  /// network correction); its elastic model is the fitted nominal's except for
+  /// CandidateKind::Nominal.
+  std::shared_ptr<const material::Correction> correction;
+  /// CandidateKind::Network: the index of the candidate it was distilled from, and its gain over
+  /// it in noise standard deviations (paired_significance; negative: worse than its teacher).
+  int teacher = -1;
+  double gain_over_teacher = 0;
   bool completed = false; ///< the validation simulation completed
   ErrorSummary validation; ///< at the held-out observations [m]
   /// Its material's stability (material_stability) at the stretches of its validation run
   /// amplified to σ^1.5 (amplified_stretches): where a larger motion of the same kind goes. Not
   /// checked (all stable) for the nominals.
   StabilityReport extrapolation;
-  ErrorSummary training; ///< at the training observations [m] (the loop's own signal)
+  /// At the training observations [m] (the loop's own signal); NaN for a network (not simulated
+  /// on the training data).
+  ErrorSummary training;
   /// Its improvement on the reference (the fitted nominal, or the given one without a fit) in
   /// standard deviations of what noise alone would give: z = (‖r − o‖² − ‖c − o‖²) / (2σ‖c − r‖)
   /// over the held-out observations o, with r, c the reference's and this candidate's predictions
@@ -95,6 +110,8 @@ struct RecipeResult {
   material::ElasticModelType nominal_type {};
   fem::MaterialModel fitted_nominal; ///< the nominal material with the fitted parameters
   LearningState loop; ///< stage 3's final state (history, best)
+  /// Stage 5's distillation, if it ran (its candidate is the last one).
+  std::optional<NetworkDistillation> network;
   std::vector<Candidate> candidates;
   int chosen = -1; ///< index into candidates
   double seconds = 0;
@@ -122,6 +139,25 @@ struct RecipeResume {
 /// constant Rayleigh damping (fit-parameters needs both).
 NominalParameters nominal_parameters_of(
     const fem::MaterialModel& material, material::ElasticModelType& type);
+
+/// A paired test of candidate predictions `c` against reference predictions `r` of the
+/// observations `o` with noise σ per coordinate: z = (‖r − o‖² − ‖c − o‖²) / (2σ‖c − r‖), the
+/// gain in standard deviations of what noise alone would give (the noise term of the difference,
+/// −2 nᵀ(c − r), has standard deviation 2σ‖c − r‖). ±∞ (0 if c = r) when σ‖c − r‖ = 0.
+double paired_significance(const VecX& r, const VecX& c, const VecX& o, double sigma);
+
+/// How much larger than its teacher's a network's validation RMS may be and still count as
+/// "as good", whatever the noise: with exact data (σ → 0) the paired test calls any difference
+/// significant, and a network that reproduces its teacher to a fraction of a per cent (its
+/// distillation error) predicts the held-out data within rounding of the teacher's prediction.
+inline constexpr double kNetworkTolerance = 0.01;
+
+/// Stage 5's decision: a network candidate replaces its teacher when it is eligible, passes the
+/// reference test (significance ≥ kSignificance, unless `has_reference` is false) and is as good
+/// as its teacher: not worse by kSignificance noise deviations, or its validation RMS within
+/// (1 + kNetworkTolerance) of the teacher's.
+bool network_replaces_teacher(
+    const Candidate& network, const Candidate& teacher, bool has_reference);
 
 /// Stage 4's choice. `predictions[i]` is candidate i's prediction of the held-out observations
 /// `observed` (both flat: frame, observed vertex, xyz; empty if it did not complete), `reference`
