@@ -137,10 +137,24 @@ void run_demo(const fs::path& out, double fraction) {
   const auto e_fitted = learn::as_percent_of(learn::position_error(test_fitted, test_truth), size);
   const auto e_learned
       = learn::as_percent_of(learn::position_error(test_learned, test_truth), size);
+  // With a network chosen, its RBF teacher beside it.
+  std::vector<VecX> test_teacher;
+  bool teacher_completed = false;
+  if (chosen.kind == learn::CandidateKind::Network) {
+    sim::Scene s = with_material(test, result.fitted_nominal);
+    s.material.correction = result.candidates.at(static_cast<size_t>(chosen.teacher)).correction;
+    sim::ForwardRun run = sim::simulate_positions(s);
+    teacher_completed = run.completed;
+    test_teacher = std::move(run.positions);
+  }
   std::printf("\n   %-16s %10s %10s\n", "model", "err_L [%]", "mean [%]");
   std::printf("   %-16s %10.3f %10.4f\n   %-16s %10.3f %10.4f\n   %-16s %10.4f %10.5f\n", "nominal",
       e_nominal.max, e_nominal.mean, "fitted nominal", e_fitted.max, e_fitted.mean, "learned",
       e_learned.max, e_learned.mean);
+  if (teacher_completed) {
+    const auto e = learn::as_percent_of(learn::position_error(test_teacher, test_truth), size);
+    std::printf("   %-16s %10.4f %10.5f   (the network's RBF teacher)\n", "RBF", e.max, e.mean);
+  }
   if (learned.training_stretches) {
     learn::StretchCoverage coverage(test.mesh, learned.training_stretches);
     for (const auto& x : test_learned)
@@ -157,10 +171,13 @@ void run_demo(const fs::path& out, double fraction) {
   report.title = "elastolearn demo: a bar's material learned from "
       + std::to_string(observed.num_observed()) + " observed vertices";
   io::add_recipe_sections(report, motions, result);
-  io::add_test_motion_sections(report, "test motion (thrown upward)", test, test_truth,
-      { { "nominal", &test_nominal }, { "fitted nominal (parameter fit)", &test_fitted },
-          { "learned", &test_learned } },
-      "learned");
+  std::vector<io::LabelledRun> test_runs { { "nominal", &test_nominal },
+    { "fitted nominal (parameter fit)", &test_fitted },
+    { "learned (" + learn::to_string(chosen.kind) + ")", &test_learned } };
+  if (!test_teacher.empty())
+    test_runs.push_back({ "the network's RBF teacher", &test_teacher, teacher_completed });
+  io::add_test_motion_sections(
+      report, "test motion (thrown upward)", test, test_truth, test_runs, test_runs[2].label);
   const fem::MaterialModel learned_model = result.material(train.material);
   io::add_correction_section(report, learned_model, &truth,
       learned.training_stretches ? &*learned.training_stretches : nullptr);
