@@ -6,10 +6,10 @@
 
 #include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/io/evaluation_report.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_evaluation.hpp>
 #include <elastolearn/io/material_file.hpp>
-#include <elastolearn/io/report_builder.hpp>
 #include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
@@ -35,61 +35,6 @@ struct EvaluateOptions {
 /// The progress display of a run labelled `label` (none with --quiet).
 ProgressCallback progress(const EvaluateOptions& opts, const std::string& label) {
   return opts.quiet ? ProgressCallback {} : terminal_progress(label);
-}
-
-/// The --report folder: error per frame of the nominal, the fitted-parameter baseline (the
-/// learned file's nominal without its correction), the learned material and, for a network, its
-/// RBF teacher; the animation of the true and learned motions; the learned correction's curves.
-void write_report(const EvaluateOptions& opts, const io::MaterialFile& file,
-    const sim::Scene& learned_scene, const std::vector<VecX>& truth, const io::ModelRun& nominal,
-    const io::ModelRun& learned, const fem::MaterialModel* true_material, nlohmann::json summary) {
-  std::vector<io::ModelRun> extra;
-  if (file.correction) {
-    sim::Scene fitted = learned_scene;
-    fitted.material.correction = nullptr;
-    extra.push_back(
-        { "fitted nominal", "the learned file's nominal without its correction", {}, {}, {}, {} });
-    io::simulate_model(fitted, progress(opts, extra.back().label), "", extra.back());
-  }
-  if (file.training.contains("teacher")) {
-    sim::Scene teacher = learned_scene;
-    teacher.material.correction = io::correction_from_json(
-        io::JsonObject(file.training.at("teacher"), opts.material, "training.teacher"));
-    extra.push_back({ "learned RBF (the network's teacher)",
-        io::describe_material_model(teacher.material), {}, {}, {}, {} });
-    io::simulate_model(teacher, progress(opts, extra.back().label), "", extra.back());
-  }
-  std::vector<io::LabelledRun> runs = { { "nominal", &nominal.frames, nominal.report.completed } };
-  for (const io::ModelRun& r : extra)
-    runs.push_back({ r.label, &r.frames, r.report.completed });
-  const std::string learned_label
-      = "learned" + (file.correction ? " (" + io::describe_correction(*file.correction) + ")" : "");
-  runs.push_back({ learned_label, &learned.frames, learned.report.completed });
-
-  io::LearningReport report;
-  report.title = "elastolearn evaluate " + opts.scene + " --material " + opts.material;
-  report.size = learned_scene.mesh.bounding_box_diagonal();
-  io::add_test_motion_sections(
-      report, "test motion " + opts.scene, learned_scene, truth, runs, learned_label);
-  const material::StretchRange* trained
-      = file.training_stretches ? &*file.training_stretches : nullptr;
-  if (file.correction || true_material)
-    io::add_correction_section(report, learned_scene.material, true_material, trained);
-  if (!true_material)
-    report.notes.push_back("No true material given (--truth-material): the correction is shown "
-                           "without the truth's.");
-  summary["command"] = "evaluate";
-  summary["scene"] = opts.scene;
-  summary["material"] = opts.material;
-  summary["truth"] = opts.truth;
-  for (io::ModelRun& r : extra) {
-    r.error = learn::position_error(r.frames, truth);
-    r.percent = learn::as_percent_of(r.error, report.size);
-    summary["others"][r.label] = io::model_run_to_json(r);
-  }
-  report.summary = summary;
-  std::printf("%s\n",
-      io::describe_report(opts.report, io::write_learning_report(opts.report, report)).c_str());
 }
 
 void run_evaluate(const EvaluateOptions& opts) {
@@ -119,8 +64,6 @@ void run_evaluate(const EvaluateOptions& opts) {
   const sim::Scene& scene = file.scene;
   const io::MaterialFile material_file = io::read_material_file(opts.material);
   const std::vector<VecX> truth = io::read_truth_trajectory(opts.truth, scene);
-  sim::Scene learned_scene = scene;
-  learned_scene.material = io::material_model(material_file, opts.material);
   std::optional<fem::MaterialModel> true_material;
   if (!opts.truth_material.empty()) {
     true_material
@@ -171,9 +114,11 @@ void run_evaluate(const EvaluateOptions& opts) {
     std::printf("report: %s\n", opts.json.c_str());
   }
   if (!opts.report.empty()) {
-    write_report(opts, material_file, learned_scene, truth, e.nominal, e.learned,
-        true_material ? &*true_material : nullptr,
-        io::evaluation_to_json(e, scene, opts.scene, opts.material, opts.truth));
+    const io::EvaluationReportInputs inputs { &scene, opts.scene, &material_file, opts.material,
+      &truth, opts.truth, true_material ? &*true_material : nullptr };
+    const io::ReportOutcome written = io::write_evaluation_report(opts.report, inputs, e,
+        [&opts](const std::string& label) { return progress(opts, label); });
+    std::printf("%s\n", io::describe_report(opts.report, written).c_str());
   }
   for (const io::ModelRun* run : { &e.nominal, &e.learned }) {
     if (!run->report.completed) {

@@ -10,6 +10,7 @@
 #include <elastolearn/io/learned_material.hpp>
 #include <elastolearn/io/learning_checkpoint.hpp>
 #include <elastolearn/io/learning_report.hpp>
+#include <elastolearn/io/learning_run_report.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/report_builder.hpp>
 #include <elastolearn/io/report_resources.hpp>
@@ -74,44 +75,12 @@ void print_iteration(const elastolearn::learn::IterationRecord& r, double diagon
   std::fflush(stdout);
 }
 
-/// The --report folder: the recipe's run on the first motion, the written material's correction
-/// (against the truth if given), the learned file's provenance.
-void write_report(const LearnOptions& o, std::span<const elastolearn::learn::Motion> motions,
-    const elastolearn::learn::RecipeResult& result, const elastolearn::io::MaterialFile& learned,
-    const elastolearn::fem::MaterialModel* truth) {
-  using namespace elastolearn;
-  std::printf("report: simulating the candidates on %s for the plots\n", motions[0].name.c_str());
-  std::fflush(stdout);
-  io::LearningReport report;
-  report.title = "elastolearn learn " + o.scene;
-  const fem::MaterialModel written = io::material_model(learned, o.output);
-  io::add_recipe_sections(report, motions, result);
-  const material::StretchRange* trained
-      = learned.training_stretches ? &*learned.training_stretches : nullptr;
-  if (written.correction || truth)
-    io::add_correction_section(report, written, truth, trained);
-  if (!truth)
-    report.notes.push_back("No true material given (--truth-material): the correction is shown "
-                           "without the truth's.");
-  report.summary = { { "command", "learn" }, { "scene", o.scene }, { "learned", o.output },
-    { "truth_material",
-        o.truth_material.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.truth_material) },
-    { "size_m", report.size }, { "recipe", learned.training.at("recipe") },
-    { "best_iteration", result.loop.best_iteration }, { "seconds", result.seconds } };
-  if (learned.training.contains("network"))
-    report.summary["network"] = learned.training.at("network");
-  report.provenance = learned.training;
-  std::printf(
-      "%s\n", io::describe_report(o.report, io::write_learning_report(o.report, report)).c_str());
-}
-
 void run_learn(const LearnOptions& o) {
   using namespace elastolearn;
   if (!o.truth_material.empty() && o.report.empty())
     throw InputError("--truth-material", "is used by the report only: give --report DIR too");
   const io::TrainingSet set = io::read_learning_data(o.scene, o.observations, "--observations");
-  const std::filesystem::path checkpoint
-      = o.checkpoint.empty() ? o.output + ".checkpoint.json" : o.checkpoint;
+  const std::filesystem::path checkpoint = io::learning_checkpoint_path(o.output, o.checkpoint);
   {
     // With --resume the checkpoint is read and then rewritten on purpose: it is an output only.
     std::vector<CommandOutput> outputs
@@ -146,10 +115,7 @@ void run_learn(const LearnOptions& o) {
   const io::LearningInputs inputs { o.scene, o.observations, io::recipe_options_to_json(options) };
   std::optional<learn::RecipeResume> resume;
   if (o.resume) {
-    if (!std::filesystem::exists(checkpoint))
-      throw InputError(
-          checkpoint.string(), "no checkpoint to resume from (run without --resume first)");
-    resume = io::read_learning_checkpoint(checkpoint, inputs);
+    resume = io::resume_learning_checkpoint(checkpoint, inputs, "--resume");
     std::printf("resuming from %s at iteration %d\n", checkpoint.string().c_str(),
         resume->loop.next_iteration);
   }
@@ -234,8 +200,14 @@ void run_learn(const LearnOptions& o) {
   if (learned.training_stretches)
     std::printf("training stretches: %s (simulate and evaluate note where a motion leaves them)\n",
         learn::describe(*learned.training_stretches).c_str());
-  if (!o.report.empty())
-    write_report(o, motions, result, learned, truth ? &*truth : nullptr);
+  if (!o.report.empty()) {
+    std::printf("report: simulating the candidates on %s for the plots\n", motions[0].name.c_str());
+    std::fflush(stdout);
+    const io::LearningRunReportInputs report { o.scene, o.output, motions, &result, &learned,
+      truth ? &*truth : nullptr, o.truth_material };
+    std::printf("%s\n",
+        io::describe_report(o.report, io::write_learning_run_report(o.report, report)).c_str());
+  }
 }
 
 void add_learn_command(CLI::App& root) {

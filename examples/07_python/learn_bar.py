@@ -4,12 +4,15 @@
 Run from the repository root after building (docs/python.md):
 
     PYTHONPATH=build/python /usr/bin/python3 examples/07_python/learn_bar.py [--quick] [--out DIR]
+        [--dropout P]
 
 1. load the training and test scenes of examples/04_learning (nominal: corotated, E = 1.75 MPa);
 2. simulate the "real" object (truth.json: neo-Hookean, E = 1 MPa) on both motions;
-3. observe 13 % of the training motion's surface vertices, with 0.1 mm of noise;
+3. observe 13 % of the training motion's surface vertices, with 0.1 mm of noise (and, with
+   --dropout P, a fraction P of the markers lost in occlusion bursts);
 4. learn a material from them with the one recipe (docs/learning_recipe.md);
-5. evaluate nominal and learned material on the test motion (err_L, paper 000 Table 1);
+5. evaluate nominal and learned material on the test motion (err_L, paper 000 Table 1), with a
+   report (DIR/report/report.html: plots and an animation; docs/report.md);
 6. compare the stresses of the three materials along a uniaxial stretch within the training
    motion's stretches.
 
@@ -32,6 +35,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="a shorter recipe (smoke test)")
     parser.add_argument("--out", default="elastolearn-python", help="output folder")
+    parser.add_argument("--dropout", type=float, default=0.0,
+                        help="fraction of lost marker-frames, as observe --dropout (default 0)")
     args = parser.parse_args()
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -52,10 +57,11 @@ def main():
           f"{1e3 * sag:.1f} mm; positions {train_truth.positions.shape}")
 
     # 3. What a camera sees.
-    obs = el.observe(train_truth.trajectory, visible_fraction=0.13, noise=1e-4, seed=1,
-                     output=out / "obs.h5")
+    obs = el.observe(train_truth.trajectory, visible_fraction=0.13, noise=1e-4,
+                     dropout=args.dropout, seed=1, output=out / "obs.h5")
+    lost = 1 - obs.valid.mean()  # obs.valid: (T, k) bool, False where a marker was lost
     print(f"observed {obs.num_observed} of {len(train.surface_vertices)} surface vertices over "
-          f"{obs.num_frames} frames")
+          f"{obs.num_frames} frames ({100 * lost:.1f} % of the marker-frames lost)")
 
     # 4. Learn.
     options = dict(max_iterations=1, forward_fit=0) if args.quick else {}
@@ -74,9 +80,10 @@ def main():
                   f"{100 * c['validation_rms_error_m'] / train.size:.4f} % of the size")
 
     # 5. Evaluate on the test motion.
-    report = el.evaluate(test, learned, out / "test_truth.h5")
+    report = el.evaluate(test, learned, out / "test_truth.h5", report=out / "report",
+                         truth_material=truth)
     print(f"test motion err_L: nominal {report['nominal']['err_L_percent']:.4g} %, learned "
-          f"{report['learned']['err_L_percent']:.4g} %")
+          f"{report['learned']['err_L_percent']:.4g} %; report: {out / 'report' / 'report.html'}")
 
     # 6. Stress along a uniaxial stretch (lateral stretches held at 1) [kPa], within the
     # stretches the training motion visited (outside them the correction extrapolates).

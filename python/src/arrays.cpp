@@ -73,6 +73,18 @@ py::array_t<int> to_array(const std::vector<int>& v) {
   return a;
 }
 
+py::array_t<bool> to_array(
+    const observe::ValidityMask& valid, Eigen::Index frames, Eigen::Index k) {
+  py::array_t<bool> a({ static_cast<py::ssize_t>(frames), static_cast<py::ssize_t>(k) });
+  bool* out = a.mutable_data();
+  if (valid.size() == 0)
+    std::fill_n(out, frames * k, true);
+  else
+    for (Eigen::Index i = 0; i < valid.size(); ++i)
+      out[i] = valid.data()[i] != 0;
+  return a;
+}
+
 Positions to_positions(const DoubleArray& a, const std::string& name) {
   if (a.ndim() != 2 || a.shape(1) != 3)
     wrong_shape(a, name, "(n, 3)");
@@ -116,6 +128,17 @@ std::vector<int> to_ints(const IntArray& a, const std::string& name) {
   if (a.ndim() != 1)
     wrong_shape(a, name, "(k,)");
   return std::vector<int>(a.data(), a.data() + a.shape(0));
+}
+
+observe::ValidityMask to_mask(
+    const MaskArray& a, Eigen::Index frames, Eigen::Index k, const std::string& name) {
+  if (a.ndim() != 2 || a.shape(0) != frames || a.shape(1) != k) {
+    const std::string expected = "(" + std::to_string(frames) + ", " + std::to_string(k) + ")";
+    wrong_shape(a, name, expected.c_str());
+  }
+  observe::ValidityMask valid(frames, k);
+  std::copy_n(a.data(), valid.size(), valid.data());
+  return valid;
 }
 
 } // namespace elastolearn::python

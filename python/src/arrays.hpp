@@ -1,13 +1,15 @@
 #pragma once
 // numpy <-> elastolearn arrays for the Python module: vertex arrays (n, 3) float64, frame series
-// (T, n, 3) float64, index arrays (m, k) int32. Inputs are converted (forcecast) to C-ordered
-// arrays; a wrong shape throws InputError naming the argument, which Python sees as
-// elastolearn.InputError.
+// (T, n, 3) float64, index arrays (m, k) int32, validity masks (T, k) bool. Inputs are converted
+// (forcecast) to C-ordered arrays; a wrong shape throws InputError naming the argument, which
+// Python sees as elastolearn.InputError.
 #include <elastolearn/core/types.hpp>
+#include <elastolearn/observe/observation.hpp>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@ namespace py = pybind11;
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using IntArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
+using MaskArray = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>;
 
 /// (n, 3) float64 copy of `x`.
 py::array_t<double> to_array(const Positions& x);
@@ -27,6 +30,9 @@ py::array_t<double> to_array(const std::vector<VecX>& frames, Eigen::Index n);
 /// (m, k) int32 copy of an index matrix (tets, faces, edges).
 template <int Cols>
 py::array_t<int> to_array(const Eigen::Matrix<int, Eigen::Dynamic, Cols, Eigen::RowMajor>& m);
+/// (T, k) bool copy of an observation's validity mask (all true for an empty mask, which means
+/// every entry was seen).
+py::array_t<bool> to_array(const observe::ValidityMask& valid, Eigen::Index frames, Eigen::Index k);
 /// 1-D copy.
 py::array_t<double> to_array(const std::vector<double>& v);
 py::array_t<int> to_array(const std::vector<int>& v);
@@ -42,5 +48,9 @@ Eigen::Matrix<int, Eigen::Dynamic, Cols, Eigen::RowMajor> to_indices(
 /// 1-D → vector. Throws InputError("<name>", ...) for another shape.
 std::vector<double> to_doubles(const DoubleArray& a, const std::string& name);
 std::vector<int> to_ints(const IntArray& a, const std::string& name);
+/// (T, k) → validity mask (values as given; Observation::validate checks them). Throws
+/// InputError("<name>", ...) for another shape.
+observe::ValidityMask to_mask(
+    const MaskArray& a, Eigen::Index frames, Eigen::Index k, const std::string& name);
 
 } // namespace elastolearn::python

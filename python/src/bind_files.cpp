@@ -35,10 +35,15 @@ io::TrajectoryData make_trajectory(const DoubleArray& rest_positions, const Doub
 }
 
 Observation make_observation(const IntArray& vertex_ids, const DoubleArray& positions, double dt,
-    double start_time, const std::map<std::string, std::string>& metadata) {
+    double start_time, const std::map<std::string, std::string>& metadata,
+    const std::optional<MaskArray>& valid) {
   Observation o;
   o.observation.vertex_ids = to_ints(vertex_ids, "vertex_ids");
   o.observation.positions = to_frames(positions, "positions");
+  if (valid) {
+    o.observation.valid
+        = to_mask(*valid, o.observation.num_frames(), o.observation.num_observed(), "valid");
+  }
   o.observation.dt = dt;
   o.observation.start_time = start_time;
   o.observation.validate("observation");
@@ -99,15 +104,26 @@ void bind_files(py::module_& m) {
 
   py::class_<Observation>(m, "Observation",
       "Observed positions of k mesh vertices over T frames spaced dt apart: vertex_ids (k,), "
-      "positions (T, k, 3), dt, start_time and string metadata (docs/observations.md).")
+      "positions (T, k, 3), dt, start_time, string metadata and valid (T, k): False where a "
+      "marker was lost (its position means nothing, NaN in files) (docs/observations.md).")
       .def(py::init(&make_observation), py::arg("vertex_ids"), py::arg("positions"), py::arg("dt"),
-          py::arg("start_time") = 0.0, py::arg("metadata") = std::map<std::string, std::string> {})
+          py::arg("start_time") = 0.0, py::arg("metadata") = std::map<std::string, std::string> {},
+          py::arg("valid") = py::none())
       .def_property_readonly(
           "vertex_ids", [](const Observation& o) { return to_array(o.observation.vertex_ids); })
       .def_property_readonly("positions",
           [](const Observation& o) {
             return to_array(o.observation.positions, o.observation.num_observed());
           })
+      .def_property_readonly(
+          "valid",
+          [](const Observation& o) {
+            return to_array(
+                o.observation.valid, o.observation.num_frames(), o.observation.num_observed());
+          },
+          "(T, k) bool: True where the marker was seen")
+      .def_property_readonly(
+          "num_valid", [](const Observation& o) { return o.observation.num_valid(); })
       .def_property_readonly("dt", [](const Observation& o) { return o.observation.dt; })
       .def_property_readonly(
           "start_time", [](const Observation& o) { return o.observation.start_time; })

@@ -7,9 +7,14 @@
 
 #include <elastolearn/core/command_paths.hpp>
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/io/evaluation_report.hpp>
+#include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/learned_material.hpp>
+#include <elastolearn/io/learning_checkpoint.hpp>
+#include <elastolearn/io/learning_run_report.hpp>
 #include <elastolearn/io/material_evaluation.hpp>
 #include <elastolearn/io/observation_file.hpp>
+#include <elastolearn/io/report_resources.hpp>
 #include <elastolearn/io/scene_output.hpp>
 #include <elastolearn/io/training_set.hpp>
 #include <elastolearn/io/trajectory_observation.hpp>
@@ -81,25 +86,40 @@ Simulation simulate(const py::handle& scene_arg, std::optional<int> frames,
   return result;
 }
 
+template <typename T> T value(const py::handle& v, const std::string& name) {
+  try {
+    return v.cast<T>();
+  } catch (const py::cast_error&) {
+    throw InputError(name, "has the wrong type (" + std::string(py::str(py::type::of(v))) + ")");
+  }
+}
+
 Observation observe(const py::handle& trajectory, std::optional<double> visible_fraction,
-    std::optional<IntArray> vertices, double noise, std::uint64_t seed,
-    std::optional<std::filesystem::path> output) {
-  if (visible_fraction.has_value() == vertices.has_value())
+    const py::handle& vertices, double noise, double dropout, double dropout_burst,
+    std::uint64_t seed, std::optional<std::filesystem::path> output) {
+  if (visible_fraction.has_value() == !vertices.is_none())
     throw InputError("observe", "give exactly one of visible_fraction and vertices");
+  std::vector<CommandInput> inputs;
   io::ObservationRequest request;
-  if (vertices)
-    request.vertices = to_ints(*vertices, "vertices");
+  std::string vertex_file;
+  if (is_path(vertices, vertex_file)) {
+    inputs.push_back({ vertex_file, "vertex list (vertices)" });
+    request.vertices = io::read_vertex_id_list(vertex_file);
+    request.vertices_source = vertex_file;
+  } else if (!vertices.is_none()) {
+    request.vertices = to_ints(value<IntArray>(vertices, "vertices"), "vertices");
+  }
   request.visible_fraction = visible_fraction.value_or(0);
   request.noise = noise;
   request.seed = seed;
+  request.dropout = dropout;
+  request.dropout_burst = dropout_burst;
   std::string source;
   const io::TrajectoryData data = trajectory_argument(trajectory, source);
-  if (output) {
-    std::vector<CommandInput> inputs;
-    if (source != "trajectory")
-      inputs.push_back({ source, "trajectory" });
+  if (source != "trajectory")
+    inputs.push_back({ source, "trajectory" });
+  if (output)
     check_command_paths(inputs, { { *output, "observation output" } });
-  }
   Observation result;
   {
     py::gil_scoped_release release;
@@ -113,20 +133,12 @@ Observation observe(const py::handle& trajectory, std::optional<double> visible_
 }
 
 /// learn's keyword options: name → how it sets the recipe's options (the CLI flags' names with
-/// underscores; docs/python.md lists them).
+/// underscores, in --help's order; a flag is a bool; docs/python.md lists them).
 struct LearnSettings {
   learn::RecipeOptions recipe;
 };
 
 using Setter = std::function<void(LearnSettings&, const py::handle&)>;
-
-template <typename T> T value(const py::handle& v, const std::string& name) {
-  try {
-    return v.cast<T>();
-  } catch (const py::cast_error&) {
-    throw InputError(name, "has the wrong type (" + std::string(py::str(py::type::of(v))) + ")");
-  }
-}
 
 const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
   using S = LearnSettings;
@@ -135,8 +147,8 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
     { "noise", [](S& s, H v) { s.recipe.noise = v.is_none() ? -1.0 : value<double>(v, "noise"); } },
     { "validation_fraction",
         [](S& s, H v) { s.recipe.validation_fraction = value<double>(v, "validation_fraction"); } },
-    { "fit_parameters",
-        [](S& s, H v) { s.recipe.fit_parameters = value<bool>(v, "fit_parameters"); } },
+    { "no_parameter_fit",
+        [](S& s, H v) { s.recipe.fit_parameters = !value<bool>(v, "no_parameter_fit"); } },
     { "parameter_fit_iterations",
         [](S& s, H v) {
           s.recipe.parameter_fit.max_iterations = value<int>(v, "parameter_fit_iterations");
@@ -150,6 +162,10 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
     { "pod_stride",
         [](S& s, H v) { s.recipe.loop.pod.frame_stride = value<int>(v, "pod_stride"); } },
     { "full_space", [](S& s, H v) { s.recipe.loop.full_space = value<bool>(v, "full_space"); } },
+    { "pod_forward_only",
+        [](S& s, H v) {
+          s.recipe.loop.pod_with_constrained = !value<bool>(v, "pod_forward_only");
+        } },
     { "kernels", [](S& s, H v) { s.recipe.loop.centres = value<int>(v, "kernels"); } },
     { "position_weight",
         [](S& s, H v) {
@@ -170,10 +186,18 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
         [](S& s, H v) {
           s.recipe.loop.reconstruction.frame_stride = value<int>(v, "frame_stride");
         } },
-    { "fit_damping",
-        [](S& s, H v) { s.recipe.loop.rbf.fit_damping = value<bool>(v, "fit_damping"); } },
-    { "quadratic_tail",
-        [](S& s, H v) { s.recipe.loop.rbf.quadratic_tail = value<bool>(v, "quadratic_tail"); } },
+    { "unprojected_reconstruction",
+        [](S& s, H v) {
+          s.recipe.loop.projected_reconstruction = !value<bool>(v, "unprojected_reconstruction");
+        } },
+    { "full_space_weight",
+        [](S& s, H v) {
+          s.recipe.loop.reconstruction.full_space_weight = value<double>(v, "full_space_weight");
+        } },
+    { "no_damping",
+        [](S& s, H v) { s.recipe.loop.rbf.fit_damping = !value<bool>(v, "no_damping"); } },
+    { "linear_tail",
+        [](S& s, H v) { s.recipe.loop.rbf.quadratic_tail = !value<bool>(v, "linear_tail"); } },
     { "damping_regularization",
         [](S& s, H v) {
           s.recipe.loop.rbf.damping_regularization = value<double>(v, "damping_regularization");
@@ -193,13 +217,29 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
         } },
     { "kernel_smoothing",
         [](S& s, H v) { s.recipe.loop.rbf.epsilon = value<double>(v, "kernel_smoothing"); } },
-    { "energy_kernels",
-        [](S& s, H v) { s.recipe.loop.rbf.energy_kernels = value<bool>(v, "energy_kernels"); } },
-    { "network", [](S& s, H v) { s.recipe.network.enabled = value<bool>(v, "network"); } },
+    { "stress_kernels",
+        [](S& s, H v) { s.recipe.loop.rbf.energy_kernels = !value<bool>(v, "stress_kernels"); } },
+    { "neo_hookean_tail",
+        [](S& s, H v) {
+          s.recipe.loop.rbf.neo_hookean_tail = value<bool>(v, "neo_hookean_tail");
+        } },
+    { "damping_quadratic_tail",
+        [](S& s, H v) {
+          s.recipe.loop.rbf.damping_quadratic_tail = value<bool>(v, "damping_quadratic_tail");
+        } },
+    { "allow_rest_stress",
+        [](S& s, H v) {
+          s.recipe.loop.rbf.stress_free_rest = !value<bool>(v, "allow_rest_stress");
+        } },
+    { "no_network", [](S& s, H v) { s.recipe.network.enabled = !value<bool>(v, "no_network"); } },
     { "network_kind",
         [](S& s, H v) {
           s.recipe.network.kind = learn::network_kind_from_name(
               value<std::string>(v, "network_kind"), "network_kind");
+        } },
+    { "network_rate_jitter",
+        [](S& s, H v) {
+          s.recipe.network.samples.rate_jitter = value<double>(v, "network_rate_jitter");
         } },
     { "network_motion_scales",
         [](S& s, H v) {
@@ -248,12 +288,48 @@ std::string iteration_line(const learn::IterationRecord& r, double size) {
 
 Material learn(const std::filesystem::path& scene,
     std::optional<std::filesystem::path> observations, std::optional<std::filesystem::path> output,
+    std::optional<std::filesystem::path> checkpoint_arg, bool resume,
+    std::optional<std::filesystem::path> report_dir, const py::handle& truth_material_arg,
     bool verbose, const py::kwargs& options) {
+  if (!truth_material_arg.is_none() && !report_dir)
+    throw InputError("truth_material", "is used by the report only: give report too");
   const LearnSettings settings = learn_settings(options);
   const io::TrainingSet set
       = io::read_learning_data(scene, observations.value_or(""), "observations");
-  if (output)
-    check_command_paths(set.inputs, { { *output, "learned material output" } });
+  // As the command: checkpoints after every iteration, by default beside the output.
+  std::optional<std::filesystem::path> checkpoint = checkpoint_arg;
+  if (!checkpoint && output)
+    checkpoint = io::learning_checkpoint_path(*output, {});
+  if (resume && !checkpoint)
+    throw InputError("resume", "needs a checkpoint: give checkpoint or output");
+  {
+    // With resume the checkpoint is read and then rewritten on purpose: it is an output only.
+    std::vector<CommandOutput> outputs;
+    if (output)
+      outputs.push_back({ *output, "learned material output" });
+    if (checkpoint)
+      outputs.push_back({ *checkpoint, "checkpoint" });
+    std::vector<CommandInput> inputs = set.inputs;
+    std::string path;
+    if (is_path(truth_material_arg, path))
+      inputs.push_back({ path, "true material (truth_material)" });
+    if (report_dir) {
+      for (CommandOutput& o : io::report_outputs(*report_dir, "report folder"))
+        outputs.push_back(std::move(o));
+      io::report_resource_dir(); // throws now, not after the work, if the report cannot be made
+    }
+    check_command_paths(inputs, outputs);
+  }
+  std::optional<Material> true_material;
+  if (!truth_material_arg.is_none())
+    true_material = material_argument(truth_material_arg);
+  const io::LearningInputs inputs { scene.string(),
+    observations ? observations->string() : std::string(),
+    io::recipe_options_to_json(settings.recipe) };
+  std::optional<learn::RecipeResume> resumed;
+  if (resume)
+    resumed = io::resume_learning_checkpoint(*checkpoint, inputs, "resume");
+
   const double size = set.motions.front().scene.mesh.bounding_box_diagonal();
   const auto say = [verbose](const std::string& line) {
     if (verbose) {
@@ -261,6 +337,9 @@ Material learn(const std::filesystem::path& scene,
       py::print(line, py::arg("flush") = true);
     }
   };
+  if (resumed)
+    say("resuming from " + checkpoint->string() + " at iteration "
+        + std::to_string(resumed->loop.next_iteration));
   learn::RecipeCallbacks callbacks;
   callbacks.message = say;
   callbacks.loop.iteration = [&](const learn::IterationRecord& r) { say(iteration_line(r, size)); };
@@ -273,54 +352,100 @@ Material learn(const std::filesystem::path& scene,
     }
     return interrupted;
   };
+  learn::ParameterFitReport fitted
+      = resumed ? resumed->parameter_fit : learn::ParameterFitReport {};
+  if (checkpoint) {
+    callbacks.parameters_fitted = [&fitted](const learn::ParameterFitReport& f) { fitted = f; };
+    callbacks.loop.checkpoint = [&](const learn::LearningState& s) {
+      io::write_learning_checkpoint(*checkpoint, inputs, { fitted, s });
+    };
+  }
   io::MaterialFile learned;
   {
     py::gil_scoped_release release;
-    const learn::RecipeResult result
-        = learn::learn_material(set.motions, settings.recipe, callbacks);
+    const learn::RecipeResult result = learn::learn_material(
+        set.motions, settings.recipe, callbacks, resumed ? &*resumed : nullptr);
     if (!result.interrupted) {
       learned = io::learned_material_file(set, scene.string(), result, settings.recipe);
       if (output)
         io::write_material_file(*output, learned);
+      if (report_dir) {
+        const io::LearningRunReportInputs report { scene.string(),
+          output ? output->string() : std::string("learned"), set.motions, &result, &learned,
+          true_material ? &true_material->model : nullptr,
+          true_material ? true_material->source : std::string() };
+        io::write_learning_run_report(*report_dir, report);
+      }
     }
   }
   if (interrupted) {
-    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    const std::string message = checkpoint
+        ? "elastolearn.learn: interrupted; resume with the same call and resume=True (checkpoint "
+            + checkpoint->string() + ")"
+        : std::string("elastolearn.learn: interrupted");
+    PyErr_SetString(PyExc_KeyboardInterrupt, message.c_str());
     throw py::error_already_set();
   }
   return make_material(std::move(learned), output ? output->string() : std::string("learned"));
 }
 
 py::object evaluate(const py::handle& scene_arg, const py::handle& material_arg,
-    const py::handle& truth_arg, std::optional<std::filesystem::path> output, bool progress) {
-  const io::SceneFile file = scene_argument(scene_arg);
-  const Material material = material_argument(material_arg);
-  std::string truth_source;
-  const io::TrajectoryData truth_data = trajectory_argument(truth_arg, truth_source);
-  const std::vector<VecX> truth = io::truth_frames(truth_data, truth_source, file.scene);
-  io::EvaluationOptions options;
-  if (output) {
+    const py::handle& truth_arg, std::optional<std::filesystem::path> output,
+    std::optional<std::filesystem::path> json, std::optional<std::string> solver,
+    std::optional<std::filesystem::path> report_dir, const py::handle& truth_material_arg,
+    bool progress) {
+  if (!truth_material_arg.is_none() && !report_dir)
+    throw InputError("truth_material", "is used by the report only: give report too");
+  io::SceneFile file = scene_argument(scene_arg);
+  {
     std::vector<CommandInput> inputs = file.inputs;
-    for (const py::handle& h : { material_arg, truth_arg }) {
+    for (const py::handle& h : { material_arg, truth_arg, truth_material_arg }) {
       std::string path;
       if (is_path(h, path))
         inputs.push_back({ path, "input" });
     }
-    check_command_paths(inputs, { { *output, "learned trajectory output" } });
-    options.learned_trajectory = *output;
+    std::vector<CommandOutput> outputs;
+    if (output)
+      outputs.push_back({ *output, "learned trajectory output" });
+    if (json)
+      outputs.push_back({ *json, "JSON report (json)" });
+    if (report_dir) {
+      for (CommandOutput& o : io::report_outputs(*report_dir, "report folder"))
+        outputs.push_back(std::move(o));
+      io::report_resource_dir(); // throws now, not after the work, if the report cannot be made
+    }
+    check_command_paths(inputs, outputs);
   }
+  if (solver)
+    file.scene.linear_solver = sim::linear_solver_type_from_string(*solver);
+  const Material material = material_argument(material_arg);
+  std::string truth_source;
+  const io::TrajectoryData truth_data = trajectory_argument(truth_arg, truth_source);
+  const std::vector<VecX> truth = io::truth_frames(truth_data, truth_source, file.scene);
+  std::optional<Material> true_material;
+  if (!truth_material_arg.is_none())
+    true_material = material_argument(truth_material_arg);
+  io::EvaluationOptions options;
+  if (output)
+    options.learned_trajectory = *output;
   if (progress)
     options.progress = [](const std::string& label) { return terminal_progress(label); };
-  nlohmann::json report;
+  const std::string scene_name = file.path.empty() ? std::string("scene") : file.path.string();
+  nlohmann::json result;
   {
     py::gil_scoped_release release;
     const io::MaterialEvaluation e
         = io::evaluate_material(file.scene, material.file, material.source, truth, options);
-    report = io::evaluation_to_json(e, file.scene,
-        file.path.empty() ? std::string("scene") : file.path.string(), material.source,
-        truth_source);
+    result = io::evaluation_to_json(e, file.scene, scene_name, material.source, truth_source);
+    if (json)
+      io::write_json_file(*json, result);
+    if (report_dir) {
+      const io::EvaluationReportInputs inputs { &file.scene, scene_name, &material.file,
+        material.source, &truth, truth_source, true_material ? &true_material->model : nullptr };
+      io::write_evaluation_report(*report_dir, inputs, e, options.progress);
+    }
   }
-  return to_python(report);
+  return to_python(result);
 }
 
 } // namespace
@@ -359,9 +484,12 @@ void bind_runs(py::module_& m) {
       py::arg("output") = py::none(), py::arg("every") = 1, py::arg("progress") = false);
   m.def("observe", &observe, py::arg("trajectory"), py::kw_only(),
       py::arg("visible_fraction") = py::none(), py::arg("vertices") = py::none(),
-      py::arg("noise") = 0.0, py::arg("seed") = 1, py::arg("output") = py::none());
+      py::arg("noise") = 0.0, py::arg("dropout") = 0.0, py::arg("dropout_burst") = 5.0,
+      py::arg("seed") = 1, py::arg("output") = py::none());
   m.def("learn", &learn, py::arg("scene"), py::arg("observations") = py::none(), py::kw_only(),
-      py::arg("output") = py::none(), py::arg("verbose") = false);
+      py::arg("output") = py::none(), py::arg("checkpoint") = py::none(), py::arg("resume") = false,
+      py::arg("report") = py::none(), py::arg("truth_material") = py::none(),
+      py::arg("verbose") = false);
   m.def("learn_options", [] {
     std::vector<std::string> names;
     for (const auto& entry : learn_option_table())
@@ -369,7 +497,9 @@ void bind_runs(py::module_& m) {
     return names;
   });
   m.def("evaluate", &evaluate, py::arg("scene"), py::arg("material"), py::arg("truth"),
-      py::kw_only(), py::arg("output") = py::none(), py::arg("progress") = false);
+      py::kw_only(), py::arg("output") = py::none(), py::arg("json") = py::none(),
+      py::arg("solver") = py::none(), py::arg("report") = py::none(),
+      py::arg("truth_material") = py::none(), py::arg("progress") = false);
 }
 
 } // namespace elastolearn::python

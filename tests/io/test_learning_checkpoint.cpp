@@ -132,5 +132,21 @@ TEST(LearningCheckpoint, RefusesACheckpointOfOtherInputs) {
   }
 }
 
+TEST(LearningCheckpoint, DefaultPathAndMissingCheckpoint) {
+  EXPECT_EQ(learning_checkpoint_path("out/learned.json", ""), "out/learned.json.checkpoint.json");
+  EXPECT_EQ(learning_checkpoint_path("out/learned.json", "run.json"), "run.json");
+  Fixture f;
+  std::filesystem::remove(f.file);
+  try {
+    resume_learning_checkpoint(f.file, f.inputs, "--resume");
+    ADD_FAILURE() << "a missing checkpoint was resumed";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+        f.file.string() + ": no checkpoint to resume from (run without --resume first)");
+  }
+  write_learning_checkpoint(f.file, f.inputs, { {}, {} });
+  EXPECT_EQ(resume_learning_checkpoint(f.file, f.inputs, "--resume").loop.next_iteration, 0);
+}
+
 } // namespace
 } // namespace elastolearn::io

@@ -208,6 +208,23 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
   write_json_file(path, j);
 }
 
+std::filesystem::path learning_checkpoint_path(
+    const std::filesystem::path& output, const std::filesystem::path& checkpoint) {
+  if (!checkpoint.empty())
+    return checkpoint;
+  std::filesystem::path path = output;
+  path += ".checkpoint.json";
+  return path;
+}
+
+learn::RecipeResume resume_learning_checkpoint(
+    const std::filesystem::path& path, const LearningInputs& inputs, const std::string& option) {
+  if (!std::filesystem::exists(path))
+    throw InputError(
+        path.string(), "no checkpoint to resume from (run without " + option + " first)");
+  return read_learning_checkpoint(path, inputs);
+}
+
 learn::RecipeResume read_learning_checkpoint(
     const std::filesystem::path& path, const LearningInputs& inputs) {
   const nlohmann::json j = read_json_file(path);

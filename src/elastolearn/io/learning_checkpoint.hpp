@@ -29,6 +29,17 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
 learn::RecipeResume read_learning_checkpoint(
     const std::filesystem::path& path, const LearningInputs& inputs);
 
+/// The checkpoint file of a run that writes the learned material to `output`: `checkpoint` if
+/// not empty, else OUTPUT.checkpoint.json (`learn --checkpoint`'s default).
+std::filesystem::path learning_checkpoint_path(
+    const std::filesystem::path& output, const std::filesystem::path& checkpoint);
+
+/// read_learning_checkpoint for a resumed run (`option` names the request to resume, e.g.
+/// "--resume"): throws InputError naming `path` when there is no file there ("no checkpoint to
+/// resume from (run without --resume first)").
+learn::RecipeResume resume_learning_checkpoint(
+    const std::filesystem::path& path, const LearningInputs& inputs, const std::string& option);
+
 /// One iteration's record as JSON (also used in reports and in the learned material's
 /// "training" provenance).
 nlohmann::json iteration_record_to_json(const learn::IterationRecord& record);

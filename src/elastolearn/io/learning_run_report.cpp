@@ -1,0 +1,33 @@
+#include <elastolearn/io/learning_run_report.hpp>
+#include <elastolearn/io/report_builder.hpp>
+
+namespace elastolearn::io {
+
+ReportOutcome write_learning_run_report(
+    const std::filesystem::path& dir, const LearningRunReportInputs& in) {
+  const learn::RecipeResult& result = *in.result;
+  const MaterialFile& learned = *in.learned;
+  LearningReport report;
+  report.title = "elastolearn learn " + in.scene_path;
+  const fem::MaterialModel written = material_model(learned, in.output_path);
+  add_recipe_sections(report, in.motions, result);
+  const material::StretchRange* trained
+      = learned.training_stretches ? &*learned.training_stretches : nullptr;
+  if (written.correction || in.truth)
+    add_correction_section(report, written, in.truth, trained);
+  if (!in.truth)
+    report.notes.push_back("No true material given (--truth-material): the correction is shown "
+                           "without the truth's.");
+  report.summary
+      = { { "command", "learn" }, { "scene", in.scene_path }, { "learned", in.output_path },
+          { "truth_material",
+              in.truth_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(in.truth_path) },
+          { "size_m", report.size }, { "recipe", learned.training.at("recipe") },
+          { "best_iteration", result.loop.best_iteration }, { "seconds", result.seconds } };
+  if (learned.training.contains("network"))
+    report.summary["network"] = learned.training.at("network");
+  report.provenance = learned.training;
+  return write_learning_report(dir, report);
+}
+
+} // namespace elastolearn::io
