@@ -6,6 +6,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <regex>
+#include <set>
 #include <support/cli_runner.hpp>
 
 #include <gtest/gtest.h>
@@ -101,11 +104,66 @@ TEST_F(CliTest, InfoDescribesMeshesTrajectoriesAndScenes) {
   EXPECT_EQ(run("info " + (m_dir / "missing.node").string()).exit_code, 2);
 }
 
-TEST_F(CliTest, ExampleScenesParse) {
-  for (const char* example :
-      { "01_cantilever/cantilever.json", "02_sphere/sphere.json", "03_real_mesh/elephant.json" }) {
-    const auto r = run(std::string("info ") + ELASTOLEARN_EXAMPLES_DIR + "/" + example);
-    EXPECT_EQ(r.exit_code, 0) << example << ": " << r.output;
+namespace {
+
+/// The example files of one format ("scene" or "material"), as paths relative to examples/:
+/// every JSON file under examples/ whose "format" is elastolearn-<kind>/1.
+std::set<std::string> example_files(const std::string& kind) {
+  const std::regex format("\"format\"\\s*:\\s*\"elastolearn-" + kind + "/1\"");
+  const fs::path root(ELASTOLEARN_EXAMPLES_DIR);
+  std::set<std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    if (entry.path().extension() != ".json")
+      continue;
+    std::ifstream in(entry.path());
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (std::regex_search(text, format))
+      files.insert(fs::relative(entry.path(), root).string());
+  }
+  return files;
+}
+
+} // namespace
+
+// Every example scene and material file loads (meshes, selections, material fields), so an example
+// cannot rot unnoticed; `info` builds the scene as `simulate` does.
+TEST_F(CliTest, ExampleScenesAndMaterialsLoad) {
+  const auto scenes = example_files("scene");
+  const auto materials = example_files("material");
+  for (const char* known : { "01_cantilever/cantilever.json", "02_sphere/sphere.json",
+           "03_real_mesh/elephant.json", "04_learning/bar_train.json", "04_learning/bar_test.json",
+           "08_transfer/ball_train.json", "08_transfer/elephant_test.json" })
+    EXPECT_EQ(scenes.count(known), 1u) << known << " was not found as a scene";
+  for (const char* known : { "04_learning/truth.json", "08_transfer/truth.json" })
+    EXPECT_EQ(materials.count(known), 1u) << known << " was not found as a material";
+  for (const auto& scene : scenes) {
+    const auto r = run("info " + std::string(ELASTOLEARN_EXAMPLES_DIR) + "/" + scene);
+    EXPECT_EQ(r.exit_code, 0) << scene << ": " << r.output;
+    EXPECT_NE(r.output.find("scene '"), std::string::npos) << scene << ": " << r.output;
+  }
+  for (const auto& material : materials) {
+    const auto r = run("info " + std::string(ELASTOLEARN_EXAMPLES_DIR) + "/" + material);
+    EXPECT_EQ(r.exit_code, 0) << material << ": " << r.output;
+    EXPECT_NE(r.output.find("learned material"), std::string::npos) << material << ": " << r.output;
+  }
+  // The transfer example drives the mesh of 03_real_mesh (referenced, not copied).
+  const auto r
+      = run("info " + std::string(ELASTOLEARN_EXAMPLES_DIR) + "/08_transfer/elephant_test.json");
+  EXPECT_NE(r.output.find("2830 tets"), std::string::npos) << r.output;
+}
+
+// The example scripts are too slow for this suite (minutes of learning); their shell syntax is
+// checked here, what they compute in their READMEs.
+TEST_F(CliTest, ExampleScriptsHaveValidShellSyntax) {
+  const fs::path root(ELASTOLEARN_EXAMPLES_DIR);
+  std::set<std::string> scripts;
+  for (const auto& entry : fs::recursive_directory_iterator(root))
+    if (entry.path().extension() == ".sh")
+      scripts.insert(entry.path().string());
+  EXPECT_EQ(scripts.count((root / "08_transfer" / "run.sh").string()), 1u);
+  for (const auto& script : scripts) {
+    const int status = std::system(("bash -n '" + script + "' 2>&1").c_str());
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << script;
   }
 }
 
