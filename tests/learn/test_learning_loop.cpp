@@ -93,7 +93,7 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   EXPECT_LT(learned_error, nominal_error / 5);
   EXPECT_LT(learned_error, 2 * 0.0312);
 
-  // The distilled network (paper §6.2, `learn --network`): N fitted on the training motion at
+  // The distilled network (paper §6.2, the recipe's stage 5): N fitted on the training motion at
   // three amplitudes, Δα₁ carried over from the teacher (distilled instead, the network's
   // simulation of the demo's test motion diverges: docs/learning.md). It must simulate the unseen
   // swing stably and stay well below the nominal error (its fit is ~1.5 % of the teacher's
