@@ -255,3 +255,86 @@ TEST(RayleighDampingForce, DampingJacobianIsMinusVelocityDerivative) {
   const VecX fd = force_at(term, x, v) - force_at(term, x, VecX::Zero(v.size()));
   EXPECT_LT(v.dot(fd), 0.0);
 }
+
+namespace {
+
+/// A smooth isotropic correction N_i = a e_i + b e_i² + c Σ e (e = σ − 1) [Pa] with a learned
+/// stiffness damping Δα₁(σ) = δ + γ (σ₀ − 1), rate-independent like the learned ones.
+class QuadraticCorrection final : public material::Correction {
+  public:
+  QuadraticCorrection(double delta, double gamma)
+      : m_delta(delta)
+      , m_gamma(gamma) { }
+  std::string name() const override { return "quadratic"; }
+  Vec3 correction(const Vec3& s, const Vec3&) const override {
+    const Vec3 e = s - Vec3::Ones();
+    return (kA * e + kB * e.cwiseAbs2()).array() + kC * e.sum();
+  }
+  void correction_gradient(const Vec3& s, const Vec3&, Mat3& ds, Mat3& dr) const override {
+    const Vec3 e = s - Vec3::Ones();
+    ds = Mat3::Constant(kC);
+    ds.diagonal().array() += kA + 2 * kB * e.array();
+    dr.setZero();
+  }
+  bool depends_on_rates() const override { return false; }
+  double stiffness_damping(const Vec3& s) const override { return m_delta + m_gamma * (s[0] - 1); }
+  std::unique_ptr<Correction> clone() const override {
+    return std::make_unique<QuadraticCorrection>(*this);
+  }
+
+  private:
+  static constexpr double kA = -4e4, kB = 3e5, kC = 1e4;
+  double m_delta, m_gamma;
+};
+
+} // namespace
+
+TEST(LearnedStiffnessDamping, ForceIsAlpha1CorrectedPlusDeltaAlpha1NominalStiffnessAlongV) {
+  // f_d = −α₁ K_corrected v − Δα₁ K_nominal v (paper Eq. 13; ElasticForce forms it as one
+  // tangent of the weighted stresses): with a constant Δα₁, α₁ times the directional derivative
+  // of the corrected elastic force plus Δα₁ times the nominal one's, by central differences
+  // (O(ε²) ≈ 1e-12 relative). The corrected and nominal stiffnesses differ by ~10 % here, so a
+  // Δα₁ applied to the wrong one fails by ~Δα₁/α₁ · 10 %.
+  const auto mesh = small_bar();
+  const double alpha1 = 0.01, delta = 0.004;
+  const auto correction = std::make_shared<QuadraticCorrection>(delta, 0.0);
+  const auto exact = rayleigh(0, alpha1, material::DampingTangent::Exact);
+  fem::ElasticForce damped(mesh, { model(0), correction, exact, 1000 });
+  fem::ElasticForce corrected(mesh, { model(0), correction, nullptr, 1000 });
+  fem::ElasticForce nominal(mesh, { model(0), nullptr, nullptr, 1000 });
+  const VecX x = deformed(mesh, 0.3);
+  const VecX v = random_velocity(x.size(), 13);
+  const VecX zero = VecX::Zero(x.size());
+  const VecX f_damping = force_at(damped, x, v) - force_at(damped, x, zero);
+  const double eps = 1e-6;
+  const auto directional = [&](fem::ElasticForce& term) -> VecX {
+    return (force_at(term, x + eps * v, zero) - force_at(term, x - eps * v, zero)) / (2 * eps);
+  };
+  const VecX d_corrected = directional(corrected), d_nominal = directional(nominal);
+  ASSERT_GT((d_corrected - d_nominal).norm(), 0.05 * d_nominal.norm());
+  EXPECT_LE(
+      (f_damping - (alpha1 * d_corrected + delta * d_nominal)).norm(), 1e-6 * f_damping.norm());
+}
+
+TEST(LearnedStiffnessDamping, UnprojectedJacobianIsMinusTheVelocityDerivative) {
+  // With Δα₁ varying per element (and α₁ + Δα₁ clamped at 0 in some), the damping force is still
+  // linear in v: Newton's c_v block must be exactly −∂f/∂v (central differences, exact for a
+  // linear function up to round-off).
+  const auto mesh = small_bar();
+  for (const double alpha1 : { 0.01, 0.0 }) {
+    SCOPED_TRACE(testing::Message() << "alpha1 " << alpha1);
+    const auto correction = std::make_shared<QuadraticCorrection>(0.003, 0.05);
+    fem::ElasticForce term(mesh,
+        { model(0), correction, rayleigh(0.2, alpha1, material::DampingTangent::FlipFree), 1000 });
+    term.set_project_tangent(false);
+    fem::DofMap dofs(mesh.num_vertices(), {});
+    fem::SystemMatrix A(mesh.tets(), dofs);
+    const VecX x = deformed(mesh, 0.3);
+    const VecX v = random_velocity(x.size(), 17);
+    VecX f = VecX::Zero(x.size());
+    A.set_zero();
+    term.add_force_and_jacobian({ x, v, 0.0 }, 0.0, 1.0, f, A);
+    test::expect_jacobian_matches(
+        -Eigen::MatrixXd(A.matrix()), [&](const VecX& w) { return force_at(term, x, w); }, v, 1e-7);
+  }
+}

@@ -58,41 +58,45 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
       const auto xe = gather_tet(state.x, tet);
       const auto ve = gather_tet(state.v, tet);
       c.frame = material::principal_frame(deformation_gradient(xe, rest));
+      const Vec3& stretches = c.frame.stretches;
       Vec3 rates = Vec3::Zero();
       const bool need_rate = correction || (damping != nullptr);
       Mat3 F_rate;
       if (need_rate)
         F_rate = deformation_gradient(ve, rest);
-      if (correction)
+      if (correction && correction->depends_on_rates())
         rates = material::stretch_rates(c.frame, F_rate);
-      c.stress
-          = material::corrected_principal_stress(*elastic, correction, c.frame.stretches, rates);
+      c.stress = material::corrected_principal_stress(*elastic, correction, stretches, rates);
       Mat3 P = material::first_piola(c.frame, c.stress.stress);
-      c.alpha = damping ? damping->coefficients(c.frame.stretches[0])
-                        : material::RayleighCoefficients {};
+      c.alpha = damping ? damping->coefficients(stretches[0]) : material::RayleighCoefficients {};
       // A learned Δα₁ scales the nominal stiffness (paper Eq. 13); the total never turns negative.
-      c.alpha1_change
-          = material::corrected_stiffness_damping(c.alpha.alpha1, correction, c.frame.stretches)
+      c.alpha1_change = material::corrected_stiffness_damping(c.alpha.alpha1, correction, stretches)
           - c.alpha.alpha1;
-      c.has_tangent = false;
-      if (c.alpha.alpha1 != 0 || c.alpha1_change != 0) {
-        // Stiffness damping −α₁ K_e v_e = −vol (α₁ dP/dF : Ḟ) G: a directional derivative, no 9×9
-        // or 12×12. K_e is the corrected model's damping stiffness, the learned Δα₁ acts on the
-        // nominal one (see the class comment). Unprojected: the PSD projection is Newton's device
-        // (add_jacobian), and the damping force must stay linear in the correction.
+      c.has_damping = c.alpha.alpha1 != 0 || c.alpha1_change != 0;
+      if (c.has_damping) {
+        // Stiffness damping −(α₁ K_e + Δα₁ K_e^nom) v_e = −vol (dP_d/dF : Ḟ) G: a directional
+        // derivative, no 9×9 or 12×12. K_e is the corrected model's damping stiffness, the learned
+        // Δα₁ acts on the nominal one (see the class comment). Unprojected: the PSD projection is
+        // Newton's device (add_jacobian), and the damping force must stay linear in the
+        // correction.
         material::CorrectedStress scratch;
         const material::CorrectedStress& elastic_stress
-            = material::elastic_part(*elastic, correction, c.frame.stretches, c.stress, scratch);
-        c.tangent = material::damping_tangent(
-            c.frame, elastic_stress.stress, elastic_stress.d_stretches, m_damping_tangent);
-        c.has_tangent = true;
-        if (c.alpha.alpha1 != 0)
-          P += c.alpha.alpha1 * material::first_piola_differential(c.frame, c.tangent, F_rate);
-        if (c.alpha1_change != 0) {
-          c.nominal_tangent = material::damping_tangent(*elastic, c.frame, m_damping_tangent);
-          P += c.alpha1_change
-              * material::first_piola_differential(c.frame, c.nominal_tangent, F_rate);
+            = material::elastic_part(*elastic, correction, stretches, c.stress, scratch);
+        if (c.alpha1_change == 0) {
+          c.damping = material::damping_tangent(
+              c.frame, elastic_stress.stress, elastic_stress.d_stretches, m_damping_tangent);
+          c.damping_scale = c.alpha.alpha1;
+        } else {
+          // One tangent of the weighted stresses instead of two tangents weighted.
+          const double a1 = c.alpha.alpha1, da1 = c.alpha1_change;
+          c.damping = material::damping_tangent(c.frame,
+              a1 * elastic_stress.stress + da1 * elastic->principal_stress(stretches),
+              a1 * elastic_stress.d_stretches
+                  + da1 * elastic->principal_stress_derivative(stretches),
+              m_damping_tangent);
+          c.damping_scale = 1;
         }
+        P += c.damping_scale * material::first_piola_differential(c.frame, c.damping, F_rate);
       }
       Eigen::Map<Eigen::Matrix<double, 3, 4>> force(m_force_buffer.data() + 12 * e);
       force.noalias() = -rest.volume * P * rest.gradients;
@@ -130,19 +134,17 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
     // c_x K_e + c_v (α₁ K_e^damp + Δα₁ K_e^nom,damp) as one eigen-form tangent (the eigen-form is
     // linear in dP/dF), projected once as a whole.
     material::PrincipalTangent tangent;
-    if (!c.has_tangent) {
+    if (!c.has_damping) {
       tangent = material::principal_tangent(
           c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
     } else {
       tangent = weighted_sum(c_x,
           material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, false),
-          c_v * c.alpha.alpha1, c.tangent);
-      if (c.alpha1_change != 0)
-        tangent = weighted_sum(1.0, tangent, c_v * c.alpha1_change, c.nominal_tangent);
+          c_v * c.damping_scale, c.damping);
       if (m_project_tangent)
         tangent = material::projected(tangent);
     }
-    J = element_stiffness(c.frame, tangent, rest, c.has_tangent ? 1.0 : c_x);
+    J = element_stiffness(c.frame, tangent, rest, c.has_damping ? 1.0 : c_x);
     if (c.alpha.alpha0 != 0) {
       if (m_mass == MassType::Lumped) {
         J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
@@ -155,10 +157,8 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
       // rate part may be PSD together even where the rate part alone is not; projecting them
       // separately would overstate the damping and stall Newton.
       Mat3 rayleigh = Mat3::Zero();
-      if (c.has_tangent)
-        rayleigh = c.alpha.alpha1 * c.tangent.block;
-      if (c.alpha1_change != 0)
-        rayleigh += c.alpha1_change * c.nominal_tangent.block;
+      if (c.has_damping)
+        rayleigh = c.damping_scale * c.damping.block;
       if (m_project_tangent)
         rayleigh = material::symmetric_psd(rayleigh);
       const Mat3 d_rates = m_project_tangent

@@ -72,11 +72,13 @@ class ElasticForce final : public ForceTerm {
     material::RayleighCoefficients alpha; ///< the damping model's (nominal) α₀, α₁
     /// A correction's Δα₁ as applied: (α₁ + Δα₁)⁺ − α₁ ≥ −α₁ (0 without a correction).
     double alpha1_change = 0;
-    /// material::damping_tangent of P̂ + N; valid if has_tangent.
-    material::PrincipalTangent tangent;
-    /// material::damping_tangent of P̂; valid if alpha1_change ≠ 0.
-    material::PrincipalTangent nominal_tangent;
-    bool has_tangent = false;
+    /// The damping stiffness α₁ K_e^d + Δα₁ K_e^nom,d as damping_scale · damping (valid if
+    /// has_damping): without a Δα₁, damping = material::damping_tangent of P̂ + N and
+    /// damping_scale = α₁; with one, damping = the damping tangent of α₁ (P̂ + N) + Δα₁ P̂ (the
+    /// eigen-form is linear in the stress and its derivative) and damping_scale = 1.
+    material::PrincipalTangent damping;
+    double damping_scale = 0;
+    bool has_damping = false;
   };
   bool cache_matches(const ForceState& state) const;
   void gather_forces(VecX& f) const;

@@ -101,17 +101,14 @@ void activate(Activation a, int n, const double* z, double* f, double* d1, doubl
   }
 }
 
-/// f, f' (and f'') of a fixed-size block, elementwise: ELU, ReLU and squareplus as packed array
-/// expressions, the others through activation_values.
-template <typename Z, typename F>
-void activate_block(Activation a, const Z& z, F& f, F& d1, F* d2) {
+/// f and f' of a fixed-size block (the stress network's), elementwise: ELU and squareplus as
+/// packed array expressions, the others through activation_values.
+template <typename Z, typename F> void activate_block(Activation a, const Z& z, F& f, F& d1) {
   switch (a) {
   case Activation::Elu: {
     const F e = z.array().min(0.0).exp().matrix();
     f = (z.array().max(0.0) + (e.array() - 1.0)).matrix();
     d1 = e;
-    if (d2)
-      *d2 = (z.array() > 0).select(0.0, e.array()).matrix();
     return;
   }
   case Activation::Squareplus: {
@@ -119,8 +116,6 @@ void activate_block(Activation a, const Z& z, F& f, F& d1, F* d2) {
     const auto inv = q.inverse().eval();
     f = (0.5 * (z.array() + q)).matrix();
     d1 = (0.5 * (1.0 + z.array() * inv)).matrix();
-    if (d2)
-      *d2 = (2.0 * inv * inv * inv).matrix();
     return;
   }
   default:
@@ -128,42 +123,100 @@ void activate_block(Activation a, const Z& z, F& f, F& d1, F* d2) {
       const ActivationValues v = activation_values(a, z.data()[i]);
       f.data()[i] = v.f;
       d1.data()[i] = v.d1;
-      if (d2)
-        d2->data()[i] = v.d2;
     }
   }
 }
 
-/// The energy network with two hidden layers of width W, in fixed-size Eigen (the common
-/// architectures; NnCorrection::energy_correction's loops serve the others): ∇_p g and, if
-/// `hessian_p` is non-null, ∇²_p g, with the identity of energy_correction.
+/// f, f', f'' of a fixed-size block for the energy network's hidden layers, with the value f
+/// only if `f` is non-null (the last hidden layer's values are not needed: the network's value
+/// is not). Squareplus and ELU as packed array expressions, the others through
+/// activation_values.
 template <int W>
-Vec3 energy_two_layers(const double* flat,
-    const std::array<int, NnCorrection::max_hidden_layers + 2>& offset, Activation act,
-    const Vec3& p, Mat3* hessian_p) {
-  using MatW3 = Eigen::Matrix<double, W, 3, Eigen::RowMajor>;
-  using MatWW = Eigen::Matrix<double, W, W, Eigen::RowMajor>;
-  using VecW = Eigen::Matrix<double, W, 1>;
-  const Eigen::Map<const MatW3> W1(flat + offset[0]);
-  const Eigen::Map<const VecW> b1(flat + offset[0] + 3 * W);
-  const Eigen::Map<const MatWW> W2(flat + offset[1]);
-  const Eigen::Map<const VecW> b2(flat + offset[1] + W * W);
-  const Eigen::Map<const VecW> w3(flat + offset[2]);
-  VecW a1, s1, c1, a2, s2, c2;
-  const VecW z1 = W1 * p + b1;
-  activate_block(act, z1, a1, s1, hessian_p ? &c1 : nullptr);
-  const VecW z2 = W2 * a1 + b2;
-  activate_block(act, z2, a2, s2, hessian_p ? &c2 : nullptr);
-  const VecW t2 = w3.cwiseProduct(s2); // ∂g/∂z₂
-  const VecW d1 = W2.transpose() * t2; // ∂g/∂a₁
-  const VecW t1 = d1.cwiseProduct(s1); // ∂g/∂z₁
-  if (hessian_p) {
-    // J₁ = W₁, J₂ = W₂ diag(f'(z₁)) W₁; ∇²g = J₁ᵀ diag(δ₁ f''₁) J₁ + J₂ᵀ diag(δ₂ f''₂) J₂.
-    const MatW3 J2 = W2 * (s1.asDiagonal() * W1);
-    const VecW k1 = d1.cwiseProduct(c1), k2 = w3.cwiseProduct(c2);
-    *hessian_p = W1.transpose() * k1.asDiagonal() * W1 + J2.transpose() * k2.asDiagonal() * J2;
+[[gnu::always_inline]] inline void activate_energy_block(Activation a,
+    const Eigen::Matrix<double, W, 1>& z, Eigen::Matrix<double, W, 1>* f,
+    Eigen::Matrix<double, W, 1>& d1, Eigen::Matrix<double, W, 1>& d2) {
+  switch (a) {
+  case Activation::Squareplus: {
+    const Eigen::Array<double, W, 1> q = (z.array() * z.array() + 4.0).sqrt(), inv = q.inverse();
+    if (f)
+      *f = (0.5 * (z.array() + q)).matrix();
+    d1 = (0.5 * (1.0 + z.array() * inv)).matrix();
+    d2 = (2.0 * inv * inv * inv).matrix();
+    return;
   }
-  return W1.transpose() * t1;
+  case Activation::Elu: {
+    const Eigen::Array<double, W, 1> e = z.array().min(0.0).exp();
+    if (f)
+      *f = (z.array().max(0.0) + (e - 1.0)).matrix();
+    d1 = e.matrix();
+    d2 = (z.array() > 0).select(0.0, e).matrix();
+    return;
+  }
+  default:
+    for (int i = 0; i < W; ++i) {
+      const ActivationValues v = activation_values(a, z[i]);
+      if (f)
+        (*f)[i] = v.f;
+      d1[i] = v.d1;
+      d2[i] = v.d2;
+    }
+  }
+}
+
+/// The energy network with two hidden layers of width W (the common architectures;
+/// NnCorrection::energy_network_gradient's loops serve the others): ∇_x g and, if `hessian_x` is
+/// non-null, ∇²_x g, with the identity of NnCorrection::energy_correction. `k` is the layout
+/// NnCorrection::m_energy_kernel holds: W₁ (W × 3), b₁, W₂ (W × W), W₂ᵀ, b₂, w₃, matrices
+/// column-major, so that every product below is a sum of columns scaled by one number: W-long
+/// packed operations, no horizontal sums but the final dot products.
+template <int W>
+Vec3 energy_two_layers(const double* k, Activation act, const Vec3& x, Mat3* hessian_x) {
+  using VecW = Eigen::Matrix<double, W, 1>;
+  using MatW3 = Eigen::Matrix<double, W, 3>;
+  using MatWW = Eigen::Matrix<double, W, W>;
+  const Eigen::Map<const MatW3> W1(k);
+  const Eigen::Map<const VecW> b1(k + 3 * W);
+  const Eigen::Map<const MatWW> W2(k + 4 * W);
+  const Eigen::Map<const MatWW> W2t(k + 4 * W + W * W);
+  const Eigen::Map<const VecW> b2(k + 4 * W + 2 * W * W);
+  const Eigen::Map<const VecW> w3(k + 5 * W + 2 * W * W);
+  // Forward: z₁ = W₁ x + b₁, a₁ = f(z₁), z₂ = W₂ a₁ + b₂ (the value g = w₃ᵀ f(z₂) + b₃ is not
+  // needed).
+  const VecW z1 = b1 + W1.col(0) * x[0] + W1.col(1) * x[1] + W1.col(2) * x[2];
+  VecW a1, s1, c1, s2, c2;
+  activate_energy_block<W>(act, z1, &a1, s1, c1);
+  VecW z2 = b2;
+  for (int c = 0; c < W; ++c)
+    z2 += W2.col(c) * a1[c];
+  activate_energy_block<W>(act, z2, nullptr, s2, c2);
+  // Reverse: t₂ = ∂g/∂z₂, d₁ = ∂g/∂a₁ = W₂ᵀ t₂, t₁ = ∂g/∂z₁; ∇_x g = W₁ᵀ t₁.
+  const VecW t2 = w3.cwiseProduct(s2);
+  VecW d1 = W2t.col(0) * t2[0];
+  for (int r = 1; r < W; ++r)
+    d1 += W2t.col(r) * t2[r];
+  const VecW t1 = d1.cwiseProduct(s1);
+  if (hessian_x) {
+    // J₁ = W₁, J₂ = ∂z₂/∂x = W₂ diag(f'(z₁)) W₁; ∇²g = J₁ᵀ diag(d₁ ⊙ f''₁) J₁ + J₂ᵀ diag(w₃ ⊙
+    // f''₂) J₂, its upper triangle then mirrored (symmetric bit for bit).
+    MatW3 J2;
+    for (int j = 0; j < 3; ++j) {
+      const VecW sw = s1.cwiseProduct(W1.col(j));
+      VecW col = W2.col(0) * sw[0];
+      for (int c = 1; c < W; ++c)
+        col += W2.col(c) * sw[c];
+      J2.col(j) = col;
+    }
+    const VecW k1 = d1.cwiseProduct(c1), k2 = w3.cwiseProduct(c2);
+    Mat3& h = *hessian_x;
+    for (int i = 0; i < 3; ++i) {
+      const VecW u1 = k1.cwiseProduct(W1.col(i)), u2 = k2.cwiseProduct(J2.col(i));
+      for (int j = i; j < 3; ++j) {
+        h(i, j) = (u1.cwiseProduct(W1.col(j)) + u2.cwiseProduct(J2.col(j))).sum();
+        h(j, i) = h(i, j);
+      }
+    }
+  }
+  return { W1.col(0).dot(t1), W1.col(1).dot(t1), W1.col(2).dot(t1) };
 }
 
 /// The stress network with two hidden layers of width W for four input columns at once (the
@@ -185,9 +238,9 @@ Eigen::Array4d stress_two_layers(const double* flat,
   const double b3 = flat[offset[2] + W];
   BlockW a1, s1, a2, s2;
   const BlockW z1 = (W1 * x).colwise() + b1;
-  activate_block(act, z1, a1, s1, static_cast<BlockW*>(nullptr));
+  activate_block(act, z1, a1, s1);
   const BlockW z2 = (W2 * a1).colwise() + b2;
-  activate_block(act, z2, a2, s2, static_cast<BlockW*>(nullptr));
+  activate_block(act, z2, a2, s2);
   if (d_x) {
     const BlockW t2 = s2.array().colwise() * w3.array();
     const BlockW t1 = (W2.transpose() * t2).cwiseProduct(s1);
@@ -340,6 +393,24 @@ NnCorrection::NnCorrection(Parameters p)
   // Two hidden layers of one common width run the fixed-size kernels.
   if (m_layers == 3 && m_width[1] == m_width[2] && (m_width[1] == 6 || m_width[1] == 8))
     m_fixed_width = m_width[1];
+  if (m_fixed_width > 0 && m_p.kind == NnKind::Energy) {
+    // energy_two_layers' layout: W₁ (W × 3), b₁, W₂ (W × W), W₂ᵀ, b₂, w₃, column-major.
+    const int w = m_fixed_width;
+    const double* W1 = m_flat.data() + m_offset[0];
+    const double* W2 = m_flat.data() + m_offset[1];
+    const double* w3 = m_flat.data() + m_offset[2];
+    m_energy_kernel.clear();
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < w; ++r)
+        m_energy_kernel.push_back(W1[r * 3 + c]);
+    m_energy_kernel.insert(m_energy_kernel.end(), W1 + 3 * w, W1 + 4 * w);
+    for (int c = 0; c < w; ++c)
+      for (int r = 0; r < w; ++r)
+        m_energy_kernel.push_back(W2[r * w + c]);
+    m_energy_kernel.insert(m_energy_kernel.end(), W2, W2 + w * w);
+    m_energy_kernel.insert(m_energy_kernel.end(), W2 + w * w, W2 + w * w + w);
+    m_energy_kernel.insert(m_energy_kernel.end(), w3, w3 + w);
+  }
 }
 
 Lanes NnCorrection::stress_lanes(const Lanes* x, Lanes* d_x) const {
@@ -466,19 +537,26 @@ Vec3 NnCorrection::energy_correction(const Vec3& s, Mat3* hessian) const {
   Mat3* want_h = hessian ? &h_x : nullptr;
   Vec3 g_x;
   if (m_fixed_width == 6)
-    g_x = energy_two_layers<6>(m_flat.data(), m_offset, m_p.activation, in.x, want_h);
+    g_x = energy_two_layers<6>(m_energy_kernel.data(), m_p.activation, in.x, want_h);
   else if (m_fixed_width == 8)
-    g_x = energy_two_layers<8>(m_flat.data(), m_offset, m_p.activation, in.x, want_h);
+    g_x = energy_two_layers<8>(m_energy_kernel.data(), m_p.activation, in.x, want_h);
   else
     g_x = energy_network_gradient(in.x, want_h);
-  // From x to p: ∇_p = (∂x/∂p)ᵀ ∇_x, ∇²_p = (∂x/∂p)ᵀ ∇²_x (∂x/∂p) + Σ_c ∂g/∂x_c ∇²_p x_c.
-  const Vec3 grad_p = in.d_p.transpose() * g_x;
+  // From x to p: ∇_p = Dᵀ ∇_x, ∇²_p = Dᵀ ∇²_x D + Σ_c ∂g/∂x_c ∇²_p x_c with D = ∂x/∂p, whose
+  // only entries besides D₀₀ = 1 are D₁₁ = ∂q/∂p₂, D₂₁ = ∂x₃/∂p₂ and D₂₂ = ∂x₃/∂p₃ (written
+  // out: the upper triangle, which is all energy_chain reads).
+  const double d11 = in.d_p(1, 1), d21 = in.d_p(2, 1), d22 = in.d_p(2, 2);
+  const Vec3 grad_p(g_x[0], d11 * g_x[1] + d21 * g_x[2], d22 * g_x[2]);
   Mat3 h_p;
   if (hessian) {
-    h_p = in.d_p.transpose() * h_x.selfadjointView<Eigen::Upper>() * in.d_p;
-    h_p(1, 1) += g_x[1] * in.q_22 + g_x[2] * in.x3_22;
-    h_p(1, 2) += g_x[2] * in.x3_23;
-    h_p(2, 1) = h_p(1, 2);
+    const Mat3& h = h_x;
+    h_p(0, 0) = h(0, 0);
+    h_p(0, 1) = d11 * h(0, 1) + d21 * h(0, 2);
+    h_p(0, 2) = d22 * h(0, 2);
+    h_p(1, 1) = d11 * d11 * h(1, 1) + 2 * d11 * d21 * h(1, 2) + d21 * d21 * h(2, 2)
+        + g_x[1] * in.q_22 + g_x[2] * in.x3_22;
+    h_p(1, 2) = d22 * (d11 * h(1, 2) + d21 * h(2, 2)) + g_x[2] * in.x3_23;
+    h_p(2, 2) = d22 * d22 * h(2, 2);
   }
   return energy_chain(e, p, grad_p, hessian ? &h_p : nullptr, hessian);
 }

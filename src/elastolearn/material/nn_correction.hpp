@@ -178,6 +178,9 @@ class NnCorrection final : public Correction {
   int m_layers = 0;
   /// 6 or 8 for two hidden layers of that width (fixed-size kernels), else 0.
   int m_fixed_width = 0;
+  /// Energy kind with m_fixed_width > 0: the folded layers in the fixed-size kernel's layout
+  /// (column-major W₁, b₁, W₂, W₂ᵀ, b₂, w₃; see energy_two_layers in the .cpp).
+  std::vector<double> m_energy_kernel;
 };
 
 } // namespace elastolearn::material
