@@ -68,6 +68,9 @@ void TrackingOptions::validate() const {
     fail("truncation", "must be in (0, 1), got " + to_text(truncation));
   if (em_iterations < 1)
     fail("em_iterations", "must be at least 1, got " + std::to_string(em_iterations));
+  if (initial_em_iterations < 1)
+    fail("initial_em_iterations",
+        "must be at least 1, got " + std::to_string(initial_em_iterations));
   if (!(em_tolerance >= 0) || !std::isfinite(em_tolerance))
     fail("em_tolerance", "must be non-negative and finite, got " + to_text(em_tolerance));
 }
@@ -185,6 +188,7 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
         ++l;
       const capture::CloudIndex index(cloud);
       int level_iterations = 0;
+      const int budget = dynamic ? options.em_iterations : options.initial_em_iterations;
       while (true) {
         Level& level = levels[l];
         const Eigen::Map<const Positions> x_guess(guess.data(), n, 3);
@@ -221,7 +225,7 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
         // EM at this σ until the solve stays within em_tolerance·σ of where the pairs were
         // found (they would hardly change), or em_iterations; then the next finer σ.
         const bool settled = moved <= options.em_tolerance * level.sigma;
-        if (settled || ++level_iterations >= options.em_iterations) {
+        if (settled || ++level_iterations >= budget) {
           if (l == 0)
             break;
           --l;
@@ -239,13 +243,23 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
     frame.time = simulator.time();
     if (frame.points > 0) {
       const VecX& x = simulator.positions();
-      frame.rms = distance.rms(Eigen::Map<const Positions>(x.data(), n, 3), cloud);
+      distance.distances(Eigen::Map<const Positions>(x.data(), n, 3), cloud, d);
+      frame.rms = std::sqrt(d.squaredNorm() / double(d.size()));
+      double inliers = 0;
+      for (Eigen::Index i = 0; i < d.size(); ++i) {
+        if (d[i] > k_inlier_distance * report.sigma)
+          ++frame.outliers;
+        else
+          inliers += d[i] * d[i];
+      }
+      if (frame.outliers < frame.points)
+        frame.rms_inliers = std::sqrt(inliers / double(frame.points - frame.outliers));
     }
     sink(t, frame.time, simulator.positions(), simulator.velocities());
     report.frames.push_back(frame);
     if (progress)
       progress(t + 1, T,
-          "frame " + std::to_string(t) + ": rms " + to_text(frame.rms) + " m, "
+          "frame " + std::to_string(t) + ": rms " + to_text(frame.rms_inliers) + " m, "
               + std::to_string(frame.em_iterations) + " EM");
   }
   report.completed = report.message.empty();
