@@ -128,6 +128,8 @@ void run_track(TrackCommandOptions opts) {
       seen, seen ? std::sqrt(sum_inliers / seen) : 0.0, observe::k_inlier_distance, worst_frame,
       worst, seen ? std::sqrt(sum / seen) : 0.0,
       points ? 100.0 * double(outliers) / double(points) : 0.0);
+  for (const std::string& note : report.notes)
+    std::printf("note: %s\n", note.c_str());
   if (writer.frames() > 0) {
     writer.finish({ { "scene", scene.name }, { "material", scene.material.elastic->name() },
         { "dt", to_text_exact(scene.dt) }, { "clouds", opts.clouds },

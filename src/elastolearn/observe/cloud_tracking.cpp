@@ -188,6 +188,7 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
         ++l;
       const capture::CloudIndex index(cloud);
       int level_iterations = 0;
+      bool have_converged = false;
       const int budget = dynamic ? options.em_iterations : options.initial_em_iterations;
       while (true) {
         Level& level = levels[l];
@@ -214,9 +215,24 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
         ++frame.em_iterations;
         frame.newton_iterations += solve.iterations;
         if (!solve.converged) {
-          failed = &solve;
+          // Keep the last converged solve of this frame (for frame 0, at least the initial
+          // state): a later frame's EM can still catch up. A frame with no such state fails.
+          if (dynamic && !have_converged) {
+            failed = &solve;
+            break;
+          }
+          report.notes.push_back("frame " + std::to_string(t) + ": EM stopped after "
+              + std::to_string(frame.em_iterations - 1) + " solves at σ = " + to_text(level.sigma)
+              + " m, the next did not converge (" + solve.message
+              + "); the frame keeps the last converged one");
+          // Backward Euler: x₊ = x + h v₊, so the kept step's velocity is (x₊ − x) / h.
+          if (dynamic)
+            simulator.set_state(guess, (guess - x_start) / scene.dt, t_start + scene.dt);
+          else
+            simulator.set_state(guess, v_start, t_start);
           break;
         }
+        have_converged = true;
         const VecX& x = simulator.positions();
         double moved = 0;
         for (int v = 0; v < n; ++v)

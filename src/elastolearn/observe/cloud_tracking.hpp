@@ -83,6 +83,9 @@ struct TrackingReport {
   int samples = 0; ///< surface samples at σ
   int levels = 0; ///< coarse-to-fine levels available
   double seconds = 0; ///< wall time
+  /// Frames whose EM stopped early because a re-solve did not converge (they keep the last
+  /// converged solve; frame 0 at worst the initial state), one line each.
+  std::vector<std::string> notes;
 };
 
 /// Track `clouds` (frame t at clouds.start_time + t·dt) with `scene`: its dt must equal clouds.dt,
