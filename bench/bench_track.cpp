@@ -22,6 +22,8 @@
 
 #include <tbb/info.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -31,6 +33,14 @@
 using namespace elastolearn;
 
 namespace {
+
+/// CPU time of the process so far, all threads [s].
+double cpu_seconds() {
+  rusage usage {};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec)
+      + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
 
 sim::Scene cantilever(double young, int frames) {
   sim::Scene scene = test::bar_scene({ .size = Vec3(0.4, 0.1, 0.1),
@@ -130,8 +140,10 @@ int main(int argc, char** argv) {
   cloud_frames.clear();
 
   std::vector<VecX> tracked;
+  const double cpu_start = cpu_seconds();
   const auto report = observe::track_clouds(nominal, clouds, "bench clouds", options,
       [&](int, double, const VecX& x, const VecX&) { tracked.push_back(x); });
+  const double cpu = cpu_seconds() - cpu_start;
   if (!report.completed) {
     std::fprintf(stderr, "tracking failed: %s\n", report.message.c_str());
     return 1;
@@ -156,10 +168,11 @@ int main(int argc, char** argv) {
   std::printf("clouds: %.0f points per frame on average (camera at %.2f m), σ = %g m\n",
       double(points) / n, distance, sigma);
   std::printf("threads: %d (oneTBB default concurrency)\n", tbb::info::default_concurrency());
-  std::printf("tracking: %.2f s wall, %.1f ms/frame; %.2f solves and %.1f Newton iterations per "
+  std::printf("tracking: %.2f s wall (%.2f s CPU, all threads), %.1f ms/frame; %.2f solves and "
+              "%.1f Newton iterations per "
               "frame; σ used %g m, λ = %g, %d samples, %d levels\n",
-      report.seconds, 1e3 * report.seconds / n, double(em) / n, double(newton) / n, report.sigma,
-      options.weight, report.samples, report.levels);
+      report.seconds, cpu, 1e3 * report.seconds / n, double(em) / n, double(newton) / n,
+      report.sigma, options.weight, report.samples, report.levels);
   std::printf("surface vertices vs truth: tracked RMS %.3g m (max %.3g m); untracked nominal RMS "
               "%.3g m (max %.3g m)\n",
       tracked_rms, tracked_max, nominal_rms, nominal_max);
