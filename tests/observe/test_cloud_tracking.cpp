@@ -194,8 +194,8 @@ TEST(CloudTracking, FollowsTheScansOfTheTruthWithAWrongNominalMaterial) {
   std::printf("surface vertex RMS vs truth: nominal %.3g m, tracked %.3g m; worst frame RMS "
               "cloud→surface %.3g m; %d samples, %d levels\n",
       untracked, error, worst_rms, report.samples, report.levels);
-  // Measured (the defaults: λ = 1, EM to 5 solves per σ level, 20 in frame 0): nominal 39 mm, tracked 0.46 mm, worst frame
-  // 1.09 mm. The wrong material is far off (so the test can fail) ...
+  // Measured (the defaults: λ = 1, EM to 5 solves per σ level, 20 in frame 0): nominal 39 mm,
+  // tracked 0.46 mm, worst frame 1.09 mm. The wrong material is far off (so the test can fail) ...
   EXPECT_GT(untracked, 10 * sigma);
   // ... tracking removes ~99 % of it (bound with 4× slack) and lands within σ of the truth: the
   // ~650 points per frame average the noise, but frame 0 starts ~6 cm off at the tip.
