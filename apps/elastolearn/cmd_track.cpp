@@ -94,7 +94,7 @@ void run_track(TrackCommandOptions opts) {
       report.sigma, sigma_source.c_str(),
       report.sigma > opts.tracking.sigma ? ", raised to the sample floor" : "",
       opts.tracking.weight, report.stiffness_per_area, report.samples, report.levels);
-  std::string rms_list;
+  std::string rms_list, inlier_list;
   double worst = 0, sum = 0, sum_inliers = 0;
   int worst_frame = 0, seen = 0;
   long em = 0, newton = 0;
@@ -102,6 +102,7 @@ void run_track(TrackCommandOptions opts) {
   for (std::size_t t = 0; t < report.frames.size(); ++t) {
     const auto& f = report.frames[t];
     rms_list += (t ? " " : "") + to_text_exact(f.rms);
+    inlier_list += (t ? " " : "") + to_text_exact(f.rms_inliers);
     em += f.em_iterations;
     newton += f.newton_iterations;
     if (f.points == 0)
