@@ -181,7 +181,8 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
       const Eigen::Map<const Positions> predicted(guess.data(), n, 3);
       distance.distances(predicted, cloud, d);
       frame.rms_predicted = std::sqrt(d.squaredNorm() / double(d.size()));
-      // Start at the finest σ whose reach (3.72σ) covers twice the 90th-percentile distance.
+      // Start at the finest σ ≥ half the 90th-percentile distance: its reach, 3.72σ, is then
+      // ~1.9× the distance of all but the farthest tenth of the points (outliers among them).
       const double far = quantile(d, 0.9);
       int l = 0;
       while (l + 1 < static_cast<int>(levels.size()) && levels[l].sigma < 0.5 * far)
