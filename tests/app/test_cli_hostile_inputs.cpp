@@ -464,6 +464,13 @@ const std::vector<Case> kCases = {
   { "scan_output_is_trajectory", nothing(), "scan traj.h5 --camera cam.json -o traj.h5", { "traj.h5", kReplace } },
   { "scan_output_is_camera", nothing(), "scan traj.h5 --camera cam.json -o cam.json", { "cam.json", kReplace } },
   { "scan_output_under_file", nothing(), "scan traj.h5 --camera cam.json -o notadir/c.h5", { "notadir/c.h5", "not a folder" } },
+  { "track_dt_differs_from_scene", nothing(), "track scene.json --clouds clouds.h5 -q -o out.h5", { "clouds.h5: dt", "0.002" } },
+  { "track_clouds_nan", clouds("c.h5", [](H5Spec& s) { s.f64["/clouds/points"].second[4] = kNaN; }), "track scene.json --clouds c.h5 -q -o out.h5", { "c.h5: /clouds/points", "non-finite" } },
+  { "track_noise_sigma_garbage", clouds("c.h5", [](H5Spec& s) { s.attributes["noise_sigma"] = "one mm"; }), "track scene.json --clouds c.h5 -q -o out.h5", { "c.h5", "noise_sigma", "'one mm'" } },
+  { "track_negative_sigma", nothing(), "track scene.json --clouds clouds.h5 --sigma -1 -q -o out.h5", { "tracking.sigma" } },
+  { "track_zero_weight", nothing(), "track scene.json --clouds clouds.h5 --sigma 0.001 --weight 0 -q -o out.h5", { "tracking.weight" } },
+  { "track_trajectory_as_clouds", nothing(), "track scene.json --clouds traj.h5 -q -o out.h5", { "traj.h5" } },
+  { "track_output_is_clouds", nothing(), "track scene.json --clouds clouds.h5 -q -o clouds.h5", { "clouds.h5", kReplace } },
 
   // ---- TetGen .node/.ele --------------------------------------------------------------------
   { "tetgen_empty_node", both(text("b.node", ""), text("b.ele", kEle)), "info b.node", { "b.node" } },

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace elastolearn::capture {
 
@@ -60,6 +61,15 @@ void CloudIndex::within(
   params.sorted = false;
   m_impl->tree->radiusSearch(query.data(), radius * radius, out, params);
   std::sort(out.begin(), out.end());
+}
+
+std::pair<Eigen::Index, double> CloudIndex::nearest(const Vec3& query) const {
+  if (!m_impl->tree)
+    return { -1, std::numeric_limits<double>::infinity() };
+  Eigen::Index index = -1;
+  double distance = 0;
+  m_impl->tree->knnSearch(query.data(), 1, &index, &distance);
+  return { index, distance };
 }
 
 double CloudIndex::median_spacing() const {

@@ -29,6 +29,10 @@ class CloudIndex {
   void within(
       const Vec3& query, double radius, std::vector<std::pair<Eigen::Index, double>>& out) const;
 
+  /// The point nearest to `query`, as (point index, squared distance); (−1, +∞) for an empty
+  /// cloud. Thread safe.
+  std::pair<Eigen::Index, double> nearest(const Vec3& query) const;
+
   /// Median distance from a point to its nearest other point [m] (0 with fewer than 2 points):
   /// the cloud's spacing, e.g. for subdivision_for_spacing. Parallel.
   double median_spacing() const;
