@@ -4,7 +4,8 @@
 // then compare nominal / fitted / learned with the truth on a different, larger test motion.
 // err_L = max vertex position error over the test trajectory, % of the rest bounding-box diagonal.
 //
-//   bench_learning [--quick] [--data DIR] [--dropout P] [--modes R --kernels M ...] [CASE ...]
+//   bench_learning [--quick] [--data DIR] [--dropout P] [--scan C [--scan-noise S] [--outliers F]]
+//                  [--modes R --kernels M ...] [CASE ...]
 //   (no case = all; --help)
 //   bench_learning --random N --seed S [--random-case I] [--draw-only]   (random cases, each
 //   learned by the one recipe, learn::learn_material, with its default options: issue 19)
@@ -14,6 +15,7 @@
 #include "learning_cases.hpp"
 #include "random_cases.hpp"
 
+#include <elastolearn/capture/virtual_scanner.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/learn/stretch_coverage.hpp>
@@ -86,6 +88,12 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
 /// draws the bursts (default 2).
 double g_dropout = 0;
 std::uint64_t g_dropout_seed = 2;
+/// --scan C: the named cases learn from virtual depth scans of their training motion by C = 1 or
+/// 2 cameras (scan_cameras) instead of vertex observations (issue 20's point clouds), with depth
+/// noise --scan-noise S [m] (default 1 mm) and a fraction --outliers F of outlier returns.
+int g_scan_cameras = 0;
+double g_scan_noise = 1e-3;
+double g_outliers = 0;
 bool g_truth_only = false; ///< --truth-only: simulate the truth's motions and the nominal test,
                            ///< then stop (for tuning scenes)
 /// The recipe every case learns with: its defaults, changed only by the expert flags below, which
@@ -181,6 +189,45 @@ bool diverged(const learn::IterationRecord& r) {
   return !r.forward_completed && !r.forward_unstable;
 }
 
+/// The cameras of --scan: 640×480 pixels, 45° vertical field of view, looking at the rest mesh's
+/// bounding-box centre from 2 diagonals away: the first from the front (+z) and a little above,
+/// the second from the right (+x) and above. A 0.3 m object then spans about a third of the
+/// image height, 1.6 mm per pixel.
+std::vector<capture::DepthCamera> scan_cameras(const mesh::TetMesh& mesh, int count) {
+  const auto box = mesh.bounding_box();
+  const Vec3 centre = box.center();
+  const double d = mesh.bounding_box_diagonal();
+  const Vec3 directions[2] = { Vec3(0, 0.5, 2).normalized(), Vec3(2, 1, -0.3).normalized() };
+  std::vector<capture::DepthCamera> cameras;
+  for (int i = 0; i < count; ++i) {
+    capture::DepthCamera c;
+    c.name = i == 0 ? "front" : "side";
+    c.position = centre + 2 * d * directions[i];
+    c.look_at(centre, Vec3(0, 1, 0), "bench");
+    c.set_field_of_view(45);
+    cameras.push_back(c);
+  }
+  return cameras;
+}
+
+/// The truth's training motion as --scan sees it.
+std::shared_ptr<const learn::CloudCapture> scan_motion(
+    const sim::Scene& scene, const std::vector<Positions>& frames) {
+  capture::ScanOptions options;
+  options.noise = g_scan_noise;
+  options.outlier_fraction = g_outliers;
+  capture::VirtualScanner scanner(scene.mesh.surface_faces(), scene.mesh.num_vertices(),
+      scan_cameras(scene.mesh, g_scan_cameras), options);
+  std::vector<capture::CloudFrame> clouds;
+  capture::scan_frames(
+      scanner, frames, [&](long, const capture::CloudFrame& cloud) { clouds.push_back(cloud); });
+  auto capture = std::make_shared<learn::CloudCapture>();
+  capture->clouds = capture::PointCloudSequence::from_frames(clouds, scene.dt, 0, "scan");
+  capture->sigma = g_scan_noise;
+  capture->source = "virtual scan";
+  return capture;
+}
+
 Row run_case(const LearningCase& c) {
   Row row;
   row.name = c.name;
@@ -240,7 +287,18 @@ Row run_case(const LearningCase& c) {
   callbacks.loop.iteration
       = [&](const learn::IterationRecord& r) { print_iteration(r, size, "   "); };
   t0 = Clock::now();
-  const std::vector<learn::Motion> motions { { c.name + " training", c.train, observed } };
+  std::vector<learn::Motion> motions { { c.name + " training", c.train, observed } };
+  if (g_scan_cameras > 0) {
+    t0 = Clock::now();
+    motions.front().captured = scan_motion(c.train, frames);
+    motions.front().observed = {};
+    const auto& clouds = motions.front().captured->clouds;
+    std::printf("   scanned by %d camera(s), σ = %g m, %g %% outliers: %.0f points per frame "
+                "(%.1f s)\n",
+        g_scan_cameras, g_scan_noise, 100 * g_outliers,
+        static_cast<double>(clouds.num_points()) / clouds.num_frames(), seconds_since(t0));
+    t0 = Clock::now();
+  }
   const learn::RecipeResult learned = learn::learn_material(motions, g_recipe, callbacks);
   row.learn_total = seconds_since(t0);
   for (const auto& r : learned.loop.history) {
@@ -257,6 +315,10 @@ Row run_case(const LearningCase& c) {
     row.kernels = std::max(row.kernels, r.centres);
   }
   row.fit_seconds = learned.parameter_fit.seconds;
+  if (g_scan_cameras > 0) {
+    row.name += " (" + std::to_string(g_scan_cameras) + "-camera scan)";
+    row.observed = learned.observed.front().num_observed();
+  }
   row.chosen = learn::to_string(learned.choice().kind);
   if (learned.choice().iteration >= 0)
     row.chosen += " " + std::to_string(learned.choice().iteration);
@@ -602,6 +664,12 @@ int main(int argc, char** argv) {
       g_dropout = std::stod(argv[++i]);
     else if (a == "--dropout-seed" && i + 1 < argc)
       g_dropout_seed = std::stoull(argv[++i]);
+    else if (a == "--scan" && i + 1 < argc)
+      g_scan_cameras = std::stoi(argv[++i]);
+    else if (a == "--scan-noise" && i + 1 < argc)
+      g_scan_noise = std::stod(argv[++i]);
+    else if (a == "--outliers" && i + 1 < argc)
+      g_outliers = std::stod(argv[++i]);
     else if (a == "--truth-only")
       g_truth_only = true;
     else if (a == "--no-fit")
@@ -660,7 +728,8 @@ int main(int argc, char** argv) {
       draw_only = true;
     else if (a == "--help" || a == "-h") {
       std::printf("usage: bench_learning [--quick] [--truth-only] [--no-fit] [--data DIR] "
-                  "[--dropout P [--dropout-seed S]] [--modes "
+                  "[--dropout P [--dropout-seed S]] [--scan C [--scan-noise S] [--outliers F]] "
+                  "[--modes "
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
                   "[--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
@@ -679,7 +748,10 @@ int main(int argc, char** argv) {
           "its default options (the learning overrides above do not apply); --random-case I: only "
           "case I of that draw; --draw-only: print the draws without simulating\n--dropout P: "
           "the named cases' training observations lose a fraction P of their marker-frames in "
-          "occlusion bursts (mean 5 frames) drawn from --dropout-seed S (default 2)\n");
+          "occlusion bursts (mean 5 frames) drawn from --dropout-seed S (default 2)\n--scan C: "
+          "the named cases learn from virtual depth scans of their training motion by C = 1 or 2 "
+          "cameras (640×480, 45°, 2 diagonals away), depth noise --scan-noise S [m] (default "
+          "0.001), outlier fraction --outliers F (default 0)\n");
       return 0;
     } else if (a == "all")
       names.insert(names.end(), kCases.begin(), kCases.end());

@@ -27,7 +27,7 @@
 namespace {
 
 struct LearnOptions {
-  std::string scene, observations, output, report, checkpoint, truth_material;
+  std::string scene, observations, clouds, output, report, checkpoint, truth_material;
   bool resume = false;
   bool quiet = false;
   std::string reconstruction = "normal_equations";
@@ -79,7 +79,8 @@ void run_learn(const LearnOptions& o) {
   using namespace elastolearn;
   if (!o.truth_material.empty() && o.report.empty())
     throw InputError("--truth-material", "is used by the report only: give --report DIR too");
-  const io::TrainingSet set = io::read_learning_data(o.scene, o.observations, "--observations");
+  const io::TrainingSet set
+      = io::read_learning_data(o.scene, o.observations, "--observations", o.clouds, "--clouds");
   const std::filesystem::path checkpoint = io::learning_checkpoint_path(o.output, o.checkpoint);
   {
     // With --resume the checkpoint is read and then rewritten on purpose: it is an output only.
@@ -112,7 +113,8 @@ void run_learn(const LearnOptions& o) {
   options.network.kind = learn::network_kind_from_name(o.network_kind, "--network-kind");
   options.validate();
 
-  const io::LearningInputs inputs { o.scene, o.observations, io::recipe_options_to_json(options) };
+  const io::LearningInputs inputs { o.scene, o.observations.empty() ? o.clouds : o.observations,
+    io::recipe_options_to_json(options) };
   std::optional<learn::RecipeResume> resume;
   if (o.resume) {
     resume = io::resume_learning_checkpoint(checkpoint, inputs, "--resume");
@@ -120,6 +122,14 @@ void run_learn(const LearnOptions& o) {
         resume->loop.next_iteration);
   }
   for (const learn::Motion& m : motions) {
+    if (m.captured) {
+      std::printf("learning from %s: %d vertices, %d tets, %d frames of dt = %g s, point clouds "
+                  "of %lld points in all, nominal %s\n",
+          m.name.c_str(), m.scene.mesh.num_vertices(), m.scene.mesh.num_tets(), m.scene.frames,
+          m.scene.dt, static_cast<long long>(m.captured->clouds.num_points()),
+          m.scene.material.elastic->name().c_str());
+      continue;
+    }
     const std::string lost = observe::describe_lost_entries(m.observed);
     std::printf("learning from %s: %d vertices, %d tets, %d frames of dt = %g s, %d observed "
                 "vertices%s, nominal %s\n",
@@ -203,7 +213,10 @@ void run_learn(const LearnOptions& o) {
   if (!o.report.empty()) {
     std::printf("report: simulating the candidates on %s for the plots\n", motions[0].name.c_str());
     std::fflush(stdout);
-    const io::LearningRunReportInputs report { o.scene, o.output, motions, &result, &learned,
+    std::vector<learn::Motion> observed = motions; // with the observations learned from
+    for (size_t i = 0; i < observed.size(); ++i)
+      observed[i].observed = result.observed[i];
+    const io::LearningRunReportInputs report { o.scene, o.output, observed, &result, &learned,
       truth ? &*truth : nullptr, o.truth_material };
     std::printf("%s\n",
         io::describe_report(o.report, io::write_learning_run_report(o.report, report)).c_str());
@@ -213,7 +226,7 @@ void run_learn(const LearnOptions& o) {
 void add_learn_command(CLI::App& root) {
   auto o = std::make_shared<LearnOptions>();
   auto* cmd = root.add_subcommand(
-      "learn", "Learn a material correction from observed vertex trajectories");
+      "learn", "Learn a material correction from observed vertex trajectories or point clouds");
   cmd->add_option("scene", o->scene,
          "scene with the nominal material (elastolearn-scene/1 JSON), or a training set of "
          "several motions (elastolearn-training/1 JSON)")
@@ -221,6 +234,9 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--observations", o->observations,
       "observation HDF5 of the scene's motion (from observe, or your capture); not with a "
       "training set");
+  cmd->add_option("--clouds", o->clouds,
+      "point-cloud HDF5 of the scene's motion instead (from scan or import-clouds): tracked, "
+      "then learned from (docs/tracking.md); not with a training set");
   cmd->add_option("-o,--output", o->output, "learned material JSON to write")->required();
   cmd->add_option("--report", o->report,
       "folder for the report: report.html (plots, animation; opens offline), summary.json, "

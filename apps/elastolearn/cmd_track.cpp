@@ -8,8 +8,10 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
 #include <elastolearn/io/cloud_file.hpp>
+#include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
+#include <elastolearn/observe/cloud_observation.hpp>
 #include <elastolearn/observe/cloud_tracking.hpp>
 
 #include <algorithm>
@@ -22,36 +24,23 @@ struct TrackCommandOptions {
   std::string scene;
   std::string clouds;
   std::string output;
+  std::string observations;
   elastolearn::observe::TrackingOptions tracking;
   bool quiet = false;
   bool sigma_given = false;
 };
-
-/// The scanner accuracy a cloud file records (scan writes noise_sigma), or 0 when it records none.
-double recorded_noise(const std::string& clouds) {
-  using namespace elastolearn;
-  const auto metadata = io::read_clouds_metadata(clouds);
-  const auto it = metadata.find("noise_sigma");
-  if (it == metadata.end())
-    return 0;
-  try {
-    std::size_t used = 0;
-    const double sigma = std::stod(it->second, &used);
-    if (used == it->second.size() && std::isfinite(sigma) && sigma >= 0)
-      return sigma;
-  } catch (const std::exception&) { }
-  throw InputError(clouds + ": / attribute 'noise_sigma'",
-      "'" + it->second + "' is not a non-negative number (the scanner's accuracy in metres)");
-}
 
 void run_track(TrackCommandOptions opts) {
   using namespace elastolearn;
   const auto file = io::read_scene_file(opts.scene);
   std::vector<CommandInput> inputs = file.inputs;
   inputs.push_back({ opts.clouds, "point clouds (--clouds)" });
-  check_command_paths(inputs, { { opts.output, "tracked trajectory (-o)" } });
+  std::vector<CommandOutput> outputs { { opts.output, "tracked trajectory (-o)" } };
+  if (!opts.observations.empty())
+    outputs.push_back({ opts.observations, "observations (--observations)" });
+  check_command_paths(inputs, outputs);
   const capture::PointCloudSequence clouds = io::read_clouds_h5(opts.clouds);
-  const double noise = recorded_noise(opts.clouds);
+  const double noise = io::read_clouds_noise_sigma(opts.clouds);
   const std::string sigma_source = opts.sigma_given ? "--sigma"
       : noise > 0                                   ? "the clouds' noise_sigma"
                                                     : "half the clouds' point spacing";
@@ -79,6 +68,7 @@ void run_track(TrackCommandOptions opts) {
         return m;
       }());
 
+  std::vector<Positions> tracked; // for --observations
   io::TrajectoryWriter writer(opts.output, scene.mesh.rest_positions(), scene.mesh.tets(), Edges(),
       scene.mesh.surface_faces());
   const auto report = observe::track_clouds(
@@ -86,6 +76,8 @@ void run_track(TrackCommandOptions opts) {
       [&](int, double time, const VecX& x, const VecX& v) {
         writer.append(time, Eigen::Map<const Positions>(x.data(), x.size() / 3, 3),
             Eigen::Map<const Positions>(v.data(), v.size() / 3, 3));
+        if (!opts.observations.empty())
+          tracked.emplace_back(unflatten(x));
       },
       opts.quiet ? ProgressCallback {} : terminal_progress("track"));
 
@@ -139,6 +131,16 @@ void run_track(TrackCommandOptions opts) {
         { "tracking_weight", to_text_exact(opts.tracking.weight) }, { "tracking_rms", rms_list } });
     std::printf("trajectory: %s\n", opts.output.c_str());
   }
+  if (report.completed && !opts.observations.empty()) {
+    observe::CloudObservationOptions observing;
+    observing.sigma = report.sigma;
+    const observe::Observation observed
+        = observe::observe_clouds(scene.mesh.surface_vertices(), tracked, clouds, observing);
+    io::write_observation_h5(opts.observations, observed);
+    std::printf("observations: %s (%s of %d surface vertices' frames seen)\n",
+        opts.observations.c_str(), to_text(observed.num_valid()).c_str(),
+        observed.num_observed() * observed.num_frames());
+  }
   if (!report.completed) {
     std::fprintf(stderr, "elastolearn: error: %s\n", report.message.c_str());
     throw CLI::RuntimeError(1);
@@ -156,6 +158,9 @@ void add_track_command(CLI::App& root) {
       ->required();
   cmd->add_option("--clouds", opts->clouds, "point-cloud HDF5 (scan, import-clouds)")->required();
   cmd->add_option("-o,--output", opts->output, "tracked trajectory HDF5 to write")->required();
+  cmd->add_option("--observations", opts->observations,
+      "also write the surface observations learn derives from the clouds around the tracked "
+      "surface (observation HDF5; docs/tracking.md)");
   auto* sigma = cmd->add_option("--sigma", opts->tracking.sigma,
       "correspondence σ [m] (default: the clouds' noise_sigma, else half their point spacing)");
   cmd->add_option("--weight", opts->tracking.weight,

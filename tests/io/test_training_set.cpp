@@ -195,13 +195,16 @@ TEST(TrainingSet, ResolvesPathsAgainstItsOwnFolderFromAnyWorkingFolder) {
 TEST(TrainingSet, ReadsOneSceneAndObservationPairWithTheSameChecks) {
   const ScratchDir dir;
   const auto entries = two_motions(dir);
-  const TrainingSet one = read_training_motion(entries[1].scene, entries[1].observations);
+  const TrainingSet one = read_training_motion({ entries[1].scene, entries[1].observations });
   ASSERT_EQ(one.motions.size(), 1u);
   EXPECT_TRUE(one.path.empty());
   EXPECT_EQ(one.motions[0].scene.frames, 7);
   EXPECT_TRUE(has_input(one, entries[1].observations));
   // a.h5 has 6 frames, b.json needs 8.
-  expect_input_error([&] { read_training_motion(entries[1].scene, entries[0].observations); },
+  expect_input_error(
+      [&] {
+        read_training_motion({ entries[1].scene, entries[0].observations });
+      },
       { "a.h5", "frames" });
 }
 

@@ -214,6 +214,21 @@ std::map<std::string, std::string> read_clouds_metadata(const std::filesystem::p
   return metadata;
 }
 
+double read_clouds_noise_sigma(const std::filesystem::path& path) {
+  const auto metadata = read_clouds_metadata(path);
+  const auto it = metadata.find("noise_sigma");
+  if (it == metadata.end())
+    return 0;
+  try {
+    std::size_t used = 0;
+    const double sigma = std::stod(it->second, &used);
+    if (used == it->second.size() && std::isfinite(sigma) && sigma >= 0)
+      return sigma;
+  } catch (const std::exception&) { }
+  throw InputError(path.string() + ": / attribute 'noise_sigma'",
+      "'" + it->second + "' is not a non-negative number (the scanner's accuracy in metres)");
+}
+
 bool is_clouds_h5(const std::filesystem::path& path) {
   try {
     const std::optional<std::string> format = h5::File::open(path).attribute("format");

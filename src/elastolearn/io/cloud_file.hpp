@@ -58,6 +58,11 @@ capture::PointCloudSequence read_clouds_h5(const std::filesystem::path& path);
 /// read_clouds_h5.
 std::map<std::string, std::string> read_clouds_metadata(const std::filesystem::path& path);
 
+/// The scanner's accuracy σ [m] a cloud file records (its "noise_sigma" attribute, which scan
+/// writes), or 0 when it records none. Throws InputError("<file>: / attribute 'noise_sigma'", ...)
+/// for a value that is not a non-negative number, and like read_clouds_h5.
+double read_clouds_noise_sigma(const std::filesystem::path& path);
+
 /// True if `path` is an HDF5 file whose "format" attribute names elastolearn point clouds (any
 /// version); false for anything else, including files that cannot be opened.
 bool is_clouds_h5(const std::filesystem::path& path);

@@ -94,10 +94,11 @@ MaterialFile learned_material_file(const TrainingSet& set, const std::string& so
   learned.training_stretches = learn::training_stretch_range(training_scene, chosen.correction);
   nlohmann::json motion_names = nlohmann::json::array();
   for (const auto& f : set.files)
-    motion_names.push_back(
-        { { "scene", f.paths.scene.string() }, { "observations", f.paths.observations.string() } });
+    motion_names.push_back({ { "scene", f.paths.scene.string() },
+        f.paths.clouds.empty() ? nlohmann::json { "observations", f.paths.observations.string() }
+                               : nlohmann::json { "clouds", f.paths.clouds.string() } });
   learned.training = { { set.path.empty() ? "scene" : "training_set", source },
-    { "motions", motion_names }, { "observed_vertices", set.motions[0].observed.num_observed() },
+    { "motions", motion_names }, { "observed_vertices", result.observed.at(0).num_observed() },
     { "best_iteration", result.loop.best_iteration },
     { "best_rms_error_m", result.loop.best_error }, { "options", recipe_options_to_json(options) },
     { "recipe", recipe_result_to_json(result) }, { "seconds", result.seconds },

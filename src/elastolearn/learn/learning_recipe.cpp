@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/timing.hpp>
+#include <elastolearn/learn/cloud_motion.hpp>
 #include <elastolearn/learn/element_state.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/material/corotated.hpp>
@@ -269,23 +270,10 @@ int choose_candidate(std::vector<Candidate>& candidates, std::span<const VecX> p
   return chosen;
 }
 
-RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions& options,
-    const RecipeCallbacks& callbacks, const RecipeResume* resume) {
-  const auto start = Clock::now();
-  options.validate();
-  if (motions.empty())
-    throw InputError("training set", "no motion to learn from");
-  for (const Motion& m : motions) {
-    m.scene.validate();
-    if (m.scene.material.correction)
-      throw InputError(m.name, "the nominal material must not carry a correction already");
-    m.observed.validate(m.scene.mesh.num_vertices(), m.scene.frames + 1, m.scene.dt, m.name);
-  }
-  RecipeResult result;
-  const fem::MaterialModel& given = motions.front().scene.material;
-  const NominalParameters given_parameters = nominal_parameters_of(given, result.nominal_type);
-  const double size = motions.front().scene.mesh.bounding_box_diagonal();
-
+/// Stages 0 and 1: σ (given or estimated), the positions smoothed to it, and the split into
+/// training and held-out data. Sets result.noise and the frame counts.
+Split prepare_data(std::span<const Motion> motions, const RecipeOptions& options,
+    RecipeResult& result, const RecipeCallbacks& callbacks, double size) {
   // Stage 0: the noise and the smoothed positions the loop follows.
   if (options.noise >= 0) {
     result.noise.sigma = options.noise;
@@ -326,9 +314,47 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   result.validation_data = split.description;
   say(callbacks, "validation: " + split.description);
 
+  return split;
+}
+
+RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions& options,
+    const RecipeCallbacks& callbacks, const RecipeResume* resume) {
+  const auto start = Clock::now();
+  options.validate();
+  if (motions.empty())
+    throw InputError("training set", "no motion to learn from");
+  for (const Motion& m : motions) {
+    m.scene.validate();
+    if (m.scene.material.correction)
+      throw InputError(m.name, "the nominal material must not carry a correction already");
+    if (!m.captured)
+      m.observed.validate(m.scene.mesh.num_vertices(), m.scene.frames + 1, m.scene.dt, m.name);
+  }
+  RecipeResult result;
+  const fem::MaterialModel& given = motions.front().scene.material;
+  const NominalParameters given_parameters = nominal_parameters_of(given, result.nominal_type);
+  const double size = motions.front().scene.mesh.bounding_box_diagonal();
+
+  // Stage −1: observations of the point-cloud captures, tracked with the given nominal.
+  std::vector<Motion> learned_from(motions.begin(), motions.end());
+  const bool clouds = std::any_of(learned_from.begin(), learned_from.end(),
+      [](const Motion& m) { return m.captured != nullptr; });
+  const auto observe_captures = [&](const fem::MaterialModel& material, const char* which) {
+    for (Motion& m : learned_from)
+      if (m.captured)
+        say(callbacks,
+            "clouds of " + m.name + " tracked with the " + which + " nominal: "
+                + observe_cloud_motion(m, material, callbacks.loop.progress).describe());
+  };
+  if (clouds)
+    observe_captures(given, "given");
+
+  // Stages 0 and 1.
+  Split split = prepare_data(learned_from, options, result, callbacks, size);
+
   // Stage 2: the nominal model's parameters, fitted to every training motion as recorded (the
   // training motions lend their scenes, their observations swapped for the raw ones meanwhile).
-  const sim::Scene& train = split.training.front().scene;
+  const sim::Scene train = split.training.front().scene;
   if (resume) {
     result.parameter_fit = resume->parameter_fit;
     result.loop = resume->loop;
@@ -354,6 +380,14 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     callbacks.parameters_fitted(result.parameter_fit);
   result.fitted_nominal
       = scene_with_parameters(train, result.nominal_type, result.parameter_fit.fitted).material;
+  // Where a cloud does not see the surface the tracked mesh follows the material it was tracked
+  // with: track again with the fitted nominal, closer to the truth, and redo stages 0 and 1.
+  if (clouds && options.fit_parameters) {
+    observe_captures(result.fitted_nominal, "fitted");
+    split = prepare_data(learned_from, options, result, callbacks, size);
+  }
+  for (const Motion& m : learned_from)
+    result.observed.push_back(m.observed);
 
   // Stage 3: the loop (and its forward fit) on the fitted nominal, following smoothed positions,
   // over every training motion.

@@ -102,6 +102,9 @@ struct Candidate {
 inline constexpr double kSignificance = 2;
 
 struct RecipeResult {
+  /// Per motion, the observations learned from: for a point-cloud capture those derived from its
+  /// clouds (cloud_motion.hpp), else the motion's own.
+  std::vector<observe::Observation> observed;
   NoiseLevel noise;
   int training_frames = 0; ///< frames per training motion used (single motion: the split)
   int validation_frames = 0; ///< frames compared in validation
