@@ -3,6 +3,7 @@
 // error naming the file and the field.
 #include "io_test_util.hpp"
 
+#include <elastolearn/io/cloud_file.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/observation_file.hpp>
@@ -317,4 +318,51 @@ TEST(TrainingSet, TellsATrainingSetFromOtherFiles) {
         write_training_set(dir / "empty.json", { { "a.json", "" } });
       },
       { "empty.json" });
+}
+
+TEST(TrainingSet, AMotionMayBePointClouds) {
+  const ScratchDir dir;
+  const auto entries = two_motions(dir);
+  // Clouds of a.json's 6 frames: one point each, the scanner's accuracy recorded.
+  std::vector<capture::CloudFrame> frames(6);
+  for (auto& f : frames)
+    f.points = Positions::Zero(1, 3);
+  const auto clouds = capture::PointCloudSequence::from_frames(frames, 0.01, 0, "clouds");
+  write_clouds_h5(dir / "a_clouds.h5", clouds, { { "noise_sigma", "0.002" } });
+  TrainingSetEntry cloud_motion;
+  cloud_motion.scene = dir / "a.json";
+  cloud_motion.clouds = dir / "a_clouds.h5";
+  write_training_set(dir / "set.json", { cloud_motion, entries[1] });
+  const Json written = read_json_file(dir / "set.json");
+  EXPECT_EQ(written["motions"][0], Json({ { "scene", "a.json" }, { "clouds", "a_clouds.h5" } }));
+
+  const TrainingSet set = read_training_set(dir / "set.json");
+  ASSERT_EQ(set.motions.size(), 2u);
+  ASSERT_NE(set.motions[0].captured, nullptr);
+  EXPECT_EQ(set.motions[0].captured->clouds.num_frames(), 6);
+  EXPECT_EQ(set.motions[0].captured->sigma, 0.002);
+  EXPECT_EQ(set.motions[0].observed.num_frames(), 0) << "derived when learning";
+  EXPECT_TRUE(same_file(set.files[0].paths.clouds, dir / "a_clouds.h5"));
+  EXPECT_TRUE(has_input(set, dir / "a_clouds.h5"));
+  EXPECT_EQ(set.motions[1].captured, nullptr);
+  const TrainingSet one = read_training_motion(cloud_motion);
+  EXPECT_NE(one.motions[0].captured, nullptr);
+
+  // Both kinds of data in one motion, and clouds that do not fit the scene, are refused.
+  const auto refused = [&](const Json& j, const std::vector<std::string>& words) {
+    write_json(dir / "bad.json", j);
+    expect_input_error([&] { read_training_set(dir / "bad.json"); }, words);
+  };
+  Json both = written;
+  both["motions"][0]["observations"] = "a.h5";
+  refused(both, { "motions[0].clouds", "not both" });
+  Json other = written;
+  other["motions"][0]["scene"] = "motions/b.json"; // 8 frames
+  refused(other, { "motions[0].clouds", "a_clouds.h5", "has 6 frames, the scene 8" });
+  expect_input_error(
+      [&] {
+        read_learning_data(
+            dir / "a.json", dir / "a.h5", "--observations", dir / "a_clouds.h5", "--clouds");
+      },
+      { "--clouds", "not with --observations" });
 }
