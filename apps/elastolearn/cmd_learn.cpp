@@ -213,10 +213,7 @@ void run_learn(const LearnOptions& o) {
   if (!o.report.empty()) {
     std::printf("report: simulating the candidates on %s for the plots\n", motions[0].name.c_str());
     std::fflush(stdout);
-    std::vector<learn::Motion> observed = motions; // with the observations learned from
-    for (size_t i = 0; i < observed.size(); ++i)
-      observed[i].observed = result.observed[i];
-    const io::LearningRunReportInputs report { o.scene, o.output, observed, &result, &learned,
+    const io::LearningRunReportInputs report { o.scene, o.output, motions, &result, &learned,
       truth ? &*truth : nullptr, o.truth_material };
     std::printf("%s\n",
         io::describe_report(o.report, io::write_learning_run_report(o.report, report)).c_str());

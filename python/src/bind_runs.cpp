@@ -287,15 +287,16 @@ std::string iteration_line(const learn::IterationRecord& r, double size) {
 }
 
 Material learn(const std::filesystem::path& scene,
-    std::optional<std::filesystem::path> observations, std::optional<std::filesystem::path> output,
+    std::optional<std::filesystem::path> observations, std::optional<std::filesystem::path> clouds,
+    std::optional<std::filesystem::path> output,
     std::optional<std::filesystem::path> checkpoint_arg, bool resume,
     std::optional<std::filesystem::path> report_dir, const py::handle& truth_material_arg,
     bool verbose, const py::kwargs& options) {
   if (!truth_material_arg.is_none() && !report_dir)
     throw InputError("truth_material", "is used by the report only: give report too");
   const LearnSettings settings = learn_settings(options);
-  const io::TrainingSet set
-      = io::read_learning_data(scene, observations.value_or(""), "observations");
+  const io::TrainingSet set = io::read_learning_data(
+      scene, observations.value_or(""), "observations", clouds.value_or(""), "clouds");
   // As the command: checkpoints after every iteration, by default beside the output.
   std::optional<std::filesystem::path> checkpoint = checkpoint_arg;
   if (!checkpoint && output)
@@ -324,7 +325,7 @@ Material learn(const std::filesystem::path& scene,
   if (!truth_material_arg.is_none())
     true_material = material_argument(truth_material_arg);
   const io::LearningInputs inputs { scene.string(),
-    observations ? observations->string() : std::string(),
+    observations ? observations->string() : (clouds ? clouds->string() : std::string()),
     io::recipe_options_to_json(settings.recipe) };
   std::optional<learn::RecipeResume> resumed;
   if (resume)
@@ -487,9 +488,9 @@ void bind_runs(py::module_& m) {
       py::arg("noise") = 0.0, py::arg("dropout") = 0.0, py::arg("dropout_burst") = 5.0,
       py::arg("seed") = 1, py::arg("output") = py::none());
   m.def("learn", &learn, py::arg("scene"), py::arg("observations") = py::none(), py::kw_only(),
-      py::arg("output") = py::none(), py::arg("checkpoint") = py::none(), py::arg("resume") = false,
-      py::arg("report") = py::none(), py::arg("truth_material") = py::none(),
-      py::arg("verbose") = false);
+      py::arg("clouds") = py::none(), py::arg("output") = py::none(),
+      py::arg("checkpoint") = py::none(), py::arg("resume") = false, py::arg("report") = py::none(),
+      py::arg("truth_material") = py::none(), py::arg("verbose") = false);
   m.def("learn_options", [] {
     std::vector<std::string> names;
     for (const auto& entry : learn_option_table())

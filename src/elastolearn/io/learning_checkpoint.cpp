@@ -149,11 +149,14 @@ nlohmann::json recipe_options_to_json(const learn::RecipeOptions& o) {
 namespace {
 
 nlohmann::json parameter_fit_json(const learn::ParameterFitReport& f) {
-  return { { "initial", to_json(f.initial) }, { "fitted", to_json(f.fitted) },
+  nlohmann::json j = { { "initial", to_json(f.initial) }, { "fitted", to_json(f.fitted) },
     { "initial_rms", f.initial_rms }, { "initial_max", f.initial_max },
     { "final_rms", f.final_rms }, { "final_max", f.final_max }, { "iterations", f.iterations },
     { "simulations", f.simulations }, { "diverged", f.diverged }, { "frames", f.frames },
     { "seconds", f.seconds }, { "stop", learn::to_string(f.stop) }, { "message", f.message } };
+  if (f.tracked_with)
+    j["tracked_with"] = to_json(*f.tracked_with);
+  return j;
 }
 
 learn::NominalParameters read_parameters(const JsonObject& o) {
@@ -180,6 +183,8 @@ learn::ParameterFitReport read_parameter_fit(const JsonObject& o) {
     if (learn::to_string(s) == stop)
       f.stop = s;
   f.message = o.string("message");
+  if (o.has("tracked_with"))
+    f.tracked_with = read_parameters(o.object("tracked_with"));
   return f;
 }
 

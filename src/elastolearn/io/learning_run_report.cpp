@@ -1,6 +1,8 @@
 #include <elastolearn/io/learning_run_report.hpp>
 #include <elastolearn/io/report_builder.hpp>
 
+#include <vector>
+
 namespace elastolearn::io {
 
 ReportOutcome write_learning_run_report(
@@ -10,7 +12,11 @@ ReportOutcome write_learning_run_report(
   LearningReport report;
   report.title = "elastolearn learn " + in.scene_path;
   const fem::MaterialModel written = material_model(learned, in.output_path);
-  add_recipe_sections(report, in.motions, result);
+  // The motions with the observations they were learned from (a cloud capture's are derived).
+  std::vector<learn::Motion> motions(in.motions.begin(), in.motions.end());
+  for (size_t i = 0; i < motions.size() && i < result.observed.size(); ++i)
+    motions[i].observed = result.observed[i];
+  add_recipe_sections(report, motions, result);
   const material::StretchRange* trained
       = learned.training_stretches ? &*learned.training_stretches : nullptr;
   if (written.correction || in.truth)

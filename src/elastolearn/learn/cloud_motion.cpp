@@ -33,6 +33,11 @@ CloudMotionReport observe_cloud_motion(
   scene.material = material;
   observe::TrackingOptions options;
   options.sigma = observe::default_tracking_sigma(capture.clouds, capture.sigma, capture.source);
+  // The pull as stiff as with the motion's own (given) nominal, whatever material tracks: its
+  // stiffness must not follow a fitted material, or a fit that went soft would track with no
+  // pull and find its own motion in the data.
+  options.weight = observe::longitudinal_modulus(motion.scene.material)
+      / observe::longitudinal_modulus(material);
   std::vector<Positions> tracked;
   tracked.reserve(static_cast<size_t>(scene.frames) + 1);
   CloudMotionReport report;

@@ -27,7 +27,8 @@ struct CloudMotionReport {
 };
 
 /// Set `motion.observed` from `motion.captured` (which must be set): track the clouds with the
-/// motion's scene and `material`, then observe the surface vertices of the tracked trajectory
+/// motion's scene and `material`, the pull as stiff as the scene's own nominal makes it (λ = 1
+/// for that material), then observe the surface vertices of the tracked trajectory
 /// where the clouds see them. Throws InputError naming the motion when the tracking fails (a Newton
 /// failure: the frame) or sees nothing.
 CloudMotionReport observe_cloud_motion(

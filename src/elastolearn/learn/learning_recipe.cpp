@@ -335,19 +335,25 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   const NominalParameters given_parameters = nominal_parameters_of(given, result.nominal_type);
   const double size = motions.front().scene.mesh.bounding_box_diagonal();
 
-  // Stage −1: observations of the point-cloud captures, tracked with the given nominal.
+  // Stage −1: observations of the point-cloud captures, tracked with the given nominal (with the
+  // nominal of the first fit when resuming: the tracking the loop followed).
   std::vector<Motion> learned_from(motions.begin(), motions.end());
   const bool clouds = std::any_of(learned_from.begin(), learned_from.end(),
       [](const Motion& m) { return m.captured != nullptr; });
-  const auto observe_captures = [&](const fem::MaterialModel& material, const char* which) {
+  const auto observe_captures = [&](const NominalParameters& p, const char* which) {
+    const fem::MaterialModel material
+        = scene_with_parameters(motions.front().scene, result.nominal_type, p).material;
     for (Motion& m : learned_from)
       if (m.captured)
         say(callbacks,
             "clouds of " + m.name + " tracked with the " + which + " nominal: "
                 + observe_cloud_motion(m, material, callbacks.loop.progress).describe());
   };
+  const std::optional<NominalParameters> resumed_tracking
+      = resume ? resume->parameter_fit.tracked_with : std::nullopt;
   if (clouds)
-    observe_captures(given, "given");
+    observe_captures(
+        resumed_tracking.value_or(given_parameters), resumed_tracking ? "first fit's" : "given");
 
   // Stages 0 and 1.
   Split split = prepare_data(learned_from, options, result, callbacks, size);
@@ -355,24 +361,42 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // Stage 2: the nominal model's parameters, fitted to every training motion as recorded (the
   // training motions lend their scenes, their observations swapped for the raw ones meanwhile).
   const sim::Scene train = split.training.front().scene;
-  if (resume) {
-    result.parameter_fit = resume->parameter_fit;
-    result.loop = resume->loop;
-  } else if (options.fit_parameters) {
+  const auto fit_from = [&](const NominalParameters& start) {
     const auto swap_observations = [&] {
       for (size_t i = 0; i < split.training.size(); ++i)
         std::swap(split.training[i].observed, split.fit_observed[i]);
     };
     swap_observations();
-    result.parameter_fit = fit_parameters(
-        split.training, result.nominal_type, given_parameters, options.parameter_fit, {});
+    ParameterFitReport f
+        = fit_parameters(split.training, result.nominal_type, start, options.parameter_fit, {});
     swap_observations();
-    const auto& f = result.parameter_fit;
     say(callbacks,
         format("parameter fit: E %.4g Pa, ν %.3f, α₀ %.3g 1/s, ", f.fitted.young, f.fitted.poisson,
             f.fitted.alpha0)
             + format("α₁ %.3g s; training error rms %.4f %% -> %.4f %% (%.1f s)", f.fitted.alpha1,
                 100 * f.initial_rms / size, 100 * f.final_rms / size, f.seconds));
+    return f;
+  };
+  if (resume) {
+    result.parameter_fit = resume->parameter_fit;
+    result.loop = resume->loop;
+  } else if (options.fit_parameters) {
+    result.parameter_fit = fit_from(given_parameters);
+    // Where no camera sees the surface the tracked mesh follows the material it was tracked
+    // with, which biases the fit toward the given nominal: track again with the fitted nominal,
+    // closer to the truth, redo stages 0 and 1 and fit again (from the given nominal, as the
+    // first: a first fit gone astray on uninformative data must not be the start).
+    if (clouds) {
+      const ParameterFitReport first = result.parameter_fit;
+      observe_captures(first.fitted, "fitted");
+      split = prepare_data(learned_from, options, result, callbacks, size);
+      result.parameter_fit = fit_from(given_parameters);
+      result.parameter_fit.tracked_with = first.fitted;
+      result.parameter_fit.initial = first.initial;
+      result.parameter_fit.initial_rms = first.initial_rms;
+      result.parameter_fit.initial_max = first.initial_max;
+      result.parameter_fit.seconds += first.seconds;
+    }
   } else {
     result.parameter_fit.initial = result.parameter_fit.fitted = given_parameters;
   }
@@ -380,12 +404,6 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     callbacks.parameters_fitted(result.parameter_fit);
   result.fitted_nominal
       = scene_with_parameters(train, result.nominal_type, result.parameter_fit.fitted).material;
-  // Where a cloud does not see the surface the tracked mesh follows the material it was tracked
-  // with: track again with the fitted nominal, closer to the truth, and redo stages 0 and 1.
-  if (clouds && options.fit_parameters) {
-    observe_captures(result.fitted_nominal, "fitted");
-    split = prepare_data(learned_from, options, result, callbacks, size);
-  }
   for (const Motion& m : learned_from)
     result.observed.push_back(m.observed);
 

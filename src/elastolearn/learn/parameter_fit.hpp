@@ -10,6 +10,7 @@
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>
 
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -118,6 +119,9 @@ struct ParameterFitReport {
   FitStop stop = FitStop::MaxIterations;
   std::string message; ///< human-readable reason (names a divergence's frame)
   std::vector<ParameterFitIteration> history; ///< start, then every accepted iteration
+  /// Point-cloud captures only (learn_material): the parameters of the nominal their clouds were
+  /// last tracked with (the first fit's; the fit above is then the refit from that tracking).
+  std::optional<NominalParameters> tracked_with;
 };
 
 /// Fit the nominal parameters to the observation by minimising

@@ -36,11 +36,6 @@ struct Level {
   Positions positions; ///< sample positions (work buffer)
 };
 
-/// Small-strain longitudinal modulus λ + 2μ [Pa]: the diagonal of ∂P̂/∂σ at rest.
-double longitudinal_modulus(const fem::MaterialModel& material) {
-  return material.elastic->principal_stress_derivative(Vec3::Ones())(0, 0);
-}
-
 double face_area(ConstRef<Positions> x, const Faces& faces, Eigen::Index f) {
   const Vec3 a = x.row(faces(f, 0)).transpose();
   return 0.5
@@ -57,6 +52,10 @@ double quantile(VecX& values, double q) {
 }
 
 } // namespace
+
+double longitudinal_modulus(const fem::MaterialModel& material) {
+  return material.elastic->principal_stress_derivative(Vec3::Ones())(0, 0);
+}
 
 void TrackingOptions::validate() const {
   if (!(sigma > 0) || !std::isfinite(sigma))

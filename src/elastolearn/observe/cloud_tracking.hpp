@@ -47,6 +47,10 @@ struct TrackingOptions {
   void validate() const;
 };
 
+/// The small-strain longitudinal modulus λ + 2μ [Pa] of a material (the diagonal of ∂P̂/∂σ at
+/// rest): M of the pull's stiffness λ · M / h.
+double longitudinal_modulus(const fem::MaterialModel& material);
+
 /// σ for a sequence when the user gives none: the scanner's accuracy `recorded_noise` [m] if
 /// positive (scan records it as noise_sigma), else half the median point spacing of the first
 /// frame with at least two points. Throws InputError(source, ...) when neither exists.
