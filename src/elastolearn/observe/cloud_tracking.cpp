@@ -18,6 +18,17 @@ namespace elastolearn::observe {
 
 namespace {
 
+/// A constant force (full 3n) [N]: in frame 0's static fit, minus the net force of the scene's
+/// initial state, so that the fit moves from that state only as far as the cloud pulls it.
+class HoldingForce final : public fem::ForceTerm {
+  public:
+  VecX force;
+  void add_force(const fem::ForceState&, VecX& f) override {
+    if (force.size() == f.size())
+      f += force;
+  }
+};
+
 constexpr FieldErrors fail("tracking");
 
 /// Surface samples are spaced at most 3σ (a cloud point on the surface is then within
@@ -107,6 +118,7 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
             + std::to_string(clouds.num_frames() - 1));
 
   TrackingReport report;
+  HoldingForce holding; // before the simulator, which keeps a pointer to it
   sim::Simulator simulator(scene);
   const sim::NewtonReport initial = simulator.apply_initial_condition();
   if (!initial.converged) {
@@ -152,6 +164,14 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
         = std::make_unique<CloudPull>(level.samples, simulator.dofs(), simulator.system_matrix());
     simulator.add_force_term(level.pull.get());
   }
+  // Frame 0: the initial state is whatever the scene says (at rest in its rest shape, held
+  // against gravity; a static equilibrium; a velocity field), and the cloud may differ from it.
+  // The fit solves f(x) − f(x₀) + pull(x) = 0: the forces that hold x₀ keep holding it, and the
+  // mesh moves away from x₀ only as far as the cloud pulls it against its elasticity. (A plain
+  // static solve would let a body released from its rest shape sag under gravity first.)
+  simulator.add_force_term(&holding);
+  holding.force = -simulator.total_force(
+      simulator.positions(), VecX::Zero(simulator.positions().size()), simulator.time());
   report.samples = levels.front().samples.num_samples();
   report.levels = static_cast<int>(levels.size());
   const capture::SurfaceDistance distance(faces, n);
@@ -251,6 +271,8 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
       if (!dynamic && !failed) // the static fit keeps the initial condition's velocity
         simulator.set_state(simulator.positions(), v_start, t_start);
     }
+    if (!dynamic)
+      holding.force.resize(0); // the dynamic frames have the scene's own forces only
     if (failed) {
       report.message = "frame " + std::to_string(t)
           + " (t = " + to_text(t_start + (dynamic ? scene.dt : 0)) + " s): " + failed->message;

@@ -20,8 +20,10 @@
 /// - Coarse to fine: when a frame's prediction is farther from its cloud than the 3.72σ reach
 ///   of the correspondences (a wrong nominal material, a fast motion), EM starts at σ·2^l with
 ///   coarser surface samples and halves σ every iteration down to σ.
-/// - Frame 0 is the scene's initial state moved to the static equilibrium of its forces plus the
-///   pull of cloud 0 (its velocity kept); every later frame is a dynamic step.
+/// - Frame 0 is the scene's initial state x₀ moved by the pull of cloud 0 against the elasticity:
+///   the static solve of f(x) − f(x₀) + pull(x) = 0 (the forces that hold x₀ keep holding it, so
+///   a body released from its rest shape does not sag first), its velocity kept; every later frame
+///   is a dynamic step.
 #include <elastolearn/capture/point_cloud.hpp>
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/sim/run_simulation.hpp>

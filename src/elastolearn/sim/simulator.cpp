@@ -153,6 +153,12 @@ NewtonReport Simulator::step() {
   return report;
 }
 
+VecX Simulator::total_force(const VecX& x, const VecX& v, double t) {
+  VecX f;
+  sum_forces(x, v, t, f);
+  return f;
+}
+
 NewtonReport Simulator::solve_static(int load_steps) {
   ELASTOLEARN_CHECK(load_steps >= 1, "load_steps must be positive");
   const VecX x0 = m_x;

@@ -57,6 +57,9 @@ class Simulator {
   const VecX& dof_masses() const { return m_dof_masses; }
   /// Add a force term (e.g. control forces, position pulls). Not owned; must outlive the simulator.
   void add_force_term(fem::ForceTerm* term) { m_extra_terms.push_back(term); }
+  /// The sum of every term's force (elastic and damping, gravity, loads, added terms) at a state
+  /// (full 3n) [N].
+  VecX total_force(const VecX& x, const VecX& v, double t);
 
   private:
   void sum_forces(const VecX& x, const VecX& v, double t, VecX& f);
