@@ -35,6 +35,10 @@ void run_fit(const FitOptions& o) {
   std::vector<CommandInput> inputs = scene_file.inputs;
   inputs.push_back({ o.observations, "observations (--observations)" });
   check_command_paths(inputs, { { o.output, "fitted material output (-o)" } });
+  if (scene.material.stiffness_scale)
+    throw InputError(o.scene,
+        "material.regions: fit-parameters fits one homogeneous material; the scene's is "
+        "heterogeneous");
   if (scene.material.correction)
     throw InputError(o.scene,
         "material: the scene's material carries a correction; fit-parameters fits a nominal one");

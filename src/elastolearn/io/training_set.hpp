@@ -50,9 +50,9 @@ struct TrainingSet {
 /// wrong or missing "format"; "motions" missing, not an array or empty; a motion that is not an
 /// object, lacks "scene" or "observations" (non-empty strings) or has other keys; unknown keys at
 /// the root; a scene or observation file that cannot be read (its reader's error); observations
-/// that do not fit their scene (vertex ids, frames + 1 frames, dt); a scene whose material
-/// already carries a correction or whose mass is not lumped; a scene whose nominal material
-/// differs from the first motion's.
+/// that do not fit their scene (vertex ids, frames + 1 frames, dt); a scene whose material is
+/// heterogeneous ("regions") or already carries a correction, or whose mass is not lumped; a scene
+/// whose nominal material differs from the first motion's.
 TrainingSet read_training_set(const std::filesystem::path& path);
 
 /// A training set of one motion from a scene file and its observation file, with the same
