@@ -67,11 +67,15 @@ void run_observe(const ObserveOptions& opts) {
   const observe::Observation& obs = observed.observation;
   io::write_observation_h5(opts.output, obs, observed.metadata);
 
-  std::printf("observed %d vertices%s (%d surface vertices, %.1f %%) over %d frames, dt = %g s",
-      obs.num_observed(), onto ? (" of " + opts.onto + "'s mesh").c_str() : "",
-      observed.surface_vertices,
-      100.0 * obs.num_observed() / std::max(1, observed.surface_vertices), obs.num_frames(),
-      obs.dt);
+  const std::string mesh = onto ? " of " + opts.onto + "'s mesh" : "";
+  if (opts.all)
+    std::printf("observed all %d vertices%s (%d on the surface) over %d frames, dt = %g s",
+        obs.num_observed(), mesh.c_str(), observed.surface_vertices, obs.num_frames(), obs.dt);
+  else
+    std::printf("observed %d vertices%s (%d surface vertices, %.1f %%) over %d frames, dt = %g s",
+        obs.num_observed(), mesh.c_str(), observed.surface_vertices,
+        100.0 * obs.num_observed() / std::max(1, observed.surface_vertices), obs.num_frames(),
+        obs.dt);
   if (opts.noise > 0)
     std::printf(
         ", noise sigma = %g m (%.3g %% of the size)", opts.noise, 100 * opts.noise / observed.size);
