@@ -28,7 +28,7 @@ DENSITY = 1000
 # bound, 5.05e6 Pa) is 25x stiffer still; README.md says what the recipe does with it.
 NOMINAL_YOUNG = 2 / (1 / SOFT + 1 / STIFF)
 DT = 1e-3
-FRAMES = 400
+FRAMES = 200
 AXIS = [SIZE[0] / 2, SIZE[1] / 2, SIZE[2] / 2]  # a point on the bar's long axis
 CLAMP = [0.0, SIZE[1] / 2, SIZE[2] / 2]  # the centre of the clamped face
 
