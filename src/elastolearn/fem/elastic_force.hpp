@@ -25,7 +25,7 @@ struct MaterialModel {
   /// the mesh it is used with; scene "material.regions"): element e's nominal stress is s_e P̂,
   /// so its stiffness and the α₁ damping of it scale too; a correction N is not scaled. Null:
   /// homogeneous (s_e = 1).
-  std::shared_ptr<const std::vector<double>> stiffness_scale;
+  std::shared_ptr<const std::vector<double>> stiffness_scale = nullptr;
 };
 
 /// Elastic (+correction) and Rayleigh damping forces of all tets, with their Jacobians.
