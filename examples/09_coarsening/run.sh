@@ -63,12 +63,15 @@ learned = json.load(open(os.path.join(out, "learned.json")))
 chosen = learned["training"]["recipe"].get("chosen_kind", "?")
 print("fitted: E %.4g Pa, nu %.4f; learned: the recipe chose %s" % (fit["young"], fit["poisson"], chosen))
 print("%-12s %10s %10s %10s" % ("motion", "nominal", "fitted", "learned"))
+stopped = False
 for motion in ("test_bend", "test_twist", "train_bend", "train_twist"):
     runs = {m: json.load(open(os.path.join(out, "eval_%s_%s.json" % (motion, m))))
             for m in ("fitted", "learned")}
     row = [runs["fitted"]["nominal"], runs["fitted"]["learned"], runs["learned"]["learned"]]
     cells = ["%10.4f" % r["err_L_percent"] + ("" if r["completed"] else "*") for r in row]
+    stopped = stopped or not all(r["completed"] for r in row)
     print("%-12s %s" % (motion, " ".join(cells)))
-print("(* stopped early)")
+if stopped:
+    print("(* the simulation stopped early; its error covers the frames before)")
 PY
 printf 'total %d s; files in %s\n' "$SECONDS" "$out"
