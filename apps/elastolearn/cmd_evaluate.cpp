@@ -1,7 +1,9 @@
 // elastolearn evaluate test_scene.json --material learned.json --truth test_traj.h5
 //                     [--json report.json] [-o learned_traj.h5]
 // Paper 000 Table 1's err_L: simulate the test scene with its own (nominal) material and with the
-// learned material, and compare both with the true trajectory over all vertices.
+// learned material, and compare both with the true trajectory over all vertices, or with an
+// observation file's vertices (e.g. `observe --onto`: a fine motion seen at a coarse mesh's
+// vertices).
 #include "command.hpp"
 
 #include <elastolearn/core/command_paths.hpp>
@@ -44,7 +46,7 @@ void run_evaluate(const EvaluateOptions& opts) {
   {
     std::vector<CommandInput> inputs = file.inputs;
     inputs.push_back({ opts.material, "material (--material)" });
-    inputs.push_back({ opts.truth, "true trajectory (--truth)" });
+    inputs.push_back({ opts.truth, "truth (--truth)" });
     std::vector<CommandOutput> outputs;
     if (!opts.output.empty())
       outputs.push_back({ opts.output, "learned trajectory output (-o)" });
@@ -63,7 +65,11 @@ void run_evaluate(const EvaluateOptions& opts) {
     file.scene.linear_solver = sim::linear_solver_type_from_string(opts.solver);
   const sim::Scene& scene = file.scene;
   const io::MaterialFile material_file = io::read_material_file(opts.material);
-  const std::vector<VecX> truth = io::read_truth_trajectory(opts.truth, scene);
+  const io::EvaluationTruth truth = io::read_evaluation_truth(opts.truth, scene);
+  if (truth.observed && !opts.report.empty())
+    throw InputError("--report",
+        "needs a trajectory of every vertex as --truth (" + opts.truth
+            + " is an observation file): the report animates the true motion");
   std::optional<fem::MaterialModel> true_material;
   if (!opts.truth_material.empty()) {
     true_material
@@ -79,8 +85,13 @@ void run_evaluate(const EvaluateOptions& opts) {
                 "diagonal) %g m\n",
         scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(), scene.frames,
         scene.dt, e.size);
-    std::printf("truth:   %s (%zu frames)\nnominal: %s\nlearned: %s\n", opts.truth.c_str(),
-        truth.size(), e.nominal.description.c_str(), e.learned.description.c_str());
+    std::printf("truth:   %s (%d frames%s)\nnominal: %s\nlearned: %s\n", opts.truth.c_str(),
+        truth.num_frames(),
+        truth.observed
+            ? (", observations of " + std::to_string(truth.observed->num_observed()) + " vertices")
+                  .c_str()
+            : "",
+        e.nominal.description.c_str(), e.learned.description.c_str());
     std::fflush(stdout);
   };
   const io::MaterialEvaluation e
@@ -115,7 +126,7 @@ void run_evaluate(const EvaluateOptions& opts) {
   }
   if (!opts.report.empty()) {
     const io::EvaluationReportInputs inputs { &scene, opts.scene, &material_file, opts.material,
-      &truth, opts.truth, true_material ? &*true_material : nullptr };
+      &truth.frames, opts.truth, true_material ? &*true_material : nullptr };
     const io::ReportOutcome written = io::write_evaluation_report(opts.report, inputs, e,
         [&opts](const std::string& label) { return progress(opts, label); });
     std::printf("%s\n", io::describe_report(opts.report, written).c_str());
@@ -141,8 +152,9 @@ void add_evaluate_command(CLI::App& root) {
   cmd->add_option(
          "--material", opts->material, "learned material file (elastolearn-material/1 JSON)")
       ->required();
-  cmd->add_option(
-         "--truth", opts->truth, "true trajectory of the test scene (HDF5, e.g. from simulate)")
+  cmd->add_option("--truth", opts->truth,
+         "true trajectory of the test scene (HDF5, e.g. from simulate), or an observation file of "
+         "its vertices (e.g. from observe --onto: err_L over the observed vertices)")
       ->required();
   cmd->add_option("--json", opts->json, "also write the numbers to this JSON file");
   cmd->add_option("-o,--output", opts->output, "write the learned material's trajectory (HDF5)");

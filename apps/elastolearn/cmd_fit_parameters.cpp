@@ -1,8 +1,10 @@
-// elastolearn fit-parameters scene.json --observations obs.h5 -o fitted.json [--frames N]
+// elastolearn fit-parameters (scene.json --observations obs.h5 | training.json) -o fitted.json
+//                           [--frames N]
 //                           [--fit young,poisson,alpha0,alpha1] [--max-iterations K] [--tolerance
 //                           T]
 // The parameter-fitting baseline (paper 000's reference [14]): fit E, ν, α₀, α₁ of the scene's
-// nominal material to the observations and write them as a material file. docs/learning.md
+// nominal material to the observations (of one scene, or of every motion of a training set at
+// once) and write them as a material file. docs/learning.md
 // "Parameter-fitting baseline".
 #include "command.hpp"
 
@@ -13,6 +15,7 @@
 #include <elastolearn/io/nominal_parameters.hpp>
 #include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/scene_file.hpp>
+#include <elastolearn/io/training_set.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
 
 #include <cstdio>
@@ -29,39 +32,77 @@ struct FitOptions {
   bool quiet = false;
 };
 
-void run_fit(const FitOptions& o) {
+/// What is fitted: one scene and its observations, or every motion of a training set.
+struct FitData {
+  std::vector<learn::Motion> motions;
+  io::MaterialFile fitted; ///< the nominal material (scene format) the parameters go into
+  std::string material_source; ///< names that material in messages
+  std::vector<CommandInput> inputs;
+};
+
+FitData read_fit_data(const FitOptions& o) {
+  FitData d;
+  if (io::is_training_set_file(o.scene)) {
+    // A training set: one fit to all its motions (learn::fit_parameters over motions), as the
+    // best single homogeneous material for all of them.
+    if (!o.observations.empty())
+      throw InputError("--observations",
+          "not with a training set, which names its observation files (" + o.scene + ")");
+    io::TrainingSet set = io::read_training_set(o.scene);
+    d.motions = std::move(set.motions);
+    d.fitted.material = std::move(set.nominal_material);
+    d.material_source = set.files.front().paths.scene.string();
+    d.inputs = std::move(set.inputs);
+    return d;
+  }
+  if (o.observations.empty())
+    throw InputError("--observations", "is required with a scene file (or give a training set)");
   const io::SceneFile scene_file = io::read_scene_file(o.scene);
   const sim::Scene& scene = scene_file.scene;
-  std::vector<CommandInput> inputs = scene_file.inputs;
-  inputs.push_back({ o.observations, "observations (--observations)" });
-  check_command_paths(inputs, { { o.output, "fitted material output (-o)" } });
+  d.inputs = scene_file.inputs;
+  d.inputs.push_back({ o.observations, "observations (--observations)" });
+  if (scene.material.stiffness_scale)
+    throw InputError(o.scene,
+        "material.regions: fit-parameters fits one homogeneous material; the scene's is "
+        "heterogeneous");
   if (scene.material.correction)
     throw InputError(o.scene,
         "material: the scene's material carries a correction; fit-parameters fits a nominal one");
   const nlohmann::json root = io::read_json_file(o.scene);
-  io::MaterialFile fitted
-      = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
-  const std::string material_source
+  d.fitted = io::scene_material(io::JsonObject(root, o.scene), scene_file.path.parent_path());
+  d.material_source
       = root.at("material").is_string() ? root.at("material").get<std::string>() : o.scene;
-  material::ElasticModelType type {};
-  const learn::NominalParameters start = io::nominal_parameters_from_json(
-      io::JsonObject(fitted.material, material_source, "material"), type);
-
   observe::Observation observed = io::read_observation_h5(o.observations);
   observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, o.observations);
+  d.motions.push_back({ o.observations, scene, std::move(observed) });
+  return d;
+}
+
+void run_fit(const FitOptions& o) {
+  FitData data = read_fit_data(o);
+  check_command_paths(data.inputs, { { o.output, "fitted material output (-o)" } });
+  io::MaterialFile& fitted = data.fitted;
+  material::ElasticModelType type {};
+  const learn::NominalParameters start = io::nominal_parameters_from_json(
+      io::JsonObject(fitted.material, data.material_source, "material"), type);
   learn::ParameterFitOptions options = o.library;
   options.parameters = learn::fit_parameters_from_string(o.fit, "--fit");
   options.parallel = !o.serial;
   options.validate();
 
+  const sim::Scene& scene = data.motions.front().scene;
   const double diagonal = scene.mesh.bounding_box_diagonal();
-  const std::string lost = observe::describe_lost_entries(observed);
-  std::printf("fitting %s of %s: %d vertices, %d tets, %d of %d frames (dt = %g s), %d observed "
-              "vertices%s, %s nominal\n",
-      o.fit.c_str(), scene.name.c_str(), scene.mesh.num_vertices(), scene.mesh.num_tets(),
-      options.frames < 0 ? scene.frames : options.frames, scene.frames, scene.dt,
-      observed.num_observed(), lost.empty() ? "" : (" (" + lost + ")").c_str(),
-      material::to_string(type).c_str());
+  int observed_vertices = 0;
+  for (const learn::Motion& m : data.motions) {
+    const std::string lost = observe::describe_lost_entries(m.observed);
+    std::printf("fitting %s of %s: %d vertices, %d tets, %d of %d frames (dt = %g s), %d "
+                "observed vertices%s, %s nominal\n",
+        o.fit.c_str(), m.scene.name.c_str(), m.scene.mesh.num_vertices(), m.scene.mesh.num_tets(),
+        options.frames < 0 ? m.scene.frames : options.frames, m.scene.frames, m.scene.dt,
+        m.observed.num_observed(), lost.empty() ? "" : (" (" + lost + ")").c_str(),
+        material::to_string(type).c_str());
+    observed_vertices += m.observed.num_observed();
+  }
   std::fflush(stdout);
   const ProgressCallback progress = [&](long, long, const std::string& line) {
     if (o.quiet)
@@ -69,8 +110,9 @@ void run_fit(const FitOptions& o) {
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
   };
-  const learn::ParameterFitReport report
-      = learn::fit_parameters(scene, type, start, observed, options, progress);
+  const learn::ParameterFitReport report = data.motions.size() == 1
+      ? learn::fit_parameters(scene, type, start, data.motions.front().observed, options, progress)
+      : learn::fit_parameters(data.motions, type, start, options, progress);
   if (report.stop == learn::FitStop::StartDiverged) {
     std::fprintf(stderr, "elastolearn: error: %s\n", report.message.c_str());
     throw CLI::RuntimeError(1);
@@ -86,16 +128,16 @@ void run_fit(const FitOptions& o) {
   nlohmann::json fitted_names = nlohmann::json::array();
   for (auto p : options.parameters)
     fitted_names.push_back(learn::to_string(p));
-  fitted.training
-      = { { "method", "parameter_fit" }, { "scene", o.scene }, { "observations", o.observations },
-          { "observed_vertices", observed.num_observed() }, { "fitted", fitted_names },
-          { "frames", report.frames }, { "initial", io::to_json(report.initial) },
-          { "final", io::to_json(report.fitted) }, { "initial_rms_error_m", report.initial_rms },
-          { "initial_max_error_m", report.initial_max }, { "final_rms_error_m", report.final_rms },
-          { "final_max_error_m", report.final_max }, { "iterations", report.iterations },
-          { "simulations", report.simulations }, { "diverged_simulations", report.diverged },
-          { "seconds", report.seconds }, { "stop", learn::to_string(report.stop) },
-          { "message", report.message }, { "history", history } };
+  fitted.training = { { "method", "parameter_fit" }, { "scene", o.scene },
+    { "observations", o.observations }, { "observed_vertices", observed_vertices },
+    { "motions", data.motions.size() }, { "fitted", fitted_names }, { "frames", report.frames },
+    { "initial", io::to_json(report.initial) }, { "final", io::to_json(report.fitted) },
+    { "initial_rms_error_m", report.initial_rms }, { "initial_max_error_m", report.initial_max },
+    { "final_rms_error_m", report.final_rms }, { "final_max_error_m", report.final_max },
+    { "iterations", report.iterations }, { "simulations", report.simulations },
+    { "diverged_simulations", report.diverged }, { "seconds", report.seconds },
+    { "stop", learn::to_string(report.stop) }, { "message", report.message },
+    { "history", history } };
   io::write_material_file(o.output, fitted);
 
   std::printf("%s: %s\n", learn::to_string(report.stop).c_str(), report.message.c_str());
@@ -119,11 +161,12 @@ void add_fit_parameters_command(CLI::App& root) {
   auto* cmd = root.add_subcommand("fit-parameters",
       "Fit E, nu and Rayleigh damping of the nominal material to observations (the baseline of "
       "learn)");
-  cmd->add_option("scene", o->scene, "scene with the start material (elastolearn-scene/1 JSON)")
+  cmd->add_option("scene", o->scene,
+         "scene with the start material (elastolearn-scene/1 JSON), or a training set "
+         "(elastolearn-training/1: one fit to all its motions)")
       ->required();
-  cmd->add_option(
-         "--observations", o->observations, "observation HDF5 (from observe, or your capture)")
-      ->required();
+  cmd->add_option("--observations", o->observations,
+      "observation HDF5 (from observe, or your capture); not with a training set");
   cmd->add_option(
          "-o,--output", o->output, "material JSON to write (fitted nominal, no correction)")
       ->required();

@@ -9,6 +9,7 @@
 #include <support/finite_difference.hpp>
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <gtest/gtest.h>
 #include <random>
 
@@ -337,4 +338,107 @@ TEST(LearnedStiffnessDamping, UnprojectedJacobianIsMinusTheVelocityDerivative) {
     test::expect_jacobian_matches(
         -Eigen::MatrixXd(A.matrix()), [&](const VecX& w) { return force_at(term, x, w); }, v, 1e-7);
   }
+}
+
+namespace {
+
+/// Per-element stiffness scales spread log-uniformly over [1e-2, 1e2], deterministic.
+std::shared_ptr<const std::vector<double>> random_scales(int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> exponent(-2, 2);
+  auto scales = std::make_shared<std::vector<double>>(count);
+  for (double& s : *scales)
+    s = std::pow(10.0, exponent(rng));
+  return scales;
+}
+
+/// The assembled Jacobian c_x K + c_v D (unprojected) and the force at (x, v).
+Eigen::MatrixXd jacobian_at(
+    fem::ElasticForce& term, const VecX& x, const VecX& v, double c_x, double c_v, VecX& f) {
+  const int n = static_cast<int>(x.size() / 3);
+  fem::DofMap dofs(n, {});
+  fem::SystemMatrix A(term.tets(), dofs);
+  f = VecX::Zero(x.size());
+  A.set_zero();
+  term.add_force_and_jacobian({ x, v, 0.0 }, c_x, c_v, f, A);
+  return Eigen::MatrixXd(A.matrix());
+}
+
+} // namespace
+
+TEST(StiffnessScale, ScaledStiffnessIsMinusForceDerivativeAndEnergyGradient) {
+  // Heterogeneous material: element e's stress is s_e P̂ with s_e over four decades. The exact
+  // stiffness must still be −∂f/∂x and the force −∂E/∂x (central differences, as the
+  // homogeneous test); the scales must matter (the forces differ from the unscaled ones).
+  const auto mesh = small_bar();
+  fem::MaterialModel scaled { model(0), nullptr, nullptr, 1000 };
+  scaled.stiffness_scale = random_scales(mesh.num_tets(), 3);
+  fem::ElasticForce term(mesh, scaled);
+  fem::ElasticForce plain(mesh, { model(0), nullptr, nullptr, 1000 });
+  term.set_project_tangent(false);
+  const VecX x = deformed(mesh, 0.4);
+  const VecX v = VecX::Zero(x.size());
+  VecX f;
+  const Eigen::MatrixXd K = jacobian_at(term, x, v, 1.0, 0.0, f);
+  ASSERT_GT((f - force_at(plain, x, v)).norm(), 0.5 * f.norm());
+  test::expect_jacobian_matches(
+      -K, [&](const VecX& y) { return force_at(term, y, v); }, x, 1e-6, 1e-6);
+  const VecX g = test::fd_gradient([&](const VecX& y) { return term.elastic_energy(y); }, x, 1e-6);
+  EXPECT_LT((g + f).cwiseAbs().maxCoeff(), 1e-6 * f.cwiseAbs().maxCoeff());
+}
+
+TEST(StiffnessScale, RayleighDampingScalesTheScaledStiffness) {
+  // f_d = −α₁ K(x) v with K the heterogeneous material's exact stiffness: α₁ times the
+  // directional derivative of the scaled elastic force (central differences, O(ε²)).
+  const auto mesh = small_bar();
+  const double alpha1 = 0.01;
+  const auto scales = random_scales(mesh.num_tets(), 5);
+  fem::MaterialModel damped_model { model(2), nullptr,
+    rayleigh(0, alpha1, material::DampingTangent::Exact), 1000 };
+  damped_model.stiffness_scale = scales;
+  fem::MaterialModel elastic_model { model(2), nullptr, nullptr, 1000 };
+  elastic_model.stiffness_scale = scales;
+  fem::ElasticForce damped(mesh, damped_model), elastic(mesh, elastic_model);
+  const VecX x = deformed(mesh, 0.3);
+  const VecX v = random_velocity(x.size(), 11);
+  const VecX zero = VecX::Zero(x.size());
+  const VecX f_damping = force_at(damped, x, v) - force_at(damped, x, zero);
+  const double eps = 1e-6;
+  const VecX directional
+      = (force_at(elastic, x + eps * v, zero) - force_at(elastic, x - eps * v, zero)) / (2 * eps);
+  EXPECT_LE((f_damping - alpha1 * directional).norm(), 1e-6 * f_damping.norm());
+}
+
+TEST(StiffnessScale, UniformScaleIsAStifferNominalAndLeavesTheCorrectionUnscaled) {
+  // Every model's stress is linear in (μ, λ): a uniform scale s is the material with s·E (same
+  // ν). With a correction N and a learned Δα₁, s P̂ + N must equal that stiffer nominal plus the
+  // same N (a scaled N would differ by (s − 1) N, ~10 % of the force here), and the damping
+  // (α₁ on the corrected stiffness, Δα₁ on the nominal one) and the Jacobians must agree too.
+  // Same arithmetic up to the order of operations: 1e-12 relative.
+  const auto mesh = small_bar();
+  const double s = 7;
+  const auto correction = std::make_shared<QuadraticCorrection>(0.004, 0.02);
+  const auto damping = rayleigh(0.3, 0.01, material::DampingTangent::Exact);
+  fem::MaterialModel scaled { model(0), correction, damping, 1000 };
+  scaled.stiffness_scale = std::make_shared<std::vector<double>>(mesh.num_tets(), s);
+  const auto stiffer = std::make_shared<material::CorotatedModel>(
+      material::Lame::from_young_poisson(3e5 * s, 0.4));
+  fem::ElasticForce a(mesh, scaled), b(mesh, { stiffer, correction, damping, 1000 });
+  fem::ElasticForce without(mesh, { stiffer, nullptr, damping, 1000 });
+  const VecX x = deformed(mesh, 0.3);
+  const VecX v = random_velocity(x.size(), 19);
+  VecX fa, fb;
+  const Eigen::MatrixXd Ja = jacobian_at(a, x, v, 1.0, 0.05, fa);
+  const Eigen::MatrixXd Jb = jacobian_at(b, x, v, 1.0, 0.05, fb);
+  ASSERT_GT((fb - force_at(without, x, v)).norm(), 1e-3 * fb.norm());
+  EXPECT_LE((fa - fb).norm(), 1e-12 * fb.norm());
+  EXPECT_LE((Ja - Jb).norm(), 1e-12 * Jb.norm());
+  EXPECT_NEAR(a.elastic_energy(x), b.elastic_energy(x), 1e-12 * b.elastic_energy(x));
+}
+
+TEST(StiffnessScale, RejectsAScaleOfTheWrongSize) {
+  const auto mesh = small_bar();
+  fem::MaterialModel m { model(0), nullptr, nullptr, 1000 };
+  m.stiffness_scale = std::make_shared<std::vector<double>>(mesh.num_tets() - 1, 1.0);
+  EXPECT_ANY_THROW(fem::ElasticForce(mesh, m));
 }

@@ -5,6 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
+#include <string>
 
 namespace elastolearn::fem {
 
@@ -26,6 +28,13 @@ ElasticForce::ElasticForce(const mesh::TetMesh& mesh, MaterialModel material, Ma
     , m_damping_tangent(material::damping_tangent_of(m_material.damping.get())) {
   ELASTOLEARN_CHECK(m_material.elastic != nullptr, "ElasticForce needs an elastic model");
   const int m = mesh.num_tets();
+  if (const auto& scale = m_material.stiffness_scale) {
+    ELASTOLEARN_CHECK(scale->size() == static_cast<size_t>(m),
+        "stiffness scale has " + std::to_string(scale->size()) + " entries for " + std::to_string(m)
+            + " tets");
+    for (const double s : *scale)
+      ELASTOLEARN_CHECK(std::isfinite(s) && s > 0, "stiffness scales must be positive and finite");
+  }
   const int n = mesh.num_vertices();
   m_force_buffer.assign(static_cast<size_t>(m) * 12, 0.0);
   m_vertex_offsets.assign(n + 1, 0);
@@ -46,6 +55,7 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
   const auto* correction = m_material.correction.get();
   const auto* damping = m_material.damping.get();
   const double density = m_material.density;
+  const double* scales = m_material.stiffness_scale ? m_material.stiffness_scale->data() : nullptr;
   const int m = static_cast<int>(m_tets.rows());
   if (m_cache.size() != static_cast<size_t>(m))
     m_cache.resize(m);
@@ -54,6 +64,7 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
     for (int e = r.begin(); e < r.end(); ++e) {
       const TetRestData& rest = m_rest[e];
       ElementCache& c = m_cache[e];
+      const double scale = scales ? scales[e] : 1.0;
       const Eigen::Vector4i tet = m_tets.row(e).transpose();
       const auto xe = gather_tet(state.x, tet);
       const auto ve = gather_tet(state.v, tet);
@@ -66,7 +77,8 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
         F_rate = deformation_gradient(ve, rest);
       if (correction && correction->depends_on_rates())
         rates = material::stretch_rates(c.frame, F_rate);
-      c.stress = material::corrected_principal_stress(*elastic, correction, stretches, rates);
+      c.stress
+          = material::corrected_principal_stress(*elastic, correction, stretches, rates, scale);
       Mat3 P = material::first_piola(c.frame, c.stress.stress);
       c.alpha = damping ? damping->coefficients(stretches[0]) : material::RayleighCoefficients {};
       // A learned Δα₁ scales the nominal stiffness (paper Eq. 13); the total never turns negative.
@@ -81,14 +93,14 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
         // correction.
         material::CorrectedStress scratch;
         const material::CorrectedStress& elastic_stress
-            = material::elastic_part(*elastic, correction, stretches, c.stress, scratch);
+            = material::elastic_part(*elastic, correction, stretches, c.stress, scratch, scale);
         if (c.alpha1_change == 0) {
           c.damping = material::damping_tangent(
               c.frame, elastic_stress.stress, elastic_stress.d_stretches, m_damping_tangent);
           c.damping_scale = c.alpha.alpha1;
         } else {
           // One tangent of the weighted stresses instead of two tangents weighted.
-          const double a1 = c.alpha.alpha1, da1 = c.alpha1_change;
+          const double a1 = c.alpha.alpha1, da1 = scale * c.alpha1_change;
           c.damping = material::damping_tangent(c.frame,
               a1 * elastic_stress.stress + da1 * elastic->principal_stress(stretches),
               a1 * elastic_stress.d_stretches
@@ -185,11 +197,13 @@ void ElasticForce::gather_forces(VecX& f) const {
 }
 
 double ElasticForce::elastic_energy(const VecX& x) const {
+  const auto& scales = m_material.stiffness_scale;
   double energy = 0;
   for (Eigen::Index e = 0; e < m_tets.rows(); ++e) {
     const auto frame = material::principal_frame(
         deformation_gradient(gather_tet(x, m_tets.row(e).transpose()), m_rest[e]));
-    energy += m_rest[e].volume * m_material.elastic->energy(frame.stretches);
+    energy += m_rest[e].volume * (scales ? (*scales)[e] : 1.0)
+        * m_material.elastic->energy(frame.stretches);
   }
   return energy;
 }

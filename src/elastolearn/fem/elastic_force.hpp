@@ -21,11 +21,17 @@ struct MaterialModel {
   std::shared_ptr<const material::Correction> correction; ///< optional N(F̂, Ḟ̂)
   std::shared_ptr<const material::DampingModel> damping; ///< optional Rayleigh
   double density = 1000; ///< ρ [kg/m³]
+  /// Optional per-element stiffness scale s_e > 0 of a heterogeneous material (one per tet of
+  /// the mesh it is used with; scene "material.regions"): element e's nominal stress is s_e P̂,
+  /// so its stiffness and the α₁ damping of it scale too; a correction N is not scaled. Null:
+  /// homogeneous (s_e = 1).
+  std::shared_ptr<const std::vector<double>> stiffness_scale = nullptr;
 };
 
 /// Elastic (+correction) and Rayleigh damping forces of all tets, with their Jacobians.
 ///
-/// Per element: F = Σ x_a g_aᵀ, SVD F = U F̂ Vᵀ, P = U (P̂ + N) Vᵀ, f_a = −vol P g_a;
+/// Per element: F = Σ x_a g_aᵀ, SVD F = U F̂ Vᵀ, P = U (s_e P̂ + N) Vᵀ, f_a = −vol P g_a (s_e the
+/// element's stiffness scale, 1 for a homogeneous material; P̂ below stands for s_e P̂);
 /// K_e = vol Bᵀ (dP/dF) B of the corrected model (clamped PSD in the Jacobian); damping force
 ///   −α₁ K_e^d v_e − Δα₁ K_e^nom,d v_e − α₀ M_e v_e
 /// with (α₀, α₁) the damping model's, from the element's largest stretch, and M_e the element's
@@ -45,7 +51,8 @@ struct MaterialModel {
 /// locks, element matrices straight into the SystemMatrix (SystemMatrix::add_elements).
 class ElasticForce final : public ForceTerm {
   public:
-  /// `mass` is the mass matrix the α₀ term scales (the scene's; lumped by default).
+  /// `mass` is the mass matrix the α₀ term scales (the scene's; lumped by default). Checks that a
+  /// stiffness scale has one positive finite entry per tet.
   ElasticForce(const mesh::TetMesh& mesh, MaterialModel material, MassType mass = MassType::Lumped);
 
   /// Forces; caches each element's SVD and stress (and tangent, when Rayleigh α₁ ≠ 0) for
@@ -53,7 +60,7 @@ class ElasticForce final : public ForceTerm {
   void add_force(const ForceState& state, VecX& f) override;
   void add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) override;
 
-  /// Total elastic energy Σ vol Ψ(F̂) [J] (the nominal model; the correction has no energy).
+  /// Total elastic energy Σ vol s_e Ψ(F̂) [J] (the nominal model; the correction has no energy).
   double elastic_energy(const VecX& x) const;
 
   /// Use the exact tangent instead of the PSD projection (for derivative tests; Newton wants

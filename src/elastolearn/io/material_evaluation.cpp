@@ -1,6 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/json_fields.hpp>
 #include <elastolearn/io/material_evaluation.hpp>
+#include <elastolearn/io/observation_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/observe/observation.hpp>
 
@@ -12,6 +13,21 @@ namespace elastolearn::io {
 std::vector<VecX> read_truth_trajectory(
     const std::filesystem::path& path, const sim::Scene& scene) {
   return truth_frames(read_trajectory_h5(path), path.string(), scene);
+}
+
+int EvaluationTruth::num_frames() const {
+  return observed ? observed->num_frames() : static_cast<int>(frames.size());
+}
+
+EvaluationTruth read_evaluation_truth(const std::filesystem::path& path, const sim::Scene& scene) {
+  EvaluationTruth truth;
+  if (!is_observation_h5(path)) {
+    truth.frames = read_truth_trajectory(path, scene);
+    return truth;
+  }
+  truth.observed = read_observation_h5(path);
+  truth.observed->validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt, path.string());
+  return truth;
 }
 
 std::vector<VecX> truth_frames(
@@ -106,11 +122,20 @@ std::optional<double> MaterialEvaluation::mean_ratio() const {
 MaterialEvaluation evaluate_material(const sim::Scene& scene, const MaterialFile& material,
     const std::string& material_source, const std::vector<VecX>& truth,
     const EvaluationOptions& options) {
+  EvaluationTruth all;
+  all.frames = truth;
+  return evaluate_material(scene, material, material_source, all, options);
+}
+
+MaterialEvaluation evaluate_material(const sim::Scene& scene, const MaterialFile& material,
+    const std::string& material_source, const EvaluationTruth& truth,
+    const EvaluationOptions& options) {
   sim::Scene learned_scene = scene;
   learned_scene.material = material_model(material, material_source);
   MaterialEvaluation e;
   e.size = scene.mesh.bounding_box_diagonal();
-  e.truth_frames = static_cast<int>(truth.size());
+  e.truth_frames = truth.num_frames();
+  e.truth_vertices = truth.observed ? truth.observed->num_observed() : -1;
   e.nominal.label = "nominal";
   e.nominal.description = describe_material_model(scene.material) + " (the scene's)";
   e.learned.label = "learned";
@@ -124,7 +149,8 @@ MaterialEvaluation evaluate_material(const sim::Scene& scene, const MaterialFile
   simulate_model(scene, progress(e.nominal.label), {}, e.nominal);
   simulate_model(learned_scene, progress(e.learned.label), options.learned_trajectory, e.learned);
   for (ModelRun* run : { &e.nominal, &e.learned }) {
-    run->error = learn::position_error(run->frames, truth);
+    run->error = truth.observed ? learn::observation_error(run->frames, *truth.observed)
+                                : learn::position_error(run->frames, truth.frames);
     run->percent = learn::as_percent_of(run->error, e.size);
   }
   if (material.training_stretches && material.correction) {
@@ -143,6 +169,8 @@ nlohmann::json evaluation_to_json(const MaterialEvaluation& e, const sim::Scene&
     { "material", material_path }, { "truth", truth_path },
     { "vertices", scene.mesh.num_vertices() }, { "tets", scene.mesh.num_tets() },
     { "frames", e.truth_frames }, { "dt", scene.dt }, { "size", e.size },
+    { "truth_vertices",
+        e.truth_vertices < 0 ? nlohmann::json("all") : nlohmann::json(e.truth_vertices) },
     { "nominal", model_run_to_json(e.nominal) }, { "learned", model_run_to_json(e.learned) },
     { "improvement",
         { { "err_L", optional_json(e.max_ratio()) }, { "mean", optional_json(e.mean_ratio()) } } }

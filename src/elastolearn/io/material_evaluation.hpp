@@ -29,6 +29,20 @@ std::vector<VecX> truth_frames(
 /// truth_frames of the trajectory file at `path`.
 std::vector<VecX> read_truth_trajectory(const std::filesystem::path& path, const sim::Scene& scene);
 
+/// What a test motion is compared with: the true trajectory of every vertex, or observations of
+/// some of the scene mesh's vertices — e.g. a coarse mesh's vertices carried by a fine mesh's
+/// motion (`observe --onto`, paper 000 §7.3), when the truth was simulated on another mesh.
+struct EvaluationTruth {
+  std::vector<VecX> frames; ///< flat 3n per frame (frame 0 = initial state), or empty
+  std::optional<observe::Observation> observed; ///< set instead of `frames`
+  int num_frames() const;
+};
+
+/// The truth file at `path` for `scene`: an observation file (io::is_observation_h5), validated
+/// against the scene (vertex ids < n, scene.frames + 1 frames, dt), or else a trajectory file
+/// (read_truth_trajectory). Throws InputError naming `path` and the dataset.
+EvaluationTruth read_evaluation_truth(const std::filesystem::path& path, const sim::Scene& scene);
+
 /// One simulated model and its error against the truth.
 struct ModelRun {
   std::string label; ///< "nominal" or "learned"
@@ -62,6 +76,8 @@ struct EvaluationOptions {
 struct MaterialEvaluation {
   double size = 0; ///< rest bounding-box diagonal [m]
   int truth_frames = 0;
+  /// Vertices the errors are measured at: the truth's observed ones, or −1 for every vertex.
+  int truth_vertices = -1;
   ModelRun nominal; ///< the test scene's material
   ModelRun learned; ///< the learned material (the scene's mesh, boundary conditions, time)
   /// Where the learned run's motion leaves the correction's training stretches (material files
@@ -79,6 +95,12 @@ struct MaterialEvaluation {
 /// errors cover the frames before. Throws InputError for an invalid material.
 MaterialEvaluation evaluate_material(const sim::Scene& scene, const MaterialFile& material,
     const std::string& material_source, const std::vector<VecX>& truth,
+    const EvaluationOptions& options = {});
+/// The same against either kind of truth: with observations, err_L and the other statistics are
+/// over the observed (frame, vertex) entries that were seen (learn::observation_error) — the
+/// same definition, over fewer vertices.
+MaterialEvaluation evaluate_material(const sim::Scene& scene, const MaterialFile& material,
+    const std::string& material_source, const EvaluationTruth& truth,
     const EvaluationOptions& options = {});
 
 /// The report ("format": "elastolearn-evaluation/1"; docs/file_formats.md): the file names as

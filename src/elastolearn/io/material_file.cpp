@@ -1,9 +1,11 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/io/material_file.hpp>
 #include <elastolearn/io/scene_material.hpp>
 #include <elastolearn/material/nn_correction.hpp>
 #include <elastolearn/material/rbf_correction.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -256,6 +258,11 @@ std::string describe_correction(const material::Correction& correction) {
 
 std::string describe_material_model(const fem::MaterialModel& model) {
   std::string s = model.elastic ? model.elastic->name() : std::string("(no elastic model)");
+  if (model.stiffness_scale) {
+    const auto [lo, hi]
+        = std::minmax_element(model.stiffness_scale->begin(), model.stiffness_scale->end());
+    s += ", heterogeneous (stiffness x" + to_text(*lo) + " to x" + to_text(*hi) + " by region)";
+  }
   if (model.correction)
     s += " + correction (" + describe_correction(*model.correction) + ")";
   return s;

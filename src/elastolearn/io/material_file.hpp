@@ -65,7 +65,8 @@ nlohmann::json stretch_range_to_json(const material::StretchRange& range);
 /// One line for users: "rbf, 40 centres, with damping correction" or "nn, 6-6-6-3".
 std::string describe_correction(const material::Correction& correction);
 
-/// One line for users: "corotated" or "corotated + correction (rbf, 40 centres)".
+/// One line for users: "corotated", "corotated + correction (rbf, 40 centres)" or, with a
+/// stiffness scale, "corotated, heterogeneous (stiffness x1 to x100 by region)".
 std::string describe_material_model(const fem::MaterialModel& model);
 
 /// The "material" field of a scene: an inline material object (returned as a MaterialFile

@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/material_file.hpp>
+#include <elastolearn/io/material_regions.hpp>
 #include <elastolearn/io/scene_file.hpp>
 #include <elastolearn/io/trajectory_file.hpp>
 #include <elastolearn/mesh/placement.hpp>
@@ -278,7 +279,18 @@ SceneFile parse_scene(
   if (const auto material = referenced_material(root, base_dir))
     out.inputs.push_back({ *material, "material of the scene " + file });
   MaterialFile material_file; // inline object or path of a material file
-  s.material = scene_material_model(root, base_dir, &material_file);
+  // "regions" need the mesh: the material itself is read without them (a material file has none).
+  const bool has_regions = json.contains("material") && json.at("material").is_object()
+      && json.at("material").contains("regions");
+  nlohmann::json homogeneous;
+  if (has_regions) {
+    homogeneous = json;
+    homogeneous["material"].erase("regions");
+  }
+  s.material = scene_material_model(
+      has_regions ? JsonObject(homogeneous, file) : root, base_dir, &material_file);
+  if (has_regions)
+    s.material.stiffness_scale = parse_material_regions(root.object("material"), s.mesh);
   out.material_training_stretches = material_file.training_stretches;
   out.nominal_material = std::move(material_file.material);
   s.mass = root.choice("mass", { "lumped", "consistent" }, "lumped") == "lumped"

@@ -43,6 +43,10 @@ void add_motion(TrainingSet& set, const TrainingSetEntry& paths, const std::stri
   if (scene.material.correction)
     throw InputError(scene_where,
         "material: the scene's material already carries a correction; learn from a nominal one");
+  if (scene.material.stiffness_scale)
+    throw InputError(scene_where,
+        "material.regions: learning needs one homogeneous nominal material (a correction is one "
+        "material's); learn on a homogeneous mesh, e.g. a coarse one (examples/09_coarsening)");
   if (scene.mass != fem::MassType::Lumped)
     throw InputError(scene_where,
         "mass: learning needs \"lumped\" mass (the paper's); learn with lumped mass and simulate "

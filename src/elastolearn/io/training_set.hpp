@@ -56,8 +56,8 @@ struct TrainingSet {
 /// object, lacks "scene" or has not exactly one of "observations" and "clouds" (non-empty
 /// strings) or has other keys; unknown keys at the root; a scene, observation or cloud file that
 /// cannot be read (its reader's error); observations or clouds that do not fit their scene
-/// (vertex ids, frames + 1 frames, dt); a scene whose material
-/// already carries a correction or whose mass is not lumped; a scene whose nominal material
+/// (vertex ids, frames + 1 frames, dt); a scene whose material is heterogeneous ("regions") or
+/// already carries a correction, or whose mass is not lumped; a scene whose nominal material
 /// differs from the first motion's.
 TrainingSet read_training_set(const std::filesystem::path& path);
 
