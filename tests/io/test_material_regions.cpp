@@ -147,6 +147,9 @@ TEST(MaterialRegions, LearningRefusesAHeterogeneousScene) {
   Json scene = stretched_bar(0);
   scene["keyframes"] = Json::array();
   write_json_file(dir / "scene.json", scene);
-  expect_input_error([&] { read_training_motion(dir / "scene.json", dir / "missing.h5"); },
+  expect_input_error(
+      [&] {
+        read_training_motion({ dir / "scene.json", dir / "missing.h5" });
+      },
       { "scene.json", "material.regions", "homogeneous" });
 }
