@@ -193,9 +193,10 @@ void run_learn(const LearnOptions& o) {
           + elastolearn::to_text(
               100 * (c.validation.rms / result.candidates[c.teacher].validation.rms - 1))
           + " % worse than its teacher: the RBF is kept)";
+    else if (c.completed && !reference && c.significance <= 0)
+      note = "   (no better than the fitted nominal)";
     else if (c.completed && !reference && c.significance < learn::kSignificance)
-      note = "   (" + std::string(c.significance > 0 ? "better" : "no better")
-          + " than the fitted nominal by " + elastolearn::to_text(c.significance)
+      note = "   (better than the fitted nominal by " + elastolearn::to_text(c.significance)
           + " noise deviations: not significant)";
     if (c.completed)
       std::printf(
