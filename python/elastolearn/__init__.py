@@ -58,14 +58,16 @@ def simulate(scene, *, frames=None, material=None, solver=None, output=None, eve
                                  output=output, every=every, progress=progress)
 
 
-def observe(trajectory, *, visible_fraction=None, vertices=None, noise=0.0, dropout=0.0,
-            dropout_burst=5.0, seed=1, output=None):
+def observe(trajectory, *, visible_fraction=None, vertices=None, all_vertices=False, onto=None,
+            noise=0.0, dropout=0.0, dropout_burst=5.0, seed=1, output=None):
     """Observe some surface vertices of a trajectory, as ``elastolearn observe``.
 
     trajectory: a ``Trajectory`` (with tets, e.g. ``simulate(...).trajectory``) or the path of a
     trajectory file. Give exactly one of visible_fraction (in (0, 1], spread over the surface by
-    farthest-point sampling) and vertices (an int array of vertex ids, or the path of a text file
-    of them, as ``--vertices FILE``). noise: Gaussian standard deviation per coordinate [m].
+    farthest-point sampling), vertices (an int array of vertex ids, or the path of a text file
+    of them, as ``--vertices FILE``) and all_vertices=True (every vertex, as ``--all``). onto: a
+    ``Scene`` or scene file whose mesh's vertices are observed instead, each interpolated in the
+    trajectory mesh's rest tetrahedron that contains it (``--onto``, e.g. a coarse mesh). noise: Gaussian standard deviation per coordinate [m].
     dropout: lost markers, the fraction in [0, 1) of (frame, vertex) entries lost in occlusion
     bursts of mean length dropout_burst frames (>= 1); lost entries are False in ``valid`` and NaN
     in ``positions``. seed: of the vertex choice, the noise and the dropout. output: also write
@@ -74,16 +76,18 @@ def observe(trajectory, *, visible_fraction=None, vertices=None, noise=0.0, drop
     Returns an ``Observation`` (vertex_ids (k,), positions (T, k, 3), valid (T, k), dt, metadata).
     """
     return _elastolearn.observe(trajectory, visible_fraction=visible_fraction,
-                                vertices=vertices, noise=noise, dropout=dropout,
+                                vertices=vertices, all_vertices=all_vertices, onto=onto,
+                                noise=noise, dropout=dropout,
                                 dropout_burst=dropout_burst, seed=seed, output=output)
 
 
-def learn(scene, observations=None, *, output=None, checkpoint=None, resume=False, report=None,
-          truth_material=None, verbose=False, **options):
+def learn(scene, observations=None, *, clouds=None, output=None, checkpoint=None, resume=False,
+          report=None, truth_material=None, verbose=False, **options):
     """Learn a material from observations with the one recipe, as ``elastolearn learn``.
 
     scene: the path of a scene file (its material is the nominal) with ``observations`` the path
-    of its observation file, or the path of a training-set file (then no observations).
+    of its observation file (or ``clouds`` the path of its point-cloud file, as ``--clouds``:
+    tracked, then learned from), or the path of a training-set file (then neither).
     output: also write the learned material file. checkpoint: the file written after every
     iteration (default: OUTPUT.checkpoint.json when output is given, none otherwise).
     resume: continue from that checkpoint (same scene, observations and options, spelled as
@@ -106,7 +110,8 @@ def learn(scene, observations=None, *, output=None, checkpoint=None, resume=Fals
     decided (noise, parameter fit, candidates and their validation errors, the choice).
     Ctrl-C stops between stages (KeyboardInterrupt); the same call with resume=True continues.
     """
-    return _elastolearn.learn(scene, observations, output=output, checkpoint=checkpoint,
+    return _elastolearn.learn(scene, observations, clouds=clouds, output=output,
+                              checkpoint=checkpoint,
                               resume=resume, report=report, truth_material=truth_material,
                               verbose=verbose, **options)
 

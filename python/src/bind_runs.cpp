@@ -95,12 +95,26 @@ template <typename T> T value(const py::handle& v, const std::string& name) {
 }
 
 Observation observe(const py::handle& trajectory, std::optional<double> visible_fraction,
-    const py::handle& vertices, double noise, double dropout, double dropout_burst,
-    std::uint64_t seed, std::optional<std::filesystem::path> output) {
-  if (visible_fraction.has_value() == !vertices.is_none())
-    throw InputError("observe", "give exactly one of visible_fraction and vertices");
+    const py::handle& vertices, bool all_vertices, const py::handle& onto, double noise,
+    double dropout, double dropout_burst, std::uint64_t seed,
+    std::optional<std::filesystem::path> output) {
+  if (int(visible_fraction.has_value()) + int(!vertices.is_none()) + int(all_vertices) != 1)
+    throw InputError(
+        "observe", "give exactly one of visible_fraction, vertices and all_vertices=True");
   std::vector<CommandInput> inputs;
   io::ObservationRequest request;
+  request.all_vertices = all_vertices;
+  // observe --onto: the vertices of another mesh (a scene), embedded in the trajectory's.
+  std::optional<io::SceneFile> onto_scene;
+  if (!onto.is_none()) {
+    onto_scene = scene_argument(onto);
+    for (const CommandInput& input : onto_scene->inputs)
+      inputs.push_back({ input.path, input.role + " (onto)" });
+    request.onto = &onto_scene->scene.mesh;
+    std::string path;
+    if (is_path(onto, path))
+      request.onto_source = path;
+  }
   std::string vertex_file;
   if (is_path(vertices, vertex_file)) {
     inputs.push_back({ vertex_file, "vertex list (vertices)" });
@@ -485,8 +499,9 @@ void bind_runs(py::module_& m) {
       py::arg("output") = py::none(), py::arg("every") = 1, py::arg("progress") = false);
   m.def("observe", &observe, py::arg("trajectory"), py::kw_only(),
       py::arg("visible_fraction") = py::none(), py::arg("vertices") = py::none(),
-      py::arg("noise") = 0.0, py::arg("dropout") = 0.0, py::arg("dropout_burst") = 5.0,
-      py::arg("seed") = 1, py::arg("output") = py::none());
+      py::arg("all_vertices") = false, py::arg("onto") = py::none(), py::arg("noise") = 0.0,
+      py::arg("dropout") = 0.0, py::arg("dropout_burst") = 5.0, py::arg("seed") = 1,
+      py::arg("output") = py::none());
   m.def("learn", &learn, py::arg("scene"), py::arg("observations") = py::none(), py::kw_only(),
       py::arg("clouds") = py::none(), py::arg("output") = py::none(),
       py::arg("checkpoint") = py::none(), py::arg("resume") = false, py::arg("report") = py::none(),

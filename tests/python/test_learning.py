@@ -53,6 +53,8 @@ def test_observe_equals_the_cli_and_the_trajectory(truth, cli, tmp_path):
         el.observe(traj, vertices=[0, 20])
     with pytest.raises(el.InputError, match="exactly one"):
         el.observe(traj)
+    with pytest.raises(el.InputError, match="exactly one"):
+        el.observe(traj, visible_fraction=0.5, all_vertices=True)
 
 
 def test_learn_fits_the_material_and_evaluate_measures_it(small_scene, truth, tmp_path):
@@ -136,3 +138,19 @@ def test_learn_from_point_clouds(small_scene, truth, cli, tmp_path):
     assert abs(fitted - TRUE_YOUNG) < 0.25 * abs(1e5 - TRUE_YOUNG)
     with pytest.raises(el.InputError, match="not with observations"):
         el.learn(small_scene, tmp_path / "c.h5", clouds=tmp_path / "c.h5")
+
+
+def test_observe_onto_a_coarser_mesh(small_scene, truth, tmp_path):
+    """onto= is --onto: a coarse bar's vertices, all of them fine vertices, observed in the fine
+    trajectory are the fine positions bit for bit."""
+    coarse = dict(SMALL_SCENE, mesh={"type": "box", "size": [0.2, 0.05, 0.05], "cells": [2, 1, 1]})
+    path = tmp_path / "coarse.json"
+    path.write_text(json.dumps(coarse))
+    obs = el.observe(truth, all_vertices=True, onto=path)
+    fine = el.read_trajectory(truth)
+    coarse_rest = el.load_scene(path).rest_positions
+    assert len(obs.vertex_ids) == len(coarse_rest) == 12
+    for j, v in enumerate(obs.vertex_ids):
+        match = np.flatnonzero(np.all(np.abs(fine.rest_positions - coarse_rest[v]) < 1e-12, axis=1))
+        assert len(match) == 1
+        assert np.array_equal(obs.positions[:, j], fine.positions[:, match[0]])
