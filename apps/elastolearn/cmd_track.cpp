@@ -165,6 +165,9 @@ void add_track_command(CLI::App& root) {
       "correspondence σ [m] (default: the clouds' noise_sigma, else half their point spacing)");
   cmd->add_option("--weight", opts->tracking.weight,
       "λ, the pull's stiffness relative to the material's (default 1; docs/tracking.md)");
+  cmd->add_option("--tangential-weight", opts->tracking.tangential_weight,
+      "τ in [0, 1]: weight of the tangential part of a point's distance in the pull (1: point "
+      "to point, 0: point to plane; docs/tracking.md)");
   cmd->add_option("--em-iterations", opts->tracking.em_iterations,
       "most correspondence updates per frame and σ level (default 5)");
   cmd->add_flag("-q,--quiet", opts->quiet, "no progress line");

@@ -42,6 +42,9 @@ struct PullCase {
   VecX x; ///< flat positions where the pairs were found (a deformed state)
   static constexpr double sigma = 0.02; ///< [m]: a few pairs per point on this coarse bar
   static constexpr double stiffness = 300; ///< κ [N/m]
+  /// A pull between point-to-point and point-to-plane, so that the tests see every part of A_k.
+  static constexpr double tangential_weight = 0.3;
+  Positions normals; ///< the samples' normals where the pairs were found
 
   PullCase() {
     std::mt19937 rng(3);
@@ -56,6 +59,7 @@ struct PullCase {
     pairs = capture::find_correspondences(
         capture::CloudIndex(cloud), samples.positions(deformed), match);
     x = flatten(deformed);
+    normals = capture::sample_normals(samples, scene.mesh.surface_faces(), deformed);
   }
 };
 
@@ -64,22 +68,29 @@ struct PullCase {
 TEST(CloudPull, ForceIsMinusTheGradientOfTheCorrespondenceEnergy) {
   PullCase c;
   ASSERT_GT(c.pairs.size(), 50u);
-  observe::CloudPull pull(c.samples, c.simulator.dofs(), c.simulator.system_matrix());
-  pull.set_pairs(c.cloud, c.pairs, c.stiffness);
   const VecX v = VecX::Zero(c.x.size());
+  {
+    // Point to point (τ = 1): the same energy through capture::correspondence_energy (pairs
+    // summed one by one): E_pull = κσ² E_corr, so f = −κσ² ∂E_corr/∂x, to rounding.
+    observe::CloudPull point(c.samples, c.simulator.dofs(), c.simulator.system_matrix());
+    point.set_pairs(c.cloud, c.pairs, c.stiffness, c.normals, 1.0);
+    VecX f = VecX::Zero(c.x.size());
+    point.add_force({ c.x, v, 0 }, f);
+    Positions gradient;
+    const Positions X = Eigen::Map<const Positions>(c.x.data(), c.x.size() / 3, 3);
+    const double e_corr
+        = capture::correspondence_energy(c.samples, X, c.cloud, c.pairs, c.sigma, &gradient);
+    const double scale = c.stiffness * c.sigma * c.sigma;
+    EXPECT_NEAR(point.energy(c.x), scale * e_corr, 1e-12 * scale * e_corr);
+    EXPECT_LE(
+        (f + scale * flatten(gradient)).cwiseAbs().maxCoeff(), 1e-10 * f.cwiseAbs().maxCoeff());
+  }
+  // With a tangential weight τ < 1: against finite differences of the energy. E is quadratic,
+  // so 4th-order central differences are exact up to rounding (≈ 1e-16 · E / h).
+  observe::CloudPull pull(c.samples, c.simulator.dofs(), c.simulator.system_matrix());
+  pull.set_pairs(c.cloud, c.pairs, c.stiffness, c.normals, c.tangential_weight);
   VecX f = VecX::Zero(c.x.size());
   pull.add_force({ c.x, v, 0 }, f);
-  // The same energy through capture::correspondence_energy (pairs summed one by one): E_pull =
-  // κσ² E_corr, so f = −κσ² ∂E_corr/∂x, to rounding.
-  Positions gradient;
-  const Positions X = Eigen::Map<const Positions>(c.x.data(), c.x.size() / 3, 3);
-  const double e_corr
-      = capture::correspondence_energy(c.samples, X, c.cloud, c.pairs, c.sigma, &gradient);
-  const double scale = c.stiffness * c.sigma * c.sigma;
-  EXPECT_NEAR(pull.energy(c.x), scale * e_corr, 1e-12 * scale * e_corr);
-  EXPECT_LE((f + scale * flatten(gradient)).cwiseAbs().maxCoeff(), 1e-10 * f.cwiseAbs().maxCoeff());
-  // And against finite differences of the energy: E is quadratic, so 4th-order central
-  // differences are exact up to rounding (≈ 1e-16 · E / h).
   const VecX fd = test::fd_gradient([&](const VecX& y) { return pull.energy(y); }, c.x, 1e-3);
   EXPECT_LE((f + fd).cwiseAbs().maxCoeff(), 1e-8 * f.cwiseAbs().maxCoeff());
   EXPECT_GT(f.cwiseAbs().maxCoeff(), 0);
@@ -88,7 +99,7 @@ TEST(CloudPull, ForceIsMinusTheGradientOfTheCorrespondenceEnergy) {
 TEST(CloudPull, JacobianIsMinusTheDerivativeOfTheForceOverTheFreeDofs) {
   PullCase c;
   observe::CloudPull pull(c.samples, c.simulator.dofs(), c.simulator.system_matrix());
-  pull.set_pairs(c.cloud, c.pairs, c.stiffness);
+  pull.set_pairs(c.cloud, c.pairs, c.stiffness, c.normals, c.tangential_weight);
   fem::SystemMatrix A = c.simulator.system_matrix();
   A.set_zero();
   const VecX v = VecX::Zero(c.x.size());
@@ -107,7 +118,7 @@ TEST(CloudPull, JacobianIsMinusTheDerivativeOfTheForceOverTheFreeDofs) {
     return VecX(-dofs.restrict(f));
   };
   test::expect_jacobian_matches(K, minus_force, dofs.restrict(c.x), 1e-8, 1e-3);
-  // Symmetric positive semi-definite (a sum of W_k b bᵀ ⊗ I₃ with W_k ≥ 0).
+  // Symmetric positive semi-definite (a sum of W_k b bᵀ ⊗ A_k with W_k ≥ 0, A_k PSD).
   EXPECT_LE((K - K.transpose()).cwiseAbs().maxCoeff(), 1e-12 * K.cwiseAbs().maxCoeff());
   EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(K).eigenvalues().minCoeff(),
       -1e-12 * K.cwiseAbs().maxCoeff());
@@ -116,7 +127,7 @@ TEST(CloudPull, JacobianIsMinusTheDerivativeOfTheForceOverTheFreeDofs) {
 TEST(CloudPull, ClearRemovesThePull) {
   PullCase c;
   observe::CloudPull pull(c.samples, c.simulator.dofs(), c.simulator.system_matrix());
-  pull.set_pairs(c.cloud, c.pairs, c.stiffness);
+  pull.set_pairs(c.cloud, c.pairs, c.stiffness, c.normals, c.tangential_weight);
   pull.clear();
   const VecX v = VecX::Zero(c.x.size());
   VecX f = VecX::Zero(c.x.size());

@@ -27,6 +27,22 @@ void SurfaceSamples::scatter(ConstRef<Positions> per_sample, Positions& per_vert
       per_vertex.row(vertices(k, j)) += weights(k, j) * per_sample.row(k);
 }
 
+Positions sample_normals(const SurfaceSamples& samples, const Faces& faces, ConstRef<Positions> x) {
+  Positions vertex_normals = Positions::Zero(x.rows(), 3);
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    const Eigen::RowVector3d a = x.row(faces(f, 0));
+    const Eigen::RowVector3d n = (x.row(faces(f, 1)) - a).cross(x.row(faces(f, 2)) - a); // 2·area
+    for (int j = 0; j < 3; ++j)
+      vertex_normals.row(faces(f, j)) += n;
+  }
+  Positions out = samples.positions(vertex_normals);
+  for (Eigen::Index k = 0; k < out.rows(); ++k) {
+    const double length = out.row(k).norm();
+    out.row(k) = length > 0 ? Eigen::RowVector3d(out.row(k) / length) : Eigen::RowVector3d::Zero();
+  }
+  return out;
+}
+
 SurfaceSamples sample_surface(const Faces& faces, int subdivision) {
   const int s = subdivision;
   if (s < 1 || s > 64)

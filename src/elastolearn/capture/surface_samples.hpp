@@ -26,6 +26,11 @@ struct SurfaceSamples {
   void scatter(ConstRef<Positions> per_sample, Positions& per_vertex) const;
 };
 
+/// Unit normals of the samples (K×3) of the surface `faces` at vertex positions x (n×3): the
+/// area-weighted vertex normals interpolated with the samples' barycentric weights and normalised
+/// (orientation as the faces' winding). A sample whose interpolated normal vanishes gets (0, 0, 0).
+Positions sample_normals(const SurfaceSamples& samples, const Faces& faces, ConstRef<Positions> x);
+
 /// Samples of the surface `faces` (f×3 vertex indices ≥ 0) on the barycentric lattice of step
 /// 1/subdivision: every vertex used by a face (once, ascending), then subdivision − 1 points on
 /// every edge (once per undirected edge, at i/s from its smaller-index end), then the interior

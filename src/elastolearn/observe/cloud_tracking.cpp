@@ -74,6 +74,8 @@ void TrackingOptions::validate() const {
         "must be positive and finite (the scanner's accuracy in metres), got " + to_text(sigma));
   if (!(weight > 0) || !std::isfinite(weight))
     fail("weight", "must be positive and finite, got " + to_text(weight));
+  if (!(tangential_weight >= 0 && tangential_weight <= 1))
+    fail("tangential_weight", "must be in [0, 1], got " + to_text(tangential_weight));
   if (!(truncation > 0 && truncation < 1))
     fail("truncation", "must be in (0, 1), got " + to_text(truncation));
   if (em_iterations < 1)
@@ -226,8 +228,10 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
           for (std::size_t i = 0; i < pairs.size(); ++i)
             active += (i == 0 || pairs[i].sample != pairs[i - 1].sample);
           const double observed = area * double(active) / level.samples.num_samples();
-          level.pull->set_pairs(
-              cloud, pairs, report.stiffness_per_area * observed / double(frame.points));
+          level.pull->set_pairs(cloud, pairs,
+              report.stiffness_per_area * observed / double(frame.points),
+              capture::sample_normals(level.samples, faces, x_guess),
+              l == 0 ? options.tangential_weight : 1.0);
         }
         simulator.set_state(x_start, v_start, t_start);
         solve = dynamic ? simulator.step() : simulator.solve_static(1);

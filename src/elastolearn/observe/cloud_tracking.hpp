@@ -37,6 +37,9 @@ namespace elastolearn::observe {
 struct TrackingOptions {
   double sigma = 0; ///< σ [m], > 0 (default_tracking_sigma gives the default)
   double weight = 1; ///< λ, dimensionless pull stiffness (see the file comment), > 0
+  /// τ ∈ [0, 1], the weight of a distance's tangential part in the pull (CloudPull): 1 pulls
+  /// point to point (Eq. 9 as written), 0 point to plane.
+  double tangential_weight = 1;
   double truncation = 1e-3; ///< correspondence truncation, in (0, 1)
   /// Most EM iterations per frame at the final σ (re-find pairs, re-solve the step), ≥ 1.
   int em_iterations = 5;
