@@ -83,6 +83,18 @@ VecX force_at(fem::ElasticForce& term, const VecX& x, const VecX& v) {
   return f;
 }
 
+/// The assembled Jacobian c_x K + c_v D (unprojected) and the force at (x, v).
+Eigen::MatrixXd jacobian_at(
+    fem::ElasticForce& term, const VecX& x, const VecX& v, double c_x, double c_v, VecX& f) {
+  const int n = static_cast<int>(x.size() / 3);
+  fem::DofMap dofs(n, {});
+  fem::SystemMatrix A(term.tets(), dofs);
+  f = VecX::Zero(x.size());
+  A.set_zero();
+  term.add_force_and_jacobian({ x, v, 0.0 }, c_x, c_v, f, A);
+  return Eigen::MatrixXd(A.matrix());
+}
+
 } // namespace
 
 class ElasticForceTest : public ::testing::TestWithParam<int> { };
@@ -195,15 +207,12 @@ TEST_P(ExactRayleighDampingTest, NewtonsUnprojectedJacobianIsMinusTheVelocityDer
       { model(GetParam()), nullptr, rayleigh(0.2, 0.01, material::DampingTangent::Exact), 1000 },
       fem::MassType::Consistent);
   term.set_project_tangent(false);
-  fem::DofMap dofs(mesh.num_vertices(), {});
-  fem::SystemMatrix A(mesh.tets(), dofs);
   const VecX x = deformed(mesh, 0.3);
   const VecX v = random_velocity(x.size(), 5);
-  VecX f = VecX::Zero(x.size());
-  A.set_zero();
-  term.add_force_and_jacobian({ x, v, 0.0 }, 0.0, 1.0, f, A);
+  VecX f;
   test::expect_jacobian_matches(
-      -Eigen::MatrixXd(A.matrix()), [&](const VecX& w) { return force_at(term, x, w); }, v, 1e-7);
+      -jacobian_at(term, x, v, 0.0, 1.0, f), [&](const VecX& w) { return force_at(term, x, w); }, v,
+      1e-7);
 }
 
 INSTANTIATE_TEST_SUITE_P(Materials, ExactRayleighDampingTest, ::testing::Values(0, 1, 2, 3),
@@ -238,18 +247,10 @@ TEST(RayleighDampingForce, DampingJacobianIsMinusVelocityDerivative) {
   auto damping = std::make_shared<material::RayleighDamping>(0.2, 0.005);
   fem::ElasticForce term(mesh, { model(0), nullptr, damping, 1000 });
   term.set_project_tangent(false);
-  fem::DofMap dofs(mesh.num_vertices(), {});
-  fem::SystemMatrix A(mesh.tets(), dofs);
   const VecX x = deformed(mesh, 0.3);
-  VecX v(x.size());
-  std::mt19937 rng(3);
-  std::normal_distribution<double> n01;
-  for (auto& vi : v)
-    vi = n01(rng);
-  VecX f = VecX::Zero(x.size());
-  A.set_zero();
-  term.add_force_and_jacobian({ x, v, 0.0 }, 0.0, 1.0, f, A); // c_x = 0, c_v = 1: only D
-  const Eigen::MatrixXd D = Eigen::MatrixXd(A.matrix());
+  const VecX v = random_velocity(x.size(), 3);
+  VecX f;
+  const Eigen::MatrixXd D = jacobian_at(term, x, v, 0.0, 1.0, f); // c_x = 0, c_v = 1: only D
   test::expect_jacobian_matches(
       -D, [&](const VecX& w) { return force_at(term, x, w); }, v, 1e-7);
   // Damping dissipates: vᵀ f_d ≤ 0.
@@ -328,15 +329,12 @@ TEST(LearnedStiffnessDamping, UnprojectedJacobianIsMinusTheVelocityDerivative) {
     fem::ElasticForce term(mesh,
         { model(0), correction, rayleigh(0.2, alpha1, material::DampingTangent::FlipFree), 1000 });
     term.set_project_tangent(false);
-    fem::DofMap dofs(mesh.num_vertices(), {});
-    fem::SystemMatrix A(mesh.tets(), dofs);
     const VecX x = deformed(mesh, 0.3);
     const VecX v = random_velocity(x.size(), 17);
-    VecX f = VecX::Zero(x.size());
-    A.set_zero();
-    term.add_force_and_jacobian({ x, v, 0.0 }, 0.0, 1.0, f, A);
+    VecX f;
     test::expect_jacobian_matches(
-        -Eigen::MatrixXd(A.matrix()), [&](const VecX& w) { return force_at(term, x, w); }, v, 1e-7);
+        -jacobian_at(term, x, v, 0.0, 1.0, f), [&](const VecX& w) { return force_at(term, x, w); },
+        v, 1e-7);
   }
 }
 
@@ -350,18 +348,6 @@ std::shared_ptr<const std::vector<double>> random_scales(int count, unsigned see
   for (double& s : *scales)
     s = std::pow(10.0, exponent(rng));
   return scales;
-}
-
-/// The assembled Jacobian c_x K + c_v D (unprojected) and the force at (x, v).
-Eigen::MatrixXd jacobian_at(
-    fem::ElasticForce& term, const VecX& x, const VecX& v, double c_x, double c_v, VecX& f) {
-  const int n = static_cast<int>(x.size() / 3);
-  fem::DofMap dofs(n, {});
-  fem::SystemMatrix A(term.tets(), dofs);
-  f = VecX::Zero(x.size());
-  A.set_zero();
-  term.add_force_and_jacobian({ x, v, 0.0 }, c_x, c_v, f, A);
-  return Eigen::MatrixXd(A.matrix());
 }
 
 } // namespace

@@ -17,6 +17,7 @@
 
 #include <array>
 #include <random>
+#include <string>
 
 using namespace elastolearn;
 
@@ -166,6 +167,23 @@ capture::PointCloudSequence scan_run(
   return capture::PointCloudSequence::from_frames(frames, scene.dt, 0, "scan");
 }
 
+/// A tracked run: the report and every tracked state (flat positions).
+struct Tracked {
+  observe::TrackingReport report;
+  std::vector<VecX> positions;
+};
+
+/// Track `clouds` with `scene` at σ (the other options default).
+Tracked track(const sim::Scene& scene, const capture::PointCloudSequence& clouds, double sigma,
+    const std::string& source) {
+  observe::TrackingOptions options;
+  options.sigma = sigma;
+  Tracked t;
+  t.report = observe::track_clouds(scene, clouds, source, options,
+      [&](int, double, const VecX& x, const VecX&) { t.positions.push_back(x); });
+  return t;
+}
+
 /// RMS over frames and surface vertices of the distance between two runs' surface vertices.
 double surface_rms(
     const sim::Scene& scene, const std::vector<VecX>& a, const std::vector<VecX>& b) {
@@ -190,11 +208,7 @@ TEST(CloudTracking, FollowsTheScansOfTheTruthWithAWrongNominalMaterial) {
   ASSERT_TRUE(truth_run.completed && nominal_run.completed);
   const auto clouds = scan_run(truth, truth_run, sigma);
 
-  observe::TrackingOptions options;
-  options.sigma = sigma;
-  std::vector<VecX> tracked;
-  const auto report = observe::track_clouds(nominal, clouds, "scan", options,
-      [&](int, double, const VecX& x, const VecX&) { tracked.push_back(x); });
+  const auto [report, tracked] = track(nominal, clouds, sigma, "scan");
   ASSERT_TRUE(report.completed) << report.message;
   ASSERT_EQ(tracked.size(), truth_run.positions.size());
 
@@ -223,11 +237,7 @@ TEST(CloudTracking, EmptyCloudsGiveThePlainSimulation) {
   const sim::ForwardRun run = sim::simulate_positions(scene);
   std::vector<capture::CloudFrame> frames(static_cast<std::size_t>(scene.frames + 1));
   const auto clouds = capture::PointCloudSequence::from_frames(frames, scene.dt, 0, "empty");
-  observe::TrackingOptions options;
-  options.sigma = 1e-3;
-  std::vector<VecX> tracked;
-  const auto report = observe::track_clouds(scene, clouds, "empty", options,
-      [&](int, double, const VecX& x, const VecX&) { tracked.push_back(x); });
+  const auto [report, tracked] = track(scene, clouds, 1e-3, "empty");
   ASSERT_TRUE(report.completed);
   ASSERT_EQ(tracked.size(), run.positions.size());
   for (std::size_t t = 0; t < tracked.size(); ++t)
@@ -280,12 +290,7 @@ TEST(CloudTracking, ConvergesOnARigidMotion) {
   sim::ForwardRun run;
   run.positions = moved;
   const double sigma = 1e-3;
-  const auto clouds = scan_run(scene, run, sigma);
-  observe::TrackingOptions options;
-  options.sigma = sigma;
-  std::vector<VecX> tracked;
-  const auto report = observe::track_clouds(scene, clouds, "rigid", options,
-      [&](int, double, const VecX& x, const VecX&) { tracked.push_back(x); });
+  const auto [report, tracked] = track(scene, scan_run(scene, run, sigma), sigma, "rigid");
   ASSERT_TRUE(report.completed) << report.message;
   ASSERT_EQ(tracked.size(), moved.size());
   // The largest vertex error (surface and interior) per quarter of the run. The bar starts at

@@ -8,6 +8,8 @@ import subprocess
 
 import pytest
 
+import elastolearn as el
+
 # A corotated bar fixed at x = 0, sagging under gravity: 4 × 1 × 1 cells, 20 steps of 2 ms
 # (the CLI tests' small scene).
 SMALL_SCENE = {
@@ -26,6 +28,20 @@ def small_scene(tmp_path):
     """The path of SMALL_SCENE written to a scratch folder."""
     path = tmp_path / "bar.json"
     path.write_text(json.dumps(SMALL_SCENE))
+    return path
+
+
+TRUE_YOUNG = 1.5e5  # the truth's E; SMALL_SCENE's nominal says 1e5
+
+
+@pytest.fixture
+def truth(small_scene, tmp_path):
+    """The true motion of the small scene: its material 1.5 × stiffer."""
+    material = el.Material.from_json({"format": "elastolearn-material/1", "correction": None,
+                                      "material": dict(SMALL_SCENE["material"],
+                                                       young=TRUE_YOUNG)})
+    path = tmp_path / "truth.h5"
+    el.simulate(small_scene, material=material, output=path)
     return path
 
 

@@ -9,9 +9,8 @@ import numpy as np
 import pytest
 
 import elastolearn as el
-from conftest import SMALL_SCENE
+from conftest import SMALL_SCENE, TRUE_YOUNG
 
-TRUE_YOUNG = 1.5e5  # the nominal scene says 1e5
 
 # A short learning run (0.3 s): the loop runs iterations 0 to 3, so the checkpoint written after
 # iteration 1 is in the middle of the run.
@@ -29,17 +28,6 @@ def cli_flags(options):
         elif v is not False:
             flags += [flag, v]
     return flags
-
-
-@pytest.fixture
-def truth(small_scene, tmp_path):
-    """The true motion of the small scene: its material 1.5 × stiffer."""
-    material = el.Material.from_json({"format": "elastolearn-material/1", "correction": None,
-                                      "material": dict(SMALL_SCENE["material"],
-                                                       young=TRUE_YOUNG)})
-    path = tmp_path / "truth.h5"
-    el.simulate(small_scene, material=material, output=path)
-    return path
 
 
 @pytest.fixture

@@ -7,20 +7,7 @@ import numpy as np
 import pytest
 
 import elastolearn as el
-from conftest import SMALL_SCENE
-
-TRUE_YOUNG = 1.5e5  # the nominal scene says 1e5
-
-
-@pytest.fixture
-def truth(small_scene, tmp_path):
-    """The true motion of the small scene: its material 1.5 × stiffer."""
-    material = el.Material.from_json({"format": "elastolearn-material/1", "correction": None,
-                                      "material": dict(SMALL_SCENE["material"],
-                                                       young=TRUE_YOUNG)})
-    path = tmp_path / "truth.h5"
-    el.simulate(small_scene, material=material, output=path)
-    return path
+from conftest import SMALL_SCENE, TRUE_YOUNG
 
 
 def test_observe_equals_the_cli_and_the_trajectory(truth, cli, tmp_path):

@@ -340,9 +340,12 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   std::vector<Motion> learned_from(motions.begin(), motions.end());
   const bool clouds = std::any_of(learned_from.begin(), learned_from.end(),
       [](const Motion& m) { return m.captured != nullptr; });
+  // The nominal material with parameters p.
+  const auto nominal_with = [&](const NominalParameters& p) {
+    return scene_with_parameters(motions.front().scene, result.nominal_type, p).material;
+  };
   const auto observe_captures = [&](const NominalParameters& p, const char* which) {
-    const fem::MaterialModel material
-        = scene_with_parameters(motions.front().scene, result.nominal_type, p).material;
+    const fem::MaterialModel material = nominal_with(p);
     for (Motion& m : learned_from)
       if (m.captured)
         say(callbacks,
@@ -360,7 +363,6 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
 
   // Stage 2: the nominal model's parameters, fitted to every training motion as recorded (the
   // training motions lend their scenes, their observations swapped for the raw ones meanwhile).
-  const sim::Scene train = split.training.front().scene;
   const auto fit_from = [&](const NominalParameters& start) {
     const auto swap_observations = [&] {
       for (size_t i = 0; i < split.training.size(); ++i)
@@ -402,8 +404,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   }
   if (!resume && callbacks.parameters_fitted)
     callbacks.parameters_fitted(result.parameter_fit);
-  result.fitted_nominal
-      = scene_with_parameters(train, result.nominal_type, result.parameter_fit.fitted).material;
+  result.fitted_nominal = nominal_with(result.parameter_fit.fitted);
   for (const Motion& m : learned_from)
     result.observed.push_back(m.observed);
 

@@ -59,16 +59,21 @@ void CloudPull::set_pairs(ConstRef<Positions> cloud,
   ELASTOLEARN_CHECK(stiffness > 0, "cloud pull: the stiffness must be positive");
   ELASTOLEARN_CHECK(tangential_weight >= 0 && tangential_weight <= 1,
       "cloud pull: the tangential weight must be in [0, 1]");
-  ELASTOLEARN_CHECK(normals.rows() == m_samples.num_samples() && normals.cols() == 3,
+  const bool point_to_point = tangential_weight == 1;
+  ELASTOLEARN_CHECK(
+      point_to_point || (normals.rows() == m_samples.num_samples() && normals.cols() == 3),
       "cloud pull: one normal per sample");
   clear();
   for (const capture::Correspondence& c : pairs) {
     const double w = stiffness * c.weight;
     if (m_weight[c.sample] == 0 && w != 0) {
       m_active.push_back(c.sample);
-      const Vec3 n = normals.row(c.sample).transpose();
-      m_metric[static_cast<std::size_t>(c.sample)]
-          = tangential_weight * Mat3::Identity() + (1 - tangential_weight) * n * n.transpose();
+      Mat3& metric = m_metric[static_cast<std::size_t>(c.sample)];
+      metric = Mat3::Identity();
+      if (!point_to_point) {
+        const Vec3 n = normals.row(c.sample).transpose();
+        metric = tangential_weight * metric + (1 - tangential_weight) * n * n.transpose();
+      }
     }
     m_weight[c.sample] += w;
     m_target.row(c.sample) += w * cloud.row(c.point);

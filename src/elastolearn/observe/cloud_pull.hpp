@@ -37,7 +37,8 @@ class CloudPull final : public fem::ForceTerm {
 
   /// Hold these pairs (of the samples with the N×3 `cloud`) fixed, with stiffness κ > 0 [N/m]
   /// per unit of weight, the samples' unit normals (K×3, e.g. capture::sample_normals where the
-  /// pairs were found) and the tangential weight τ ∈ [0, 1]. No pairs: no pull.
+  /// pairs were found; not read, and may be empty, at τ = 1) and the tangential weight
+  /// τ ∈ [0, 1]. No pairs: no pull.
   void set_pairs(ConstRef<Positions> cloud, const std::vector<capture::Correspondence>& pairs,
       double stiffness, ConstRef<Positions> normals, double tangential_weight);
   /// No pull.

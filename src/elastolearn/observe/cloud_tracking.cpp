@@ -228,10 +228,12 @@ TrackingReport track_clouds(const sim::Scene& scene, const capture::PointCloudSe
           for (std::size_t i = 0; i < pairs.size(); ++i)
             active += (i == 0 || pairs[i].sample != pairs[i - 1].sample);
           const double observed = area * double(active) / level.samples.num_samples();
+          // Coarser levels only acquire a far-off frame: they pull point to point.
+          const double tangential = l == 0 ? options.tangential_weight : 1.0;
           level.pull->set_pairs(cloud, pairs,
               report.stiffness_per_area * observed / double(frame.points),
-              capture::sample_normals(level.samples, faces, x_guess),
-              l == 0 ? options.tangential_weight : 1.0);
+              tangential < 1 ? capture::sample_normals(level.samples, faces, x_guess) : Positions(),
+              tangential);
         }
         simulator.set_state(x_start, v_start, t_start);
         solve = dynamic ? simulator.step() : simulator.solve_static(1);
