@@ -21,6 +21,7 @@
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/marker_dropout.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
+#include <elastolearn/sim/amplified_scene.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
@@ -81,6 +82,43 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
   return learn::as_percent_of(
       learn::position_error(run.positions, truth), scene.mesh.bounding_box_diagonal())
       .max;
+}
+
+/// --test-candidates: also print the test err_L of every candidate the validation compared (a
+/// diagnostic of the choice: does the held-out data rank them as the test does?).
+bool g_test_candidates = false;
+
+/// --test-candidates: each validated candidate's validation RMS and test err_L, one line each.
+void print_candidate_tests(const learn::RecipeResult& result, const sim::Scene& train,
+    const sim::Scene& test, const fem::MaterialModel& given_nominal, const std::vector<VecX>& truth,
+    double size) {
+  if (!g_test_candidates)
+    return;
+  for (size_t i = 0; i < result.candidates.size(); ++i) {
+    const learn::Candidate& c = result.candidates[i];
+    std::string name = learn::to_string(c.kind);
+    if (c.iteration >= 0)
+      name += " " + std::to_string(c.iteration);
+    const double test_error = c.completed
+        ? err_l(with_material(test, result.material(given_nominal, int(i))), truth)
+        : -1;
+    const auto& x = c.extrapolation;
+    std::string larger = "-";
+    if (c.completed) {
+      const auto run = sim::simulate_positions(
+          sim::amplified_scene(with_material(train, result.material(given_nominal, int(i))), 1.5));
+      larger = run.completed ? "completes" : "diverges (" + run.message + ")";
+    }
+    std::printf("   candidate %-22s training motion ×1.5: %s\n", name.c_str(), larger.c_str());
+    std::printf("   candidate %-22s validation rms %.4f %%, z %+.1f, %s (σ^1.5: %ld of %ld "
+                "unstable, min relative eigenvalue %.3g at (%.3f, %.3f, %.3f)); test err_L %.3f "
+                "%%%s\n",
+        name.c_str(), 100 * c.validation.rms / size, c.significance,
+        c.eligible() ? "eligible" : "not eligible", x.unstable_samples, x.samples,
+        x.min_relative_eigenvalue, x.worst_stretches[0], x.worst_stretches[1], x.worst_stretches[2],
+        test_error, int(i) == result.chosen ? "  <- chosen" : "");
+  }
+  std::fflush(stdout);
 }
 
 /// --dropout P: the fraction of the named cases' training marker-frames lost in occlusion bursts
@@ -341,6 +379,8 @@ Row run_case(const LearningCase& c) {
               "%.1f %%; %.1f s)\n",
       row.err_nominal, row.err_fit, row.err_learned, row.target, seconds_since(t0));
   std::fflush(stdout);
+  print_candidate_tests(
+      learned, c.train, c.test, c.train.material, truth_test, c.train.mesh.bounding_box_diagonal());
   return row;
 }
 
@@ -555,6 +595,8 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
       percent(row.err_nominal).c_str(), percent(row.err_fit).c_str(),
       percent(row.err_learned).c_str(), seconds_since(t0));
   std::fflush(stdout);
+  print_candidate_tests(result, motions.train, motions.test, o.nominal, truth_test,
+      motions.test.mesh.bounding_box_diagonal());
   return row;
 }
 
@@ -672,6 +714,8 @@ int main(int argc, char** argv) {
       g_outliers = std::stod(argv[++i]);
     else if (a == "--truth-only")
       g_truth_only = true;
+    else if (a == "--test-candidates")
+      g_test_candidates = true;
     else if (a == "--no-fit")
       g_recipe.fit_parameters = false;
     else if (a == "--modes" && i + 1 < argc)
@@ -738,7 +782,7 @@ int main(int argc, char** argv) {
                   "[--pod-forward-only] [--no-damping] [--position-weight W] "
                   "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\n"
                   "       bench_learning --random N [--seed S] [--random-case I] [--draw-only] "
-                  "[--data DIR]\ncases:");
+                  "[--data DIR]\n       (either form) [--test-candidates]\ncases:");
       for (const auto& n : kCases)
         std::printf(" %s", n.c_str());
       std::printf(
@@ -751,7 +795,9 @@ int main(int argc, char** argv) {
           "occlusion bursts (mean 5 frames) drawn from --dropout-seed S (default 2)\n--scan C: "
           "the named cases learn from virtual depth scans of their training motion by C = 1 or 2 "
           "cameras (640×480, 45°, 2 diagonals away), depth noise --scan-noise S [m] (default "
-          "0.001), outlier fraction --outliers F (default 0)\n");
+          "0.001), outlier fraction --outliers F (default 0)\n--test-candidates: also print "
+          "every validated candidate's test err_L (does the held-out data rank them as the test "
+          "does?)\n");
       return 0;
     } else if (a == "all")
       names.insert(names.end(), kCases.begin(), kCases.end());

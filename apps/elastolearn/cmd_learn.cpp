@@ -250,7 +250,7 @@ void add_learn_command(CLI::App& root) {
          "observation noise σ [m] per coordinate (default: estimated from the data)")
       ->capture_default_str();
   cmd->add_option("--validation-fraction", o->recipe.validation_fraction,
-         "fraction of the frames, at the end, held out to choose the material")
+         "fraction of every motion's frames, at its end, held out to choose the material")
       ->capture_default_str();
   cmd->add_flag("--no-parameter-fit", o->no_parameter_fit,
       "learn on the scene's nominal parameters as given (default: fit E, ν, α₀, α₁ first)");

@@ -229,6 +229,46 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
   EXPECT_LT(learned, nominal / 3) << "nominal " << nominal << " %";
 }
 
+TEST(LearningRecipe, ATrainingSetHoldsOutTheTailOfEveryMotion) {
+  // A droop and a swing: both are trained on (their first 48 frames) and both validate (their
+  // last 12), so the choice sees both kinds of motion.
+  const Case c;
+  sim::Scene swing = c.nominal;
+  swing.initial = c.truth_swing.initial;
+  const std::vector<Motion> motions { { "droop", c.nominal, observe(c.truth, 0) },
+    { "swing", swing, observe(c.truth_swing, 0) } };
+  RecipeOptions o = small_recipe();
+  o.parameter_fit.max_iterations = 2;
+  o.loop.max_iterations = 1;
+  o.loop.forward_fit.max_iterations = 0;
+  o.network.enabled = false;
+  const RecipeResult r = learn_material(motions, o);
+  ASSERT_FALSE(r.interrupted);
+  EXPECT_EQ(r.training_frames, 48);
+  EXPECT_EQ(r.validation_frames, 24);
+  EXPECT_NE(r.validation_data.find("12 of 60 frames of droop"), std::string::npos)
+      << r.validation_data;
+  EXPECT_NE(r.validation_data.find("12 of 60 frames of swing"), std::string::npos)
+      << r.validation_data;
+  // Each candidate is compared at every observed vertex of both held-out tails.
+  const long per_motion = 12 * static_cast<long>(motions[0].observed.num_observed());
+  for (const Candidate& k : r.candidates)
+    if (k.completed)
+      EXPECT_EQ(k.validation.samples, 2 * per_motion) << to_string(k.kind);
+  // The given nominal's validation error is the two tails' errors combined.
+  std::vector<ErrorSummary> tails;
+  for (const Motion& m : motions) {
+    const auto run = sim::simulate_positions(m.scene);
+    ASSERT_TRUE(run.completed);
+    tails.push_back(
+        observation_error(std::vector<VecX>(run.positions.begin() + 49, run.positions.end()),
+            m.observed.frame_range(49, 60)));
+  }
+  EXPECT_NEAR(
+      r.candidates[0].validation.rms, combined_error(tails).rms, 1e-12 * combined_error(tails).rms);
+  EXPECT_EQ(r.candidates[0].validation.max, combined_error(tails).max);
+}
+
 TEST(LearningRecipe, NoisyCaptureLearnsWithoutDivergenceAndBeatsTheNominal) {
   // σ = 0.2 % of the size (0.85 mm on the 0.42 m bar), estimated from the data.
   const Case c;

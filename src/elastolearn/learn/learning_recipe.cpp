@@ -1,4 +1,5 @@
 #include <elastolearn/core/error.hpp>
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/cloud_motion.hpp>
 #include <elastolearn/learn/element_state.hpp>
@@ -53,8 +54,9 @@ void RecipeOptions::validate() const {
   network.validate();
 }
 
-fem::MaterialModel RecipeResult::material(const fem::MaterialModel& given_nominal) const {
-  const Candidate& c = choice();
+fem::MaterialModel RecipeResult::material(
+    const fem::MaterialModel& given_nominal, int candidate) const {
+  const Candidate& c = candidate < 0 ? choice() : candidates.at(static_cast<size_t>(candidate));
   fem::MaterialModel m = c.kind == CandidateKind::Nominal ? given_nominal : fitted_nominal;
   m.correction = c.correction;
   return m;
@@ -108,56 +110,53 @@ observe::Observation frame_range(const observe::Observation& o, int first, int l
   return o.frame_range(first, last);
 }
 
+/// A held-out piece of one motion: its scene, simulated in full, and the frames of it compared.
+struct HeldOut {
+  Motion motion; ///< observed = the frames compared (as recorded)
+  int first_frame = 0; ///< frame of the scene's run that observed[0] is
+};
+
 /// The training and validation data of stage 1.
 struct Split {
   std::vector<Motion> training; ///< observations smoothed to the noise level
   /// The training motions' observations as recorded, in order (the parameter fit's data: it
   /// does not differentiate positions).
   std::vector<observe::Observation> fit_observed;
-  Motion validation; ///< scene simulated in full; observed = its frames compared
-  int first_validation_frame = 0; ///< frame of the validation scene's run that observed[0] is
+  std::vector<HeldOut> validation; ///< one per motion
   std::string description;
 };
 
-/// `smoothed`: every motion's observation smoothed to the noise level, in order.
+/// Every motion's last `validation_fraction` of frames is held out, the rest is trained on: the
+/// loop learns from every kind of motion given, and the validation sees every kind. (Holding out
+/// a whole motion instead would leave a training set of two motions one to learn from: a bend
+/// and a twist of a bar then fit ν to the bend alone.) `smoothed`: every motion's observation
+/// smoothed to the noise level, in order.
 Split split_motions(std::span<const Motion> motions, double validation_fraction,
     std::vector<observe::Observation> smoothed) {
   Split split;
-  if (motions.size() >= 2) {
-    for (size_t i = 0; i + 1 < motions.size(); ++i) {
-      split.fit_observed.push_back(motions[i].observed);
-      Motion m = motions[i];
-      m.observed = std::move(smoothed[i]);
-      split.training.push_back(std::move(m));
-    }
-    split.validation = motions.back();
-    // Frame 0 is the initial state the scene prescribes, not a prediction.
-    split.validation.observed
-        = frame_range(motions.back().observed, 1, motions.back().observed.num_frames() - 1);
-    split.first_validation_frame = 1;
-    split.description = "motion " + motions.back().name;
-    return split;
+  std::string pieces;
+  for (size_t i = 0; i < motions.size(); ++i) {
+    const Motion& m = motions[i];
+    const int frames = m.scene.frames;
+    const int held_out = std::max(1, static_cast<int>(std::lround(validation_fraction * frames)));
+    const int train_frames = frames - held_out;
+    if (train_frames < 4)
+      throw InputError(m.name,
+          "too few frames (" + std::to_string(frames) + ") to hold out the last "
+              + std::to_string(held_out) + " for validation");
+    Motion train = m;
+    train.scene.frames = train_frames;
+    train.observed = frame_range(smoothed[i], 0, train_frames);
+    split.training.push_back(std::move(train));
+    split.fit_observed.push_back(frame_range(m.observed, 0, train_frames));
+    HeldOut piece { m, train_frames + 1 };
+    piece.motion.observed = frame_range(m.observed, train_frames + 1, frames);
+    split.validation.push_back(std::move(piece));
+    if (i > 0)
+      pieces += ", ";
+    pieces += std::to_string(held_out) + " of " + std::to_string(frames) + " frames of " + m.name;
   }
-  const Motion& only = motions.front();
-  const int frames = only.scene.frames;
-  const int held_out = std::max(1, static_cast<int>(std::lround(validation_fraction * frames)));
-  const int train_frames = frames - held_out;
-  if (train_frames < 4)
-    throw InputError(only.name,
-        "too few frames (" + std::to_string(frames) + ") to hold out the last "
-            + std::to_string(held_out) + " for validation");
-  Motion train = only;
-  train.scene.frames = train_frames;
-  train.observed = frame_range(smoothed.front(), 0, train_frames);
-  split.training.push_back(std::move(train));
-  split.fit_observed.push_back(frame_range(only.observed, 0, train_frames));
-  split.validation = only;
-  split.validation.observed = frame_range(only.observed, train_frames + 1, frames);
-  split.first_validation_frame = train_frames + 1;
-  char text[160];
-  std::snprintf(text, sizeof text, "the last %d of %d frames (%.0f %%) of %s", held_out, frames,
-      100.0 * held_out / frames, only.name.c_str());
-  split.description = text;
+  split.description = "the last " + to_text(100 * validation_fraction) + " %: " + pieces;
   return split;
 }
 
@@ -194,26 +193,47 @@ VecX flat_positions(const observe::Observation& o) {
   return out;
 }
 
-/// The candidate's error on the held-out data (completed false if its simulation diverged) and
-/// its material's stability where a larger motion goes. Returns its predictions of the held-out
-/// observations (at_observed_vertices; empty if it diverged).
-VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
-  sim::Scene scene = split.validation.scene;
-  scene.material = nominal;
-  scene.material.correction = c.correction;
-  const sim::ForwardRun run = sim::simulate_positions(scene);
-  c.completed = run.completed;
-  if (!run.completed)
-    return {};
-  const std::vector<VecX> compared(
-      run.positions.begin() + split.first_validation_frame, run.positions.end());
-  c.validation = observation_error(compared, split.validation.observed);
-  if (c.correction) {
-    const MatX stretches = collect_stretches(ReconstructionMesh(scene.mesh), run.positions);
-    c.extrapolation = material_stability(*nominal.elastic, c.correction.get(),
-        amplified_stretches(stretches, kExtrapolation, 40000));
+/// `parts` one below the other (VecX or MatX of equal column counts).
+template <typename Dense> Dense stacked_rows(const std::vector<Dense>& parts) {
+  Eigen::Index rows = 0;
+  for (const Dense& p : parts)
+    rows += p.rows();
+  Dense out(rows, parts.empty() ? 1 : parts.front().cols());
+  rows = 0;
+  for (const Dense& p : parts) {
+    out.middleRows(rows, p.rows()) = p;
+    rows += p.rows();
   }
-  return at_observed_vertices(compared, split.validation.observed);
+  return out;
+}
+
+/// The candidate's error on the held-out data (completed false if a simulation diverged) and its
+/// material's stability where a larger motion goes. Returns its predictions of the held-out
+/// observations (at_observed_vertices, the pieces in order; empty if a simulation diverged).
+VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
+  std::vector<ErrorSummary> errors;
+  std::vector<VecX> predictions;
+  std::vector<MatX> stretches;
+  for (const HeldOut& piece : split.validation) {
+    sim::Scene scene = piece.motion.scene;
+    scene.material = nominal;
+    scene.material.correction = c.correction;
+    const sim::ForwardRun run = sim::simulate_positions(scene);
+    c.completed = run.completed;
+    if (!run.completed)
+      return {};
+    const std::vector<VecX> compared(
+        run.positions.begin() + piece.first_frame, run.positions.end());
+    errors.push_back(observation_error(compared, piece.motion.observed));
+    predictions.push_back(at_observed_vertices(compared, piece.motion.observed));
+    if (c.correction)
+      stretches.push_back(collect_stretches(ReconstructionMesh(scene.mesh), run.positions));
+  }
+  c.validation = combined_error(errors);
+  if (c.correction)
+    c.extrapolation = material_stability(*nominal.elastic, c.correction.get(),
+        amplified_stretches(stacked_rows(stretches), kExtrapolation, 40000));
+  return stacked_rows(predictions);
 }
 
 void say(const RecipeCallbacks& callbacks, const std::string& line) {
@@ -305,12 +325,17 @@ Split prepare_data(std::span<const Motion> motions, const RecipeOptions& options
 
   // Stage 1: training and validation data.
   Split split = split_motions(motions, options.validation_fraction, std::move(smoothed));
-  if (split.validation.observed.num_valid() == 0)
-    throw InputError(split.validation.name,
+  result.training_frames = split.training.front().scene.frames;
+  result.validation_frames = 0;
+  long seen = 0;
+  for (const HeldOut& piece : split.validation) {
+    result.validation_frames += piece.motion.observed.num_frames();
+    seen += piece.motion.observed.num_valid();
+  }
+  if (seen == 0)
+    throw InputError(split.validation.front().motion.name,
         "/observed/valid: no observed vertex is seen in the held-out frames (" + split.description
             + "), so no candidate can be validated");
-  result.training_frames = split.training.front().scene.frames;
-  result.validation_frames = split.validation.observed.num_frames();
   result.validation_data = split.description;
   say(callbacks, "validation: " + split.description);
 
@@ -486,11 +511,14 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   if (result.loop.best && tried.find(result.loop.best_iteration) == tried.end())
     add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best, result.loop.best_error);
   const int reference = options.fit_parameters ? 1 : 0;
-  const VecX observed = flat_positions(split.validation.observed);
+  std::vector<VecX> held_out;
+  for (const HeldOut& piece : split.validation)
+    held_out.push_back(flat_positions(piece.motion.observed));
+  const VecX observed = stacked_rows(held_out);
   result.chosen
       = choose_candidate(result.candidates, predictions, observed, reference, result.noise.sigma);
   if (result.chosen < 0)
-    throw InputError(split.validation.name,
+    throw InputError(split.validation.front().motion.name,
         "no candidate, not even the nominal material, simulates the held-out data");
 
   // Stage 5: the chosen RBF distilled into the network, on the first training motion (its

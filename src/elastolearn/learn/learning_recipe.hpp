@@ -4,8 +4,8 @@
 /// predicts held-out data best. The stages, each a function below:
 ///   0. noise: σ of the observations, given or estimated (observe/noise_estimate.hpp); the
 ///      positions the loop follows are smoothed in time to that level, never differentiated raw;
-///   1. split: with two or more motions the last is held out for validation; with one, its last
-///      `validation_fraction` of the frames are;
+///   1. split: every motion's last `validation_fraction` of the frames are held out for
+///      validation, the rest is the training data;
 ///   2. parameter fit: E, ν, α₀, α₁ of the nominal model fitted to the training data;
 ///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit;
 ///   4. validation: every candidate (the given nominal, the fitted nominal, each completed
@@ -38,7 +38,7 @@ namespace elastolearn::learn {
 struct RecipeOptions {
   /// Observation noise σ [m] (standard deviation per coordinate); < 0: estimated from the data.
   double noise = -1;
-  /// With one motion: the fraction of its frames, at the end, held out for validation.
+  /// The fraction of every motion's frames, at its end, held out for validation.
   double validation_fraction = 0.2;
   /// Stage 2; its `parameters` say which of E, ν, α₀, α₁ move.
   bool fit_parameters = true;
@@ -106,9 +106,10 @@ struct RecipeResult {
   /// clouds (cloud_motion.hpp), else the motion's own.
   std::vector<observe::Observation> observed;
   NoiseLevel noise;
-  int training_frames = 0; ///< frames per training motion used (single motion: the split)
-  int validation_frames = 0; ///< frames compared in validation
-  std::string validation_data; ///< "last 20 % of frames of <name>" or "motion <name>"
+  int training_frames = 0; ///< frames of the first motion trained on (the split)
+  int validation_frames = 0; ///< frames compared in validation (summed over the motions)
+  std::string
+      validation_data; ///< what was held out: "the last 20 %: 20 of 100 frames of <name>, …"
   ParameterFitReport parameter_fit; ///< stage 2 (its `fitted` = the given nominal if skipped)
   material::ElasticModelType nominal_type {};
   fem::MaterialModel fitted_nominal; ///< the nominal material with the fitted parameters
@@ -120,8 +121,9 @@ struct RecipeResult {
   double seconds = 0;
   bool interrupted = false; ///< stopped at a checkpoint; nothing was chosen
   const Candidate& choice() const { return candidates.at(static_cast<size_t>(chosen)); }
-  /// The chosen material: the fitted nominal (or the given one) with the chosen correction.
-  fem::MaterialModel material(const fem::MaterialModel& given_nominal) const;
+  /// Candidate `candidate`'s material (−1: the chosen one): the fitted nominal (or, for
+  /// CandidateKind::Nominal, the given one) with its correction.
+  fem::MaterialModel material(const fem::MaterialModel& given_nominal, int candidate = -1) const;
 };
 
 struct RecipeCallbacks {
