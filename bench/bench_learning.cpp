@@ -21,7 +21,6 @@
 #include <elastolearn/learn/stretch_coverage.hpp>
 #include <elastolearn/observe/marker_dropout.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
-#include <elastolearn/sim/amplified_scene.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
@@ -89,9 +88,8 @@ double err_l(const sim::Scene& scene, const std::vector<VecX>& truth) {
 bool g_test_candidates = false;
 
 /// --test-candidates: each validated candidate's validation RMS and test err_L, one line each.
-void print_candidate_tests(const learn::RecipeResult& result, const sim::Scene& train,
-    const sim::Scene& test, const fem::MaterialModel& given_nominal, const std::vector<VecX>& truth,
-    double size) {
+void print_candidate_tests(const learn::RecipeResult& result, const sim::Scene& test,
+    const fem::MaterialModel& given_nominal, const std::vector<VecX>& truth, double size) {
   if (!g_test_candidates)
     return;
   for (size_t i = 0; i < result.candidates.size(); ++i) {
@@ -102,21 +100,16 @@ void print_candidate_tests(const learn::RecipeResult& result, const sim::Scene& 
     const double test_error = c.completed
         ? err_l(with_material(test, result.material(given_nominal, int(i))), truth)
         : -1;
-    const auto& x = c.extrapolation;
-    std::string larger = "-";
-    if (c.completed) {
-      const auto run = sim::simulate_positions(
-          sim::amplified_scene(with_material(train, result.material(given_nominal, int(i))), 1.5));
-      larger = run.completed ? "completes" : "diverges (" + run.message + ")";
-    }
-    std::printf("   candidate %-22s training motion ×1.5: %s\n", name.c_str(), larger.c_str());
-    std::printf("   candidate %-22s validation rms %.4f %%, z %+.1f, %s (σ^1.5: %ld of %ld "
-                "unstable, min relative eigenvalue %.3g at (%.3f, %.3f, %.3f)); test err_L %.3f "
-                "%%%s\n",
+    const auto& x = c.larger_motion;
+    std::printf("   candidate %-22s validation rms %.4f %%, z %+.1f, %s (motion ×%.1f: %s, %ld of "
+                "%ld stretches unstable, min relative eigenvalue %.3g at (%.3f, %.3f, %.3f)); "
+                "test err_L %.3f %%%s\n",
         name.c_str(), 100 * c.validation.rms / size, c.significance,
-        c.eligible() ? "eligible" : "not eligible", x.unstable_samples, x.samples,
-        x.min_relative_eigenvalue, x.worst_stretches[0], x.worst_stretches[1], x.worst_stretches[2],
-        test_error, int(i) == result.chosen ? "  <- chosen" : "");
+        c.eligible() ? "eligible" : "not eligible", learn::kLargerMotion,
+        !x.checked ? "not checked" : (x.completed ? "completed" : "diverged"),
+        x.stability.unstable_samples, x.stability.samples, x.stability.min_relative_eigenvalue,
+        x.stability.worst_stretches[0], x.stability.worst_stretches[1],
+        x.stability.worst_stretches[2], test_error, int(i) == result.chosen ? "  <- chosen" : "");
   }
   std::fflush(stdout);
 }
@@ -380,7 +373,7 @@ Row run_case(const LearningCase& c) {
       row.err_nominal, row.err_fit, row.err_learned, row.target, seconds_since(t0));
   std::fflush(stdout);
   print_candidate_tests(
-      learned, c.train, c.test, c.train.material, truth_test, c.train.mesh.bounding_box_diagonal());
+      learned, c.test, c.train.material, truth_test, c.train.mesh.bounding_box_diagonal());
   return row;
 }
 
@@ -595,8 +588,8 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
       percent(row.err_nominal).c_str(), percent(row.err_fit).c_str(),
       percent(row.err_learned).c_str(), seconds_since(t0));
   std::fflush(stdout);
-  print_candidate_tests(result, motions.train, motions.test, o.nominal, truth_test,
-      motions.test.mesh.bounding_box_diagonal());
+  print_candidate_tests(
+      result, motions.test, o.nominal, truth_test, motions.test.mesh.bounding_box_diagonal());
   return row;
 }
 

@@ -133,10 +133,13 @@ TEST(LearningRecipe, ACandidateReplacesTheFittedNominalOnlyBeyondNoise) {
     EXPECT_EQ(chosen, c[1].validation.rms < c[0].validation.rms ? 1 : 0);
   }
   {
-    // An ineligible B (unstable in a larger motion) is never chosen.
+    // An ineligible B (diverged, or unstable, in a larger motion) is never chosen.
     auto c = candidates({ &fitted, &a, &b });
-    c[2].extrapolation.unstable_samples = 1;
     const std::vector<VecX> p { fitted, a, b };
+    c[2].larger_motion.completed = false;
+    EXPECT_EQ(choose_candidate(c, p, observed, 0, sigma), 0);
+    c[2].larger_motion.completed = true;
+    c[2].larger_motion.stability.unstable_samples = 1;
     EXPECT_EQ(choose_candidate(c, p, observed, 0, sigma), 0);
   }
 }
@@ -170,9 +173,9 @@ TEST(LearningRecipe, ANetworkReplacesItsTeacherOnlyWhenItValidatesAsWell) {
   EXPECT_FALSE(network_replaces_teacher(network, teacher, true));
   EXPECT_TRUE(network_replaces_teacher(network, teacher, false)) << "no reference to beat";
   network.significance = 5;
-  network.extrapolation.unstable_samples = 1;
+  network.larger_motion.completed = false;
   EXPECT_FALSE(network_replaces_teacher(network, teacher, true));
-  network.extrapolation.unstable_samples = 0;
+  network.larger_motion.completed = true;
   network.completed = false;
   EXPECT_FALSE(network_replaces_teacher(network, teacher, true));
 }
@@ -197,9 +200,10 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
       EXPECT_LE(r.choice().validation.rms, slack * k.validation.rms);
     }
     if (!k.correction) {
-      EXPECT_EQ(k.extrapolation.samples, 0) << "the nominals are not checked";
+      EXPECT_FALSE(k.larger_motion.checked) << "the nominals are not checked";
     } else if (k.completed) {
-      EXPECT_GT(k.extrapolation.samples, 0);
+      EXPECT_TRUE(k.larger_motion.checked);
+      EXPECT_GT(k.larger_motion.stability.samples, 0);
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);

@@ -28,6 +28,15 @@ nlohmann::json network_to_json(const learn::NetworkDistillation& d, bool chosen)
     { "seconds_training", d.seconds_training } };
 }
 
+/// null for a candidate not checked (the nominals).
+nlohmann::json larger_motion_to_json(const learn::LargerMotionCheck& l) {
+  if (!l.checked)
+    return nullptr;
+  return { { "factor", learn::kLargerMotion }, { "completed", l.completed },
+    { "message", l.message }, { "unstable_samples", l.stability.unstable_samples },
+    { "samples", l.stability.samples } };
+}
+
 } // namespace
 
 nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
@@ -37,8 +46,7 @@ nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
         { "completed", c.completed }, { "training_rms_error_m", finite_or_null(c.training.rms) },
         { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
         { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr },
-        { "extrapolation_unstable_samples", c.extrapolation.unstable_samples },
-        { "extrapolation_samples", c.extrapolation.samples }, { "eligible", c.eligible() },
+        { "larger_motion", larger_motion_to_json(c.larger_motion) }, { "eligible", c.eligible() },
         // null: infinite (noise σ = 0), its sign that of the validation errors' difference
         { "significance", finite_or_null(c.significance) } });
     if (c.kind == learn::CandidateKind::Network) {
