@@ -186,38 +186,40 @@ void apply_overrides(learn::LearningOptions& o) {
 }
 
 /// One line per loop or forward-fit iteration (errors as % of `size`), indented by `indent`.
-void print_iteration(const learn::IterationRecord& r, double size, const char* indent) {
-  if (r.forward_completed)
-    std::printf("%siteration %d: forward rms %.4f %%, max %.4f %%", indent, r.iteration,
-        100 * r.forward_error.rms / size, 100 * r.forward_error.max / size);
+void print_iteration(const learn::IterationRecord& record, double size, const char* indent) {
+  const learn::ForwardOutcome& f = learn::forward_of(record);
+  if (f.completed())
+    std::printf("%siteration %d: forward rms %.4f %%, max %.4f %%", indent,
+        learn::iteration_of(record), 100 * f.error().rms / size, 100 * f.error().max / size);
   else
-    std::printf("%siteration %d:", indent, r.iteration);
-  if (r.forward_fit)
+    std::printf("%siteration %d:", indent, learn::iteration_of(record));
+  if (const auto* step = learn::forward_fit_of(record))
     std::printf(" (forward fit: %s, %d kernels, %.1f s)\n",
-        r.forward_unstable           ? "trial unstable, rejected unsimulated"
-            : !r.forward_completed   ? "trial DIVERGED, rejected"
-            : r.forward_fit_accepted ? "accepted"
-                                     : "rejected",
-        r.centres, r.seconds_forward);
-  else if (r.modes > 0)
+        f.status() == learn::ForwardStatus::unstable ? "trial unstable, rejected unsimulated"
+            : !f.completed()                         ? "trial DIVERGED, rejected"
+            : step->accepted                         ? "accepted"
+                                                     : "rejected",
+        step->centres, f.seconds());
+  else if (const auto* t = learn::stages_of(record))
     std::printf(
         "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N, step kept %.3g; "
         "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
-        r.modes, r.centres, r.control_force_rms, r.correction_misfit, r.correction_target,
-        r.step_kept, r.seconds_forward, r.seconds_constrained, r.seconds_space_time,
-        r.space_time_iterations, r.seconds_reconstruction);
-  else if (!r.forward_completed)
-    std::printf(" -> this correction's forward simulation DIVERGED (%.1f s: %s); %s\n",
-        r.seconds_forward, r.forward_message.c_str(),
-        r.damped_update ? "trying half its step" : "the loop stops");
+        t->modes, t->centres, t->control_force_rms, t->correction_misfit, t->correction_target,
+        t->step_kept, f.seconds(), t->seconds_constrained, t->seconds_space_time,
+        t->space_time_iterations, t->seconds_reconstruction);
+  else if (!f.completed())
+    std::printf(" -> this correction's forward simulation DIVERGED (%.1f s: %s); %s\n", f.seconds(),
+        f.message().c_str(),
+        std::get<learn::LoopRecord>(record).damped_update() ? "trying half its step"
+                                                            : "the loop stops");
   else
-    std::printf(" (final forward check, %.1f s)\n", r.seconds_forward);
+    std::printf(" (final forward check, %.1f s)\n", f.seconds());
   std::fflush(stdout);
 }
 
 /// A forward simulation that failed (a correction rejected as unstable was never simulated).
 bool diverged(const learn::IterationRecord& r) {
-  return !r.forward_completed && !r.forward_unstable;
+  return learn::forward_of(r).status() == learn::ForwardStatus::diverged;
 }
 
 /// The cameras of --scan: 640×480 pixels, 45° vertical field of view, looking at the rest mesh's
@@ -333,17 +335,20 @@ Row run_case(const LearningCase& c) {
   const learn::RecipeResult learned = learn::learn_material(motions, g_recipe, callbacks);
   row.learn_total = seconds_since(t0);
   for (const auto& r : learned.loop.history) {
-    row.forward += r.seconds_forward;
-    row.pod += r.seconds_pod;
-    row.constrained += r.seconds_constrained;
-    row.space_time += r.seconds_space_time;
-    row.reconstruction += r.seconds_reconstruction;
-    if (r.modes > 0)
-      ++row.iterations;
+    row.forward += learn::forward_of(r).seconds();
     if (diverged(r))
       ++row.divergences;
-    row.modes = std::max(row.modes, r.modes);
-    row.kernels = std::max(row.kernels, r.centres);
+    if (const auto* step = learn::forward_fit_of(r))
+      row.kernels = std::max(row.kernels, step->centres);
+    if (const auto* t = learn::stages_of(r)) {
+      row.pod += t->seconds_pod;
+      row.constrained += t->seconds_constrained;
+      row.space_time += t->seconds_space_time;
+      row.reconstruction += t->seconds_reconstruction;
+      ++row.iterations;
+      row.modes = std::max(row.modes, t->modes);
+      row.kernels = std::max(row.kernels, t->centres);
+    }
   }
   row.fit_seconds = learned.parameter_fit.seconds;
   if (g_scan_cameras > 0) {

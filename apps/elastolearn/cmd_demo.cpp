@@ -93,17 +93,19 @@ void run_demo(const fs::path& out, double fraction) {
   };
   callbacks.loop.progress = terminal_progress("learn");
   callbacks.loop.iteration = [&](const learn::IterationRecord& r) {
-    if (!r.forward_completed) {
-      std::printf("   iteration %d: %s\n", r.iteration, r.forward_message.c_str());
+    const learn::ForwardOutcome& forward = learn::forward_of(r);
+    if (!forward.completed()) {
+      std::printf("   iteration %d: %s\n", learn::iteration_of(r), forward.message().c_str());
       return;
     }
-    std::printf("   iteration %d: rms %.4f %%, max %.4f %%", r.iteration,
-        100 * r.forward_error.rms / size, 100 * r.forward_error.max / size);
-    if (r.forward_fit)
-      std::printf("  (forward-fit step %s, %.1f s)\n",
-          r.forward_fit_accepted ? "accepted" : "rejected", r.seconds_total());
-    else if (r.modes > 0)
-      std::printf(", control force %.3e N, %.1f s\n", r.control_force_rms, r.seconds_total());
+    std::printf("   iteration %d: rms %.4f %%, max %.4f %%", learn::iteration_of(r),
+        100 * forward.error().rms / size, 100 * forward.error().max / size);
+    if (const auto* step = learn::forward_fit_of(r))
+      std::printf("  (forward-fit step %s, %.1f s)\n", step->accepted ? "accepted" : "rejected",
+          learn::seconds_of(r));
+    else if (const auto* stages = learn::stages_of(r))
+      std::printf(
+          ", control force %.3e N, %.1f s\n", stages->control_force_rms, learn::seconds_of(r));
     else
       std::printf("  (last forward check)\n");
     std::fflush(stdout);

@@ -38,40 +38,61 @@ struct LearnOptions {
   elastolearn::learn::RecipeOptions recipe;
 };
 
-/// One line per loop iteration (the learning's progress table).
-void print_iteration(const elastolearn::learn::IterationRecord& r, double diagonal) {
-  if (r.forward_fit) {
-    if (r.forward_completed)
-      std::printf("%4d %12.4f %12.4f %14s %6s %6d %9.2f   (forward fit: %s)\n", r.iteration,
-          100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal, "-", "-",
-          r.centres, r.seconds_total(),
-          r.forward_fit_accepted ? "step accepted" : "step rejected, μ × 10");
-    else if (r.forward_unstable)
-      std::printf("%4d  forward fit: trial step rejected, μ × 10 (%s)\n", r.iteration,
-          r.forward_message.c_str());
-    else
-      std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10): %s\n",
-          r.iteration, r.forward_message.c_str());
-  } else if (!r.forward_completed) {
-    std::printf(r.damped_update
+/// One line per forward-fit step (the learning's progress table).
+void print_forward_fit_step(const elastolearn::learn::ForwardFitRecord& r, double diagonal) {
+  using elastolearn::learn::ForwardStatus;
+  const auto& f = r.forward;
+  switch (f.status()) {
+  case ForwardStatus::completed:
+    std::printf("%4d %12.4f %12.4f %14s %6s %6d %9.2f   (forward fit: %s)\n", r.iteration,
+        100 * f.error().rms / diagonal, 100 * f.error().max / diagonal, "-", "-", r.centres,
+        f.seconds(), r.accepted ? "step accepted" : "step rejected, μ × 10");
+    break;
+  case ForwardStatus::unstable:
+    std::printf(
+        "%4d  forward fit: trial step rejected, μ × 10 (%s)\n", r.iteration, f.message().c_str());
+    break;
+  case ForwardStatus::diverged:
+    std::printf("%4d  forward fit: the trial step's simulation diverged (rejected, μ × 10): %s\n",
+        r.iteration, f.message().c_str());
+    break;
+  }
+}
+
+/// One line per loop iteration (the learning's progress table), two when the reconstructed
+/// correction had to be shrunk to stay stable.
+void print_loop_iteration(const elastolearn::learn::LoopRecord& r, double diagonal) {
+  const auto& f = r.forward;
+  if (!f.completed()) {
+    std::printf(r.damped_update()
             ? "%4d  forward simulation diverged (%s): trying half of this correction's step\n"
             : "%4d  forward simulation diverged (%s): stopping (the best correction so far is "
               "kept)\n",
-        r.iteration, r.forward_message.c_str());
-  } else {
+        r.iteration, f.message().c_str());
+  } else if (const auto* t = r.stages()) {
     std::printf("%4d %12.4f %12.4f %14.4e %6d %6d %9.2f   (forward %.1f, constrained %.1f, "
                 "space-time %.1f [%d it], reconstruction %.1f)\n",
-        r.iteration, 100 * r.forward_error.rms / diagonal, 100 * r.forward_error.max / diagonal,
-        r.control_force_rms, r.modes, r.centres, r.seconds_total(), r.seconds_forward,
-        r.seconds_constrained, r.seconds_space_time, r.space_time_iterations,
-        r.seconds_reconstruction);
-    if (r.step_kept < 1)
+        r.iteration, 100 * f.error().rms / diagonal, 100 * f.error().max / diagonal,
+        t->control_force_rms, t->modes, t->centres, f.seconds() + t->seconds(), f.seconds(),
+        t->seconds_constrained, t->seconds_space_time, t->space_time_iterations,
+        t->seconds_reconstruction);
+    if (t->step_kept < 1)
       std::printf("      the reconstructed correction is unstable within the training stretches "
                   "(smallest tangent eigenvalue %.2f × the nominal's): %s\n",
-          r.stability,
-          r.step_kept > 0 ? ("kept " + elastolearn::to_text(r.step_kept) + " of it").c_str()
-                          : "dropped it (the next iteration simulates the nominal)");
+          t->stability,
+          t->step_kept > 0 ? ("kept " + elastolearn::to_text(t->step_kept) + " of it").c_str()
+                           : "dropped it (the next iteration simulates the nominal)");
+  } else {
+    std::printf("%4d %12.4f %12.4f %14s %6s %6s %9.2f   (last forward check)\n", r.iteration,
+        100 * f.error().rms / diagonal, 100 * f.error().max / diagonal, "-", "-", "-", f.seconds());
   }
+}
+
+void print_iteration(const elastolearn::learn::IterationRecord& r, double diagonal) {
+  if (const auto* step = elastolearn::learn::forward_fit_of(r))
+    print_forward_fit_step(*step, diagonal);
+  else
+    print_loop_iteration(std::get<elastolearn::learn::LoopRecord>(r), diagonal);
   std::fflush(stdout);
 }
 

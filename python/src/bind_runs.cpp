@@ -289,14 +289,17 @@ LearnSettings learn_settings(const py::kwargs& options) {
 /// One line per loop iteration for `verbose` (the CLI prints a fuller table).
 std::string iteration_line(const learn::IterationRecord& r, double size) {
   char line[256];
-  if (!r.forward_completed)
-    std::snprintf(line, sizeof line, "iteration %d: forward simulation diverged (%s)", r.iteration,
-        r.forward_message.c_str());
+  const learn::ForwardOutcome& forward = learn::forward_of(r);
+  if (!forward.completed())
+    std::snprintf(line, sizeof line, "iteration %d: forward simulation %s (%s)",
+        learn::iteration_of(r),
+        forward.status() == learn::ForwardStatus::unstable ? "skipped, unstable" : "diverged",
+        forward.message().c_str());
   else
     std::snprintf(line, sizeof line,
-        "iteration %d%s: error rms %.4f %%, max %.4f %% of the size; %.1f s", r.iteration,
-        r.forward_fit ? " (forward fit)" : "", 100 * r.forward_error.rms / size,
-        100 * r.forward_error.max / size, r.seconds_total());
+        "iteration %d%s: error rms %.4f %%, max %.4f %% of the size; %.1f s",
+        learn::iteration_of(r), learn::forward_fit_of(r) ? " (forward fit)" : "",
+        100 * forward.error().rms / size, 100 * forward.error().max / size, learn::seconds_of(r));
   return line;
 }
 

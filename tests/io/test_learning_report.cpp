@@ -22,30 +22,34 @@
 namespace elastolearn::io {
 namespace {
 
-/// Two iterations with distinct values in every column.
+/// Two loop iterations with distinct values in every column, a diverged one (a damped update)
+/// and a forward-fit step.
 std::vector<learn::IterationRecord> fake_history() {
-  learn::IterationRecord a;
-  a.iteration = 0;
-  a.forward_error.rms = 0.25;
-  a.forward_error.max = 0.5;
-  a.forward_error.mean = 0.125;
-  a.control_force_rms = 3;
-  a.space_time_initial = 10;
-  a.space_time_objective = 2.5;
-  a.space_time_iterations = 4;
-  a.modes = 8;
-  a.centres = 12;
-  a.correction_misfit = 0.75;
-  a.correction_target = 1.5;
-  a.seconds_forward = 1;
-  a.seconds_pod = 2;
-  a.seconds_constrained = 3;
-  a.seconds_space_time = 4;
-  a.seconds_reconstruction = 5;
-  learn::IterationRecord b = a;
-  b.iteration = 1;
-  b.forward_error.rms = 1.0 / 3.0; // written with the stream's default 6 digits
-  return { a, b };
+  learn::ErrorSummary e;
+  e.rms = 0.25;
+  e.max = 0.5;
+  e.mean = 0.125;
+  learn::SpaceTimeStages t;
+  t.control_force_rms = 3;
+  t.space_time_initial = 10;
+  t.space_time_objective = 2.5;
+  t.space_time_iterations = 4;
+  t.modes = 8;
+  t.centres = 12;
+  t.correction_misfit = 0.75;
+  t.correction_target = 1.5;
+  t.seconds_pod = 2;
+  t.seconds_constrained = 3;
+  t.seconds_space_time = 4;
+  t.seconds_reconstruction = 5;
+  const learn::LoopRecord a { 0, learn::ForwardOutcome::completed(e, 1), t };
+  e.rms = 1.0 / 3.0; // written with the stream's default 6 digits
+  const learn::LoopRecord b { 1, learn::ForwardOutcome::completed(e, 1), t };
+  const learn::LoopRecord c { 2, learn::ForwardOutcome::diverged("diverged at frame 9", 7),
+    learn::DampedUpdate {} };
+  const learn::ForwardFitRecord d { 3,
+    learn::ForwardOutcome::completed({ 0.25, 0.0625, 0.125, 1, 2, 30 }, 6), true, 12 };
+  return { a, b, c, d };
 }
 
 std::vector<std::string> lines(const std::string& text) {
@@ -94,7 +98,7 @@ TEST(LearningReport, WritesEveryFile) {
   const ReportOutcome outcome = write_learning_report(dir.path(), report);
 
   const std::vector<std::string> csv = lines(read_text_file(dir / "convergence.csv"));
-  ASSERT_EQ(csv.size(), 3u);
+  ASSERT_EQ(csv.size(), 5u);
   EXPECT_EQ(csv[0],
       "iteration,forward_rms_m,forward_max_m,forward_mean_m,control_force_rms_N,"
       "space_time_initial,space_time_objective,space_time_iterations,modes,centres,"
@@ -102,6 +106,10 @@ TEST(LearningReport, WritesEveryFile) {
       "seconds_space_time,seconds_reconstruction");
   EXPECT_EQ(csv[1], "0,0.25,0.5,0.125,3,10,2.5,4,8,12,0.75,1.5,1,2,3,4,5");
   EXPECT_EQ(csv[2], "1,0.333333,0.5,0.125,3,10,2.5,4,8,12,0.75,1.5,1,2,3,4,5");
+  // What a step did not measure is empty: the diverged step's errors and every step's columns
+  // of the trajectory stages it did not run (a forward-fit step has its kernels).
+  EXPECT_EQ(csv[3], "2,,,,,,,,,,,,7,0,0,0,0");
+  EXPECT_EQ(csv[4], "3,0.125,0.25,0.0625,,,,,,12,,,6,0,0,0,0");
   EXPECT_EQ(read_json_file(dir / "report.json"), *report.provenance);
   EXPECT_EQ(read_json_file(dir / "summary.json"), report.summary);
   const nlohmann::json data = read_json_file(dir / "report_data.json");
@@ -121,6 +129,10 @@ TEST(LearningReport, WritesEveryFile) {
   const std::string html = read_text_file(dir / "report.html");
   EXPECT_NE(html.find("<h1>a &lt;made-up&gt; report</h1>"), std::string::npos);
   EXPECT_NE(html.find("a note"), std::string::npos);
+  // The convergence table names each kind of step.
+  for (const char* kind :
+      { "<td class=\"l\">loop</td>", "diverged (half its step next)", "forward fit, accepted" })
+    EXPECT_NE(html.find(kind), std::string::npos) << kind;
   EXPECT_EQ(html.find("@BODY@"), std::string::npos);
   EXPECT_EQ(html.find("@THREE@"), std::string::npos);
   EXPECT_NE(html.find("Copyright 2010-2024 Three.js Authors"), std::string::npos)

@@ -15,24 +15,25 @@ namespace elastolearn::io {
 namespace {
 
 TEST(ReportData, ConvergenceHasNullWhereNothingWasMeasured) {
-  learn::IterationRecord loop;
-  loop.iteration = 0;
-  loop.forward_error.rms = 0.1;
-  loop.forward_error.max = 0.2;
-  loop.control_force_rms = 3;
-  loop.modes = 8;
-  learn::IterationRecord diverged = loop;
-  diverged.iteration = 1;
-  diverged.forward_completed = false;
-  learn::IterationRecord fit = loop;
-  fit.iteration = 2;
-  fit.forward_fit = true;
-  const nlohmann::json c = convergence_json({ loop, diverged, fit });
-  EXPECT_EQ(c.at("iteration"), nlohmann::json({ 0, 1, 2 }));
-  EXPECT_EQ(c.at("forward_rms_m"), nlohmann::json({ 0.1, nullptr, 0.1 }));
-  EXPECT_EQ(c.at("control_force_rms_N"), nlohmann::json({ 3.0, nullptr, nullptr }))
-      << "a forward-fit step has no control forces";
-  EXPECT_EQ(c.at("forward_fit"), nlohmann::json({ false, false, true }));
+  learn::ErrorSummary error;
+  error.rms = 0.1;
+  error.max = 0.2;
+  learn::SpaceTimeStages stages;
+  stages.control_force_rms = 3;
+  stages.modes = 8;
+  const learn::LoopRecord loop { 0, learn::ForwardOutcome::completed(error, 1), stages };
+  const learn::LoopRecord diverged { 1, learn::ForwardOutcome::diverged("frame 3", 1),
+    learn::DampedUpdate {} };
+  const learn::ForwardFitRecord fit { 2, learn::ForwardOutcome::completed(error, 1), true, 8 };
+  const learn::LoopRecord check { 3, learn::ForwardOutcome::completed(error, 1),
+    learn::LoopEnd {} };
+  const nlohmann::json c = convergence_json({ loop, diverged, fit, check });
+  EXPECT_EQ(c.at("iteration"), nlohmann::json({ 0, 1, 2, 3 }));
+  EXPECT_EQ(c.at("completed"), nlohmann::json({ true, false, true, true }));
+  EXPECT_EQ(c.at("forward_rms_m"), nlohmann::json({ 0.1, nullptr, 0.1, 0.1 }));
+  EXPECT_EQ(c.at("control_force_rms_N"), nlohmann::json({ 3.0, nullptr, nullptr, nullptr }))
+      << "only the trajectory stages measure control forces";
+  EXPECT_EQ(c.at("forward_fit"), nlohmann::json({ false, false, true, false }));
 }
 
 TEST(ReportData, CandidatesCarryLabelsAndTheChoice) {

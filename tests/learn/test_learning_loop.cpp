@@ -10,6 +10,7 @@
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <support/bar_scene.hpp>
+#include <support/learning_history.hpp>
 
 #include <gtest/gtest.h>
 
@@ -77,7 +78,7 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   ASSERT_FALSE(state.history.empty());
   // The training fit improves by well over an order of magnitude (a stage that stops working
   // leaves it near the nominal's).
-  EXPECT_LT(state.best_error, 0.05 * state.history.front().forward_error.rms);
+  EXPECT_LT(state.best_error, 0.05 * test::forward_rms(state.history.front()));
 
   const double nominal_error = swing_error(bar_scene(truth, true), bar_scene(nominal, true));
   const double learned_error = swing_error(
@@ -170,7 +171,8 @@ TEST(LearningLoop, FullSpaceVariantLearnsOnASmallMesh) {
   options.centres = 10;
   LearningState state;
   ASSERT_TRUE(run_learning(small(nominal, false), observed, options, state));
-  EXPECT_EQ(state.history.front().modes, 72);
+  ASSERT_TRUE(stages_of(state.history.front()));
+  EXPECT_EQ(stages_of(state.history.front())->modes, 72);
   ASSERT_TRUE(state.best);
   const double nominal_error = swing_error(small(truth, true), small(nominal, true));
   const double learned_error
@@ -207,8 +209,18 @@ TEST(LearningLoop, DivergingCorrectionsAreHalvedBeforePatienceCountsThem) {
     ASSERT_TRUE(run_learning(scene, observed, options, state));
     ASSERT_EQ(state.history.size(), static_cast<size_t>(free_halvings + 1))
         << "free_halvings " << free_halvings;
-    for (const IterationRecord& r : state.history)
-      EXPECT_FALSE(r.forward_completed);
+    // Every correction diverged: halved (a damped update) while halvings are free, then the
+    // loop ended.
+    for (size_t i = 0; i < state.history.size(); ++i) {
+      const auto* r = std::get_if<LoopRecord>(&state.history[i]);
+      ASSERT_TRUE(r);
+      EXPECT_EQ(r->forward.status(), ForwardStatus::diverged);
+      EXPECT_NE(r->forward.message().find("frame"), std::string::npos) << r->forward.message();
+      if (i + 1 < state.history.size())
+        EXPECT_TRUE(r->damped_update()) << "step " << i;
+      else
+        EXPECT_TRUE(std::holds_alternative<LoopEnd>(r->next)) << "step " << i;
+    }
     EXPECT_EQ(state.divergences_in_a_row, free_halvings + 1);
     EXPECT_EQ(state.iterations_without_improvement, 1);
     EXPECT_TRUE(state.finished);
@@ -228,17 +240,22 @@ TEST(LearningLoop, TruthEqualToNominalLearnsAlmostNothing) {
   LearningState state;
   ASSERT_TRUE(run_learning(scene, observed, options, state));
   ASSERT_EQ(state.history.size(), 2u);
-  const IterationRecord& first = state.history.front();
+  const SpaceTimeStages* first = stages_of(state.history.front());
+  ASSERT_TRUE(first);
   // The constrained simulation reproduces the data and the physics holds: the control forces
   // are at the solver's residual level, ~1e-6 of the weight of a vertex (mg ≈ 0.05 N here).
-  EXPECT_LT(first.control_force_rms, 1e-5);
-  EXPECT_LT(first.correction_target, 1e-5);
+  EXPECT_LT(first->control_force_rms, 1e-5);
+  EXPECT_LT(first->correction_target, 1e-5);
   ASSERT_TRUE(state.correction);
   // The fitted correction is negligible against the nominal stress at 5 % strain (~5e4 Pa).
   for (const Vec3& s : { Vec3(1.05, 1.0, 0.98), Vec3(0.97, 1.0, 1.0), Vec3(1, 1, 1) })
     EXPECT_LT(state.correction->correction(s, Vec3::Zero()).norm(), 50.0) << s.transpose();
   // Its forward simulation is as good as the nominal's (which is exact).
-  EXPECT_LT(state.history.back().forward_error.max, 1e-5);
+  // The last step is the loop's last forward check (no trajectory stages).
+  const auto* last = std::get_if<LoopRecord>(&state.history.back());
+  ASSERT_TRUE(last);
+  EXPECT_TRUE(std::holds_alternative<LoopEnd>(last->next));
+  EXPECT_LT(last->forward.error().max, 1e-5);
 }
 
 /// RMS error of `scene` with `correction` (null = nominal) against `observed`.
@@ -268,14 +285,14 @@ TEST(LearningLoop, LearnsOneCorrectionFromTwoMotionsOnDifferentMeshes) {
   LearningState state;
   ASSERT_TRUE(run_learning(motions, small_options(), state));
   ASSERT_TRUE(state.best);
-  const IterationRecord& first = state.history.front();
+  const ErrorSummary& first = forward_of(state.history.front()).error();
   // Iteration 0's error is over both motions' observations.
   const ErrorSummary droop_nominal
       = observation_error(sim::simulate_positions(motions[0].scene).positions, motions[0].observed);
   const ErrorSummary swing_nominal
       = observation_error(sim::simulate_positions(motions[1].scene).positions, motions[1].observed);
-  EXPECT_EQ(first.forward_error.samples, droop_nominal.samples + swing_nominal.samples);
-  EXPECT_EQ(first.forward_error.max, std::max(droop_nominal.max, swing_nominal.max));
+  EXPECT_EQ(first.samples, droop_nominal.samples + swing_nominal.samples);
+  EXPECT_EQ(first.max, std::max(droop_nominal.max, swing_nominal.max));
   for (size_t i = 0; i < motions.size(); ++i) {
     const double before = rms_error(motions[i].scene, motions[i].observed, nullptr);
     const double after = rms_error(motions[i].scene, motions[i].observed, state.best);
@@ -299,11 +316,7 @@ TEST(LearningLoop, OneMotionThroughTheSpanIsTheSingleSceneRun) {
   const Motion motion { "bar", scene, observed };
   ASSERT_TRUE(run_learning(std::span(&motion, 1), options, spanned));
   ASSERT_TRUE(single.best && spanned.best);
-  ASSERT_EQ(single.history.size(), spanned.history.size());
-  for (size_t i = 0; i < single.history.size(); ++i) {
-    EXPECT_EQ(single.history[i].forward_error.rms, spanned.history[i].forward_error.rms);
-    EXPECT_EQ(single.history[i].control_force_rms, spanned.history[i].control_force_rms);
-  }
+  test::expect_same_steps(single.history, spanned.history);
   EXPECT_EQ(single.best->parameters().weights, spanned.best->parameters().weights);
   EXPECT_EQ(single.best->parameters().centres, spanned.best->parameters().centres);
   EXPECT_EQ(single.best_error, spanned.best_error);
@@ -327,13 +340,15 @@ TEST(LearningLoop, TwoCopiesOfAMotionMeasureAsOneAndStillLearn) {
   LearningState one, two;
   ASSERT_TRUE(run_learning(std::span(&motion, 1), options, one));
   ASSERT_TRUE(run_learning(twice, options, two));
-  const ErrorSummary &a = one.history.front().forward_error, &b = two.history.front().forward_error;
+  const ErrorSummary &a = forward_of(one.history.front()).error(),
+                     &b = forward_of(two.history.front()).error();
   EXPECT_EQ(b.samples, 2 * a.samples);
   EXPECT_EQ(b.max, a.max);
   EXPECT_DOUBLE_EQ(b.rms, a.rms);
   EXPECT_DOUBLE_EQ(b.mean, a.mean);
-  EXPECT_EQ(two.history.front().modes, 2 * one.history.front().modes);
-  EXPECT_DOUBLE_EQ(two.history.front().control_force_rms, one.history.front().control_force_rms);
+  ASSERT_TRUE(stages_of(one.history.front()) && stages_of(two.history.front()));
+  EXPECT_EQ(stages_of(two.history.front())->modes, 2 * stages_of(one.history.front())->modes);
+  EXPECT_DOUBLE_EQ(test::control_rms(two.history.front()), test::control_rms(one.history.front()));
   ASSERT_TRUE(two.best);
   std::printf("[ measured ] best RMS error: one copy %.3g m, two copies %.3g m, nominal %.3g m\n",
       one.best_error, two.best_error, a.rms);

@@ -281,8 +281,8 @@ TEST(LearningRecipe, NoisyCaptureLearnsWithoutDivergenceAndBeatsTheNominal) {
   const RecipeResult r = learn_material(motions, small_recipe());
   EXPECT_NEAR(r.noise.sigma, sigma, 0.15 * sigma) << "the estimate";
   for (const IterationRecord& it : r.loop.history)
-    EXPECT_TRUE(it.forward_completed || it.forward_unstable)
-        << "iteration " << it.iteration << " diverged: " << it.forward_message;
+    EXPECT_NE(forward_of(it).status(), ForwardStatus::diverged)
+        << "iteration " << iteration_of(it) << " diverged: " << forward_of(it).message();
   for (const Candidate& k : r.candidates)
     EXPECT_TRUE(k.completed) << to_string(k.kind) << " " << k.iteration;
   const double nominal = test_error(c.nominal.material, c.truth_swing);

@@ -87,7 +87,7 @@ MaterialFile learned_material_file(const TrainingSet& set, const std::string& so
   double loop_seconds = 0;
   nlohmann::json history = nlohmann::json::array();
   for (const auto& r : result.loop.history) {
-    loop_seconds += r.seconds_total();
+    loop_seconds += learn::seconds_of(r);
     history.push_back(iteration_record_to_json(r));
   }
   MaterialFile learned;

@@ -9,6 +9,9 @@ namespace elastolearn::io {
 namespace {
 
 constexpr const char* k_format = "elastolearn-learning-checkpoint";
+/// The version written. Version 3 writes one record per kind of step (iteration_record_to_json);
+/// versions 1 and 2 wrote flat records with flags, still read (read_flat_record).
+constexpr int k_version = 3;
 
 nlohmann::json correction_json(const std::shared_ptr<const material::RbfCorrection>& c) {
   return c ? correction_to_json(*c) : nlohmann::json(nullptr);
@@ -41,52 +44,147 @@ learn::ErrorSummary read_error(const JsonObject& o) {
   return e;
 }
 
-learn::IterationRecord read_record(const JsonObject& o) {
-  learn::IterationRecord r;
-  r.iteration = o.integer("iteration");
-  r.forward_error = read_error(o.object("forward_error"));
-  r.forward_completed = o.boolean("forward_completed", true);
-  r.forward_message = o.string("forward_message", "");
-  r.forward_unstable = o.boolean("forward_unstable", false);
-  r.damped_update = o.boolean("damped_update", false);
-  r.forward_fit = o.boolean("forward_fit", false);
-  r.forward_fit_accepted = o.boolean("forward_fit_accepted", false);
-  r.control_force_rms = o.number("control_force_rms");
-  r.space_time_initial = o.number("space_time_initial");
-  r.space_time_objective = o.number("space_time_objective");
-  r.space_time_iterations = o.integer("space_time_iterations");
-  r.modes = o.integer("modes");
-  r.centres = o.integer("centres");
-  r.correction_misfit = o.number("correction_misfit");
-  r.stability = o.number("stability", 0.0);
-  r.step_kept = o.number("step_kept", 1.0);
-  r.correction_target = o.number("correction_target");
+/// A record of a version-1 or -2 checkpoint: one flat object with flags for the kind of step
+/// ("forward_fit", "forward_completed", "forward_unstable", "damped_update") and every field,
+/// zero where it was not measured. A loop iteration ran the trajectory stages when it has modes
+/// or kernels (both are 0 in a record without them).
+learn::IterationRecord read_flat_record(const JsonObject& o) {
+  const int iteration = o.integer("iteration");
   const JsonObject s = o.object("seconds");
-  r.seconds_forward = s.number("forward");
-  r.seconds_pod = s.number("pod");
-  r.seconds_constrained = s.number("constrained");
-  r.seconds_space_time = s.number("space_time");
-  r.seconds_reconstruction = s.number("reconstruction");
-  return r;
+  const double seconds_forward = s.number("forward");
+  const learn::ForwardOutcome forward = o.boolean("forward_completed", true)
+      ? learn::ForwardOutcome::completed(read_error(o.object("forward_error")), seconds_forward)
+      : o.boolean("forward_unstable", false)
+      ? learn::ForwardOutcome::unstable(o.string("forward_message", ""), seconds_forward)
+      : learn::ForwardOutcome::diverged(o.string("forward_message", ""), seconds_forward);
+  if (o.boolean("forward_fit", false))
+    return learn::ForwardFitRecord { iteration, forward, o.boolean("forward_fit_accepted", false),
+      o.integer("centres") };
+  learn::LoopNext next = learn::LoopEnd {};
+  if (!forward.completed()) {
+    if (o.boolean("damped_update", false))
+      next = learn::DampedUpdate {};
+  } else if (o.integer("modes") > 0 || o.integer("centres") > 0) {
+    learn::SpaceTimeStages t;
+    t.modes = o.integer("modes");
+    t.control_force_rms = o.number("control_force_rms");
+    t.space_time_initial = o.number("space_time_initial");
+    t.space_time_objective = o.number("space_time_objective");
+    t.space_time_iterations = o.integer("space_time_iterations");
+    t.centres = o.integer("centres");
+    t.correction_misfit = o.number("correction_misfit");
+    t.correction_target = o.number("correction_target");
+    t.stability = o.number("stability", 0.0);
+    t.step_kept = o.number("step_kept", 1.0);
+    t.seconds_pod = s.number("pod");
+    t.seconds_constrained = s.number("constrained");
+    t.seconds_space_time = s.number("space_time");
+    t.seconds_reconstruction = s.number("reconstruction");
+    next = t;
+  }
+  return learn::LoopRecord { iteration, forward, next };
+}
+
+nlohmann::json forward_json(const learn::ForwardOutcome& f) {
+  nlohmann::json j = { { "status", learn::to_string(f.status()) } };
+  if (f.completed())
+    j["error"] = error_json(f.error());
+  else
+    j["message"] = f.message();
+  return j;
+}
+
+learn::ForwardOutcome read_forward(const JsonObject& o, double seconds) {
+  const std::string status = o.choice("status", { "completed", "diverged", "unstable" });
+  switch (*learn::forward_status_from_string(status)) {
+  case learn::ForwardStatus::completed:
+    return learn::ForwardOutcome::completed(read_error(o.object("error")), seconds);
+  case learn::ForwardStatus::diverged:
+    return learn::ForwardOutcome::diverged(o.string("message"), seconds);
+  case learn::ForwardStatus::unstable:
+    break;
+  }
+  return learn::ForwardOutcome::unstable(o.string("message"), seconds);
+}
+
+nlohmann::json stages_json(const learn::SpaceTimeStages& t) {
+  return { { "modes", t.modes }, { "control_force_rms", t.control_force_rms },
+    { "space_time_initial", t.space_time_initial },
+    { "space_time_objective", t.space_time_objective },
+    { "space_time_iterations", t.space_time_iterations }, { "centres", t.centres },
+    { "correction_misfit", t.correction_misfit }, { "correction_target", t.correction_target },
+    { "stability", t.stability }, { "step_kept", t.step_kept } };
+}
+
+learn::SpaceTimeStages read_stages(const JsonObject& o, const JsonObject& seconds) {
+  learn::SpaceTimeStages t;
+  t.modes = o.integer("modes");
+  t.control_force_rms = o.number("control_force_rms");
+  t.space_time_initial = o.number("space_time_initial");
+  t.space_time_objective = o.number("space_time_objective");
+  t.space_time_iterations = o.integer("space_time_iterations");
+  t.centres = o.integer("centres");
+  t.correction_misfit = o.number("correction_misfit");
+  t.correction_target = o.number("correction_target");
+  t.stability = o.number("stability");
+  t.step_kept = o.number("step_kept");
+  t.seconds_pod = seconds.number("pod");
+  t.seconds_constrained = seconds.number("constrained");
+  t.seconds_space_time = seconds.number("space_time");
+  t.seconds_reconstruction = seconds.number("reconstruction");
+  return t;
+}
+
+/// The names of LoopNext's alternatives (a loop record's "next").
+constexpr const char* k_space_time = "space_time";
+constexpr const char* k_damped_update = "damped_update";
+constexpr const char* k_end = "end";
+
+/// A record of a version-3 checkpoint (iteration_record_to_json).
+learn::IterationRecord read_record(const JsonObject& o) {
+  const int iteration = o.integer("iteration");
+  const JsonObject seconds = o.object("seconds");
+  const learn::ForwardOutcome forward
+      = read_forward(o.object("forward"), seconds.number("forward"));
+  if (o.choice("kind", { "loop", "forward_fit" }) == "forward_fit")
+    return learn::ForwardFitRecord { iteration, forward, o.boolean("accepted", false),
+      o.integer("centres") };
+  const std::string next = o.choice("next", { k_space_time, k_damped_update, k_end });
+  if (next == k_space_time)
+    return learn::LoopRecord { iteration, forward, read_stages(o.object("stages"), seconds) };
+  if (next == k_damped_update)
+    return learn::LoopRecord { iteration, forward, learn::DampedUpdate {} };
+  return learn::LoopRecord { iteration, forward, learn::LoopEnd {} };
 }
 
 } // namespace
 
-nlohmann::json iteration_record_to_json(const learn::IterationRecord& r) {
-  return { { "iteration", r.iteration }, { "forward_error", error_json(r.forward_error) },
-    { "forward_completed", r.forward_completed }, { "forward_message", r.forward_message },
-    { "forward_unstable", r.forward_unstable }, { "damped_update", r.damped_update },
-    { "forward_fit", r.forward_fit }, { "forward_fit_accepted", r.forward_fit_accepted },
-    { "control_force_rms", r.control_force_rms }, { "space_time_initial", r.space_time_initial },
-    { "space_time_objective", r.space_time_objective },
-    { "space_time_iterations", r.space_time_iterations }, { "modes", r.modes },
-    { "centres", r.centres }, { "correction_misfit", r.correction_misfit },
-    { "stability", r.stability }, { "step_kept", r.step_kept },
-    { "correction_target", r.correction_target },
-    { "seconds",
-        { { "forward", r.seconds_forward }, { "pod", r.seconds_pod },
-            { "constrained", r.seconds_constrained }, { "space_time", r.seconds_space_time },
-            { "reconstruction", r.seconds_reconstruction }, { "total", r.seconds_total() } } } };
+nlohmann::json iteration_record_to_json(const learn::IterationRecord& record) {
+  const learn::ForwardOutcome& forward = learn::forward_of(record);
+  nlohmann::json j
+      = { { "iteration", learn::iteration_of(record) }, { "forward", forward_json(forward) } };
+  nlohmann::json seconds = { { "forward", forward.seconds() } };
+  if (const learn::ForwardFitRecord* step = learn::forward_fit_of(record)) {
+    j["kind"] = "forward_fit";
+    j["accepted"] = step->accepted;
+    j["centres"] = step->centres;
+  } else {
+    const auto& loop = std::get<learn::LoopRecord>(record);
+    j["kind"] = "loop";
+    if (const learn::SpaceTimeStages* t = loop.stages()) {
+      j["next"] = k_space_time;
+      j["stages"] = stages_json(*t);
+      seconds["pod"] = t->seconds_pod;
+      seconds["constrained"] = t->seconds_constrained;
+      seconds["space_time"] = t->seconds_space_time;
+      seconds["reconstruction"] = t->seconds_reconstruction;
+    } else {
+      j["next"] = loop.damped_update() ? k_damped_update : k_end;
+    }
+  }
+  seconds["total"] = learn::seconds_of(record);
+  j["seconds"] = seconds;
+  return j;
 }
 
 nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
@@ -196,7 +294,7 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
   nlohmann::json history = nlohmann::json::array();
   for (const auto& r : state.history)
     history.push_back(iteration_record_to_json(r));
-  const nlohmann::json j = { { "format", std::string(k_format) + "/2" },
+  const nlohmann::json j = { { "format", std::string(k_format) + "/" + std::to_string(k_version) },
     { "inputs",
         { { "scene", inputs.scene }, { "observations", inputs.observations },
             { "options", inputs.options } } },
@@ -234,7 +332,7 @@ learn::RecipeResume read_learning_checkpoint(
     const std::filesystem::path& path, const LearningInputs& inputs) {
   const nlohmann::json j = read_json_file(path);
   const JsonObject root(j, path.string());
-  check_format(root, k_format, 2);
+  const int version = check_format(root, k_format, k_version);
   const JsonObject in = root.object("inputs");
   if (in.string("scene") != inputs.scene)
     in.fail("scene",
@@ -261,7 +359,7 @@ learn::RecipeResume read_learning_checkpoint(
   state.forward_fit_steps = s.integer("forward_fit_steps");
   state.forward_fit_damping = s.number("forward_fit_damping");
   for (const auto& r : s.objects("history"))
-    state.history.push_back(read_record(r));
+    state.history.push_back(version >= 3 ? read_record(r) : read_flat_record(r));
   return resume;
 }
 

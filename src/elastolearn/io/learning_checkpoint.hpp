@@ -1,5 +1,6 @@
 #pragma once
-/// \file Checkpoints of learning (JSON, "format": "elastolearn-learning-checkpoint/2"): the
+/// \file Checkpoints of learning (JSON, "format": "elastolearn-learning-checkpoint/3"; versions
+/// 1 and 2, with flat iteration records, are still read): the
 /// recipe's parameter fit and the complete learn::LearningState after an iteration — corrections
 /// written with every digit (correction_to_json), so a resumed run continues bit-for-bit — plus the
 /// inputs it belongs to, so that `learn --resume` refuses a checkpoint of another scene or
@@ -40,8 +41,11 @@ std::filesystem::path learning_checkpoint_path(
 learn::RecipeResume resume_learning_checkpoint(
     const std::filesystem::path& path, const LearningInputs& inputs, const std::string& option);
 
-/// One iteration's record as JSON (also used in reports and in the learned material's
-/// "training" provenance).
+/// One step's record as JSON (also used in reports and in the learned material's "training"
+/// provenance): {"iteration", "kind": "loop" | "forward_fit", "forward": {"status", "error" when
+/// completed, "message" otherwise}, then for a loop iteration "next": "space_time" |
+/// "damped_update" | "end" (and "stages" with space_time), for a forward-fit step "accepted" and
+/// "centres"; "seconds": {"forward", the stages' times, "total"}} (docs/file_formats.md).
 nlohmann::json iteration_record_to_json(const learn::IterationRecord& record);
 
 /// The options that determine the result, as JSON.

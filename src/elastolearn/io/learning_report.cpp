@@ -19,13 +19,29 @@ std::string convergence_csv(const std::vector<learn::IterationRecord>& history) 
          "target_N,"
          "seconds_forward,seconds_pod,seconds_constrained,seconds_space_time,seconds_"
          "reconstruction\n";
-  for (const auto& r : history)
-    csv << r.iteration << ',' << r.forward_error.rms << ',' << r.forward_error.max << ','
-        << r.forward_error.mean << ',' << r.control_force_rms << ',' << r.space_time_initial << ','
-        << r.space_time_objective << ',' << r.space_time_iterations << ',' << r.modes << ','
-        << r.centres << ',' << r.correction_misfit << ',' << r.correction_target << ','
-        << r.seconds_forward << ',' << r.seconds_pod << ',' << r.seconds_constrained << ','
-        << r.seconds_space_time << ',' << r.seconds_reconstruction << '\n';
+  // A value the step did not measure is an empty cell: the forward error of a simulation that
+  // did not complete, the trajectory stages' columns of a step that did not run them.
+  for (const auto& r : history) {
+    const learn::ForwardOutcome& forward = learn::forward_of(r);
+    csv << learn::iteration_of(r) << ',';
+    if (forward.completed())
+      csv << forward.error().rms << ',' << forward.error().max << ',' << forward.error().mean
+          << ',';
+    else
+      csv << ",,,";
+    if (const learn::SpaceTimeStages* t = learn::stages_of(r))
+      csv << t->control_force_rms << ',' << t->space_time_initial << ',' << t->space_time_objective
+          << ',' << t->space_time_iterations << ',' << t->modes << ',' << t->centres << ','
+          << t->correction_misfit << ',' << t->correction_target << ',';
+    else if (const learn::ForwardFitRecord* step = learn::forward_fit_of(r))
+      csv << ",,,,," << step->centres << ",,,";
+    else
+      csv << ",,,,,,,,";
+    const learn::SpaceTimeStages none;
+    const learn::SpaceTimeStages& t = learn::stages_of(r) ? *learn::stages_of(r) : none;
+    csv << forward.seconds() << ',' << t.seconds_pod << ',' << t.seconds_constrained << ','
+        << t.seconds_space_time << ',' << t.seconds_reconstruction << '\n';
+  }
   return csv.str();
 }
 

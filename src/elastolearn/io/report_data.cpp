@@ -38,15 +38,16 @@ nlohmann::json convergence_json(const std::vector<learn::IterationRecord>& histo
                  completed = nlohmann::json::array(), rms = nlohmann::json::array(),
                  max = nlohmann::json::array(), control = nlohmann::json::array();
   for (const auto& r : history) {
-    iteration.push_back(r.iteration);
-    forward_fit.push_back(r.forward_fit);
-    completed.push_back(r.forward_completed);
-    rms.push_back(measured(r.forward_completed, r.forward_error.rms));
-    max.push_back(measured(r.forward_completed, r.forward_error.max));
-    // The control forces come from the trajectory stages, which a forward-fit step and the last
-    // forward check (no modes) do not run.
-    control.push_back(
-        measured(r.forward_completed && !r.forward_fit && r.modes > 0, r.control_force_rms));
+    const learn::ForwardOutcome& forward = learn::forward_of(r);
+    const learn::SpaceTimeStages* stages = learn::stages_of(r);
+    iteration.push_back(learn::iteration_of(r));
+    forward_fit.push_back(learn::forward_fit_of(r) != nullptr);
+    completed.push_back(forward.completed());
+    rms.push_back(forward.completed() ? measured(true, forward.error().rms) : nullptr);
+    max.push_back(forward.completed() ? measured(true, forward.error().max) : nullptr);
+    // The control forces come from the trajectory stages, which a forward-fit step, a damped
+    // update and the last forward check do not run.
+    control.push_back(stages ? measured(true, stages->control_force_rms) : nullptr);
   }
   return { { "iteration", iteration }, { "forward_fit", forward_fit }, { "completed", completed },
     { "forward_rms_m", rms }, { "forward_max_m", max }, { "control_force_rms_N", control } };

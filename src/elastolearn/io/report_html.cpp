@@ -50,20 +50,32 @@ std::string convergence_table(const LearningReport& r) {
                     "[%]</th><th>forward max [%]</th><th>control force rms [N]</th><th>modes"
                     "</th><th>kernels</th><th>seconds</th></tr>\n";
   for (const auto& h : r.history) {
-    const char* kind = h.forward_fit ? "forward fit"
-        : !h.forward_completed       ? "diverged"
-        : h.modes > 0                ? "loop"
-                                     : "last forward check";
-    out += "<tr><td>" + std::to_string(h.iteration) + "</td><td class=\"l\">" + kind + "</td>";
-    if (h.forward_completed) {
-      out += "<td>" + number(percent * h.forward_error.rms) + "</td><td>"
-          + number(percent * h.forward_error.max) + "</td>";
+    const learn::ForwardOutcome& forward = learn::forward_of(h);
+    const learn::SpaceTimeStages* stages = learn::stages_of(h);
+    const learn::ForwardFitRecord* step = learn::forward_fit_of(h);
+    const auto* loop = std::get_if<learn::LoopRecord>(&h);
+    const char* kind = step     ? (step->accepted ? "forward fit, accepted"
+                                   : forward.status() == learn::ForwardStatus::unstable
+                                   ? "forward fit, rejected unsimulated (unstable)"
+                                   : forward.completed() ? "forward fit, rejected"
+                                                         : "forward fit, diverged (rejected)")
+        : stages                ? "loop"
+        : loop->damped_update() ? "diverged (half its step next)"
+        : forward.completed()   ? "last forward check"
+                                : "diverged (the loop stops)";
+    out += "<tr><td>" + std::to_string(learn::iteration_of(h)) + "</td><td class=\"l\">" + kind
+        + "</td>";
+    if (forward.completed()) {
+      out += "<td>" + number(percent * forward.error().rms) + "</td><td>"
+          + number(percent * forward.error().max) + "</td>";
     } else {
       out += "<td>-</td><td>-</td>";
     }
-    out += "<td>" + (h.modes > 0 && !h.forward_fit ? number(h.control_force_rms) : "-")
-        + "</td><td>" + std::to_string(h.modes) + "</td><td>" + std::to_string(h.centres)
-        + "</td><td>" + number(h.seconds_total(), "%.2f") + "</td></tr>\n";
+    const int kernels = stages ? stages->centres : step ? step->centres : 0;
+    out += "<td>" + (stages ? number(stages->control_force_rms) : "-") + "</td><td>"
+        + (stages ? std::to_string(stages->modes) : "-") + "</td><td>"
+        + (kernels > 0 ? std::to_string(kernels) : "-") + "</td><td>"
+        + number(learn::seconds_of(h), "%.2f") + "</td></tr>\n";
   }
   return out + "</table>\n";
 }

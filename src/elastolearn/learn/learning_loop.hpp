@@ -14,6 +14,8 @@
 /// `patience` iterations, or after `max_iterations` corrections. A correction whose forward
 /// simulation diverges is replaced by ½ (C_k + best) (a damped update, no trajectory stages);
 /// the first `free_halvings` divergences in a row do not count against patience, later ones do.
+/// Each iteration is one LoopRecord in LearningState::history, each forward-fit step one
+/// ForwardFitRecord (iteration_record.hpp); the stages are learning_stages.hpp's functions.
 /// Every stage is deterministic, and an iteration depends only on the current correction (and
 /// the counters in LearningState), so a run resumed from a checkpoint reaches the same result.
 /// Lost observation entries (Observation::valid) are ignored by every error and position term;
@@ -21,6 +23,7 @@
 /// no result depends on a lost entry's stored position.
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
+#include <elastolearn/learn/iteration_record.hpp>
 #include <elastolearn/learn/kmeans.hpp>
 #include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/pod_basis.hpp>
@@ -90,45 +93,6 @@ struct LearningOptions {
   void validate() const;
 };
 
-/// What one iteration measured. Times in seconds.
-struct IterationRecord {
-  int iteration = 0; ///< k (0: the nominal model)
-  ErrorSummary forward_error; ///< of C_k's forward simulation at the observed vertices [m]
-  bool forward_completed = true; ///< false if C_k's forward simulation diverged
-  std::string forward_message; ///< why it diverged (names the frame); empty when it completed
-  /// A forward-fit trial rejected unsimulated: its material is unstable (forward_completed is
-  /// false, but nothing diverged).
-  bool forward_unstable = false;
-  /// C_k diverged and C_{k+1} = ½ (C_k + best) was tried instead (a damped update).
-  bool damped_update = false;
-  /// A step of the forward fit after the loop (no trajectory stages): C_k is the trial, and
-  /// forward_fit_accepted says whether it lowered the error (and became the best).
-  bool forward_fit = false;
-  bool forward_fit_accepted = false;
-  /// √(mean r²) of the optimised trajectories (over every motion's steps and free dofs) [N]
-  double control_force_rms = 0;
-  double space_time_initial = 0; ///< E at the constrained simulation
-  double space_time_objective = 0; ///< E after optimisation
-  int space_time_iterations = 0;
-  int modes = 0; ///< POD modes (summed over the motions)
-  int centres = 0;
-  /// RMS force misfit of C_{k+1} against its targets (every motion's frames) [N]
-  double correction_misfit = 0;
-  /// The reconstructed correction's material_stability over its trajectories' stretches
-  /// (min_relative_eigenvalue: < 0 where it is unstable).
-  double stability = 0;
-  /// The fraction of the reconstructed correction kept to stay stable (1: all; 0: none, the
-  /// next iteration simulates the nominal).
-  double step_kept = 1;
-  double correction_target = 0; ///< RMS of those targets [N]
-  double seconds_forward = 0, seconds_pod = 0, seconds_constrained = 0, seconds_space_time = 0,
-         seconds_reconstruction = 0;
-  double seconds_total() const {
-    return seconds_forward + seconds_pod + seconds_constrained + seconds_space_time
-        + seconds_reconstruction;
-  }
-};
-
 /// Everything needed to continue a run: the checkpoint.
 struct LearningState {
   int next_iteration = 0; ///< k of the next forward simulation
@@ -141,12 +105,15 @@ struct LearningState {
   bool finished = false; ///< the loop (its space-time iterations) ended
   int forward_fit_steps = 0; ///< forward-fit steps taken after it
   double forward_fit_damping = -1; ///< its current μ (−1: not started)
+  /// Every step so far, in order: the loop's iterations (LoopRecord), then the forward fit's
+  /// steps (ForwardFitRecord).
   std::vector<IterationRecord> history;
 };
 
 struct LearningCallbacks {
   ProgressCallback progress; ///< within long stages
-  std::function<void(const IterationRecord&)> iteration; ///< after each iteration (log a line)
+  /// After each step, a loop iteration or a forward-fit step (log a line).
+  std::function<void(const IterationRecord&)> iteration;
   std::function<void(const LearningState&)> checkpoint; ///< after each iteration (save)
   std::function<bool()> interrupted; ///< polled between stages
 };

@@ -462,12 +462,12 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   LearningCallbacks loop_callbacks = callbacks.loop;
   loop_callbacks.checkpoint = [&](const LearningState& s) {
     const IterationRecord& r = s.history.back();
-    if (r.forward_fit) {
-      if (r.forward_fit_accepted)
-        tried[r.iteration] = s.correction;
+    if (const ForwardFitRecord* step = forward_fit_of(r)) {
+      if (step->accepted)
+        tried[step->iteration] = s.correction;
     } else {
-      if (r.forward_completed && current)
-        tried[r.iteration] = current;
+      if (forward_of(r).completed() && current)
+        tried[iteration_of(r)] = current;
       current = s.correction;
     }
     if (callbacks.loop.checkpoint)
@@ -505,24 +505,24 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   std::vector<const IterationRecord*> loop_records;
   const IterationRecord* forward_fit = nullptr;
   for (const auto& r : result.loop.history) {
-    const auto it = tried.find(r.iteration);
-    if (it == tried.end() || !it->second || !r.forward_completed)
+    const auto it = tried.find(iteration_of(r));
+    if (it == tried.end() || !it->second || !forward_of(r).completed())
       continue;
-    if (r.forward_fit)
+    if (forward_fit_of(r))
       forward_fit = &r;
     else
       loop_records.push_back(&r);
   }
   std::sort(loop_records.begin(), loop_records.end(),
       [](const IterationRecord* a, const IterationRecord* b) {
-        return a->forward_error.rms < b->forward_error.rms;
+        return forward_of(*a).error().rms < forward_of(*b).error().rms;
       });
   loop_records.resize(std::min(loop_records.size(), kLoopCandidates));
   if (forward_fit)
     loop_records.push_back(forward_fit);
   for (const IterationRecord* r : loop_records)
-    add(r->forward_fit ? CandidateKind::ForwardFit : CandidateKind::Loop, r->iteration,
-        tried.at(r->iteration), r->forward_error.rms);
+    add(forward_fit_of(*r) ? CandidateKind::ForwardFit : CandidateKind::Loop, iteration_of(*r),
+        tried.at(iteration_of(*r)), forward_of(*r).error().rms);
   // A resumed run knows the earlier iterations only through the best one.
   if (result.loop.best && tried.find(result.loop.best_iteration) == tried.end())
     add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best, result.loop.best_error);
