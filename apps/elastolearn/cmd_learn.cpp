@@ -207,11 +207,8 @@ void run_learn(const LearnOptions& o) {
     std::string note;
     if (static_cast<int>(i) == result.chosen)
       note = "   <- chosen";
-    else if (c.completed && !c.larger_motion.completed)
-      note = "   (diverged in a motion driven " + elastolearn::to_text(learn::kLargerMotion)
-          + "× as hard: not eligible)";
     else if (c.completed && !c.eligible())
-      note = "   (unstable in a motion driven " + elastolearn::to_text(learn::kLargerMotion)
+      note = "   (diverged in a motion driven " + elastolearn::to_text(learn::kLargerMotion)
           + "× as hard: not eligible)";
     else if (c.completed && c.kind == learn::CandidateKind::Network && c.teacher == result.chosen)
       note = "   (" + elastolearn::to_text(-c.gain_over_teacher) + " noise deviations and "

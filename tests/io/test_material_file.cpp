@@ -500,3 +500,29 @@ TEST(MaterialFile, SceneMayReferenceAMaterialFile) {
   expect_input_error(
       [&] { read_scene_file(dir / "broken_scene.json"); }, { "broken.json: material.young" });
 }
+
+TEST(MaterialFile, RbfTrustedStretchesRoundTrip) {
+  // Energy kernels with a trusted interval: written as [min, max], read back to the same
+  // function inside and beyond it; an unbounded end travels as null, a missing key is unbounded.
+  auto p = rbf_parameters(3, 9);
+  p.energy_kernels = true;
+  p.quadratic[1] = 2 * p.quadratic[2];
+  p.trusted_min = 0.85;
+  MaterialFile f;
+  f.material = k_nominal;
+  f.correction = std::make_shared<material::RbfCorrection>(p);
+  const Json j = material_file_to_json(f);
+  EXPECT_EQ(j["correction"]["trusted_stretches"][0], 0.85);
+  EXPECT_TRUE(j["correction"]["trusted_stretches"][1].is_null());
+  const MaterialFile g = parse_material_file(Json::parse(j.dump()), "f.json");
+  const auto& q = dynamic_cast<const material::RbfCorrection&>(*g.correction).parameters();
+  EXPECT_EQ(q.trusted_min, 0.85);
+  EXPECT_EQ(q.trusted_max, std::numeric_limits<double>::infinity());
+  for (const Vec3& s : { Vec3(1.1, 1.0, 0.9), Vec3(1.2, 0.8, 0.6) })
+    EXPECT_EQ(f.correction->correction(s, Vec3::Zero()), g.correction->correction(s, Vec3::Zero()));
+  Json bad = j;
+  bad["correction"]["trusted_stretches"] = Json::array({ 1.2 });
+  expect_bad(bad, { "bad.json: correction.trusted_stretches", "[min, max]" });
+  bad["correction"]["trusted_stretches"] = Json::array({ 1.2, 0.9 });
+  expect_bad(bad, { "bad.json: correction.trusted_stretches", "min ≤ max" });
+}

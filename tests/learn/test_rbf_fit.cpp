@@ -371,3 +371,43 @@ TEST(RbfFit, NeoHookeanTailExtrapolatesNeoHookeanMinusCorotatedIntoStrongCompres
     EXPECT_GT(e_without, 0.1);
   }
 }
+
+TEST(RbfDesign, BeyondTheTrustedStretchesTheDesignContinuesAsTheCorrection) {
+  // A x = N everywhere, also where the correction continues beyond its trusted interval, and
+  // the design's derivative is the correction's tangent there (the forward fit's Jacobian).
+  MatX centres(3, 3);
+  centres << 1.1, 1.0, 0.9, 1.0, 0.95, 0.9, 1.2, 1.1, 0.8;
+  RbfFitOptions options;
+  options.energy_kernels = true;
+  options.neo_hookean_tail = true;
+  options.epsilon = 0.03;
+  const RbfDesign design(centres, options, 0.9, 1.15);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1e3);
+  VecX x(design.num_unknowns());
+  for (auto& v : x)
+    v = g(rng);
+  const material::RbfCorrection n = design.correction(x);
+  EXPECT_EQ(n.parameters().trusted_min, 0.9);
+  EXPECT_EQ(n.parameters().trusted_max, 1.15);
+  EXPECT_LE((design.unknowns(n) - x).norm(), 1e-12 * x.norm());
+  const int u = design.elastic_unknowns();
+  RbfDesign::OutputMatrix a(3, u), b(3, u);
+  RbfDesign::OutputGradient d(9, u);
+  for (const Vec3& s : { Vec3(1.5, 0.93, 0.97), Vec3(0.6, 1.3, 1.0), Vec3(1.05, 1.0, 0.95) }) {
+    SCOPED_TRACE(testing::Message() << "σ = " << s.transpose());
+    design.output_matrix(s, a);
+    design.output_matrix(s, b, d);
+    const Vec3 expected = n.correction(s, Vec3::Zero());
+    EXPECT_LE((a * x.head(u) - expected).norm(), 1e-9 * expected.norm());
+    EXPECT_LE((b * x.head(u) - expected).norm(), 1e-9 * expected.norm());
+    Mat3 tangent, unused;
+    n.correction_gradient(s, Vec3::Zero(), tangent, unused);
+    const Mat3 from_design = (d * x.head(u)).reshaped(3, 3);
+    EXPECT_LE((from_design - tangent).norm(), 1e-9 * tangent.norm());
+  }
+  EXPECT_THROW(RbfDesign(centres, options).unknowns(n), InputError) << "another interval";
+  RbfFitOptions stress = options;
+  stress.energy_kernels = false;
+  EXPECT_THROW(RbfDesign(centres, stress, 0.9, 1.15), InputError);
+}

@@ -394,3 +394,80 @@ TEST(RbfCorrectionEnergy, ProjectedTangentOfTheCorrectedModelIsPositiveSemiDefin
   }
   EXPECT_TRUE(some_negative) << "the test's correction must make the exact tangent indefinite";
 }
+
+namespace {
+
+/// energy_correction() trusted in [0.9, 1.2] only.
+RbfCorrection trusted_energy_correction() {
+  RbfCorrection::Parameters p = energy_correction().parameters();
+  p.trusted_min = 0.9;
+  p.trusted_max = 1.2;
+  return RbfCorrection(std::move(p));
+}
+
+} // namespace
+
+TEST(RbfCorrectionEnergy, BeyondItsTrustedStretchesItKeepsTheStiffnessOfTheEdge) {
+  const RbfCorrection unbounded = energy_correction();
+  const RbfCorrection n = trusted_energy_correction();
+  Mat3 h, unused;
+  // Inside: the formula itself.
+  const Vec3 inside(1.1, 1.0, 0.95);
+  EXPECT_EQ(n.elastic_correction(inside), unbounded.elastic_correction(inside));
+  // Outside: the second-order expansion at the nearest trusted point c.
+  for (const Vec3& s : { Vec3(1.5, 1.0, 0.95), Vec3(1.4, 1.3, 0.6), Vec3(0.7, 1.1, 1.6) }) {
+    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+    const Vec3 c = s.cwiseMax(0.9).cwiseMin(1.2);
+    unbounded.correction_gradient(c, Vec3::Zero(), h, unused);
+    const Vec3 expected = unbounded.elastic_correction(c) + h * (s - c);
+    EXPECT_LE((n.elastic_correction(s) - expected).norm(), 1e-12 * expected.norm());
+    Mat3 ds;
+    EXPECT_LE((n.correction_with_gradient(s, Vec3::Zero(), ds, unused) - expected).norm(),
+        1e-12 * expected.norm());
+    EXPECT_LE((ds - h).norm(), 1e-12 * h.norm()) << "the tangent is the edge's, symmetric";
+    // Symmetric in the stretches like ΔΨ: permuting σ permutes N.
+    const Vec3 swapped = n.elastic_correction(Vec3(s[2], s[0], s[1]));
+    EXPECT_LE(
+        (swapped - Vec3(expected[2], expected[0], expected[1])).norm(), 1e-12 * expected.norm());
+  }
+  // The stiffness stays that of the edge: N is linear along a clamped direction, while the
+  // formula's (cubic and neo-Hookean tails) is not.
+  const auto along
+      = [](const RbfCorrection& c, double s1) { return c.elastic_correction(Vec3(s1, 1.0, 0.95)); };
+  const Vec3 curvature = along(n, 1.6) - 2 * along(n, 1.45) + along(n, 1.3);
+  EXPECT_LE(curvature.norm(), 1e-9 * along(n, 1.6).norm());
+  const Vec3 formula_curvature
+      = along(unbounded, 1.6) - 2 * along(unbounded, 1.45) + along(unbounded, 1.3);
+  EXPECT_GT(formula_curvature.norm(), 1e-3 * along(unbounded, 1.6).norm());
+  // C¹ across the edge: N changes by O(h) over [1.2 − h, 1.2 + h], as ∂N/∂σ says.
+  const double step = 1e-6;
+  unbounded.correction_gradient(Vec3(1.2, 1.0, 0.95), Vec3::Zero(), h, unused);
+  const Vec3 jump = along(n, 1.2 + step) - along(n, 1.2 - step);
+  EXPECT_LE((jump - 2 * step * h.col(0)).norm(), 1e-6 * (2 * step * h.col(0)).norm());
+}
+
+TEST(RbfCorrectionEnergy, OutsideItsTrustedStretchesItIsStillAnEnergy) {
+  // Where every stretch is beyond the same edge, c is fixed and N = ∇ΔΨ exactly (the continued
+  // energy is a quadratic there); its tangent matches finite differences of N.
+  const RbfCorrection n = trusted_energy_correction();
+  for (const Vec3& s : { Vec3(1.5, 1.35, 1.25), Vec3(0.8, 0.7, 0.85) }) {
+    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+    Eigen::MatrixXd stress(1, 3);
+    stress.row(0) = n.elastic_correction(s).transpose();
+    const FdFunction energy = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+      return Eigen::VectorXd::Constant(1, n.elastic_energy(y.head<3>()));
+    };
+    expect_jacobian_matches(stress, energy, Eigen::VectorXd(s), 1e-7, 1e-4);
+    expect_gradient_matches_fd(n, s, Vec3::Zero(), 1e-7);
+  }
+}
+
+TEST(RbfCorrectionEnergy, RejectsAnInvalidTrustedInterval) {
+  RbfCorrection::Parameters p = energy_correction().parameters();
+  p.trusted_min = 1.2;
+  p.trusted_max = 0.9;
+  EXPECT_THROW(RbfCorrection { p }, InputError);
+  RbfCorrection::Parameters stress = test_parameters(0.03);
+  stress.trusted_max = 1.2;
+  EXPECT_THROW(RbfCorrection { stress }, InputError) << "stress kernels have no energy";
+}

@@ -33,8 +33,7 @@ nlohmann::json larger_motion_to_json(const learn::LargerMotionCheck& l) {
   if (!l.checked)
     return nullptr;
   return { { "factor", learn::kLargerMotion }, { "completed", l.completed },
-    { "message", l.message }, { "unstable_samples", l.stability.unstable_samples },
-    { "samples", l.stability.samples } };
+    { "message", l.message } };
 }
 
 } // namespace

@@ -50,7 +50,11 @@ Json rbf_to_json(const material::RbfCorrection& c) {
     { "damping_weights", vector_to_json(p.damping_weights) },
     { "damping_slopes", vector_to_json(p.damping_slopes) },
     { "damping_constant", p.damping_constant },
-    { "damping_quadratic", vector_to_json(p.damping_quadratic) }, { "damping_floor", floor } };
+    { "damping_quadratic", vector_to_json(p.damping_quadratic) }, { "damping_floor", floor },
+    // [min, max]; null for an unbounded end (JSON has no infinity)
+    { "trusted_stretches",
+        Json::array({ std::isfinite(p.trusted_min) ? Json(p.trusted_min) : Json(nullptr),
+            std::isfinite(p.trusted_max) ? Json(p.trusted_max) : Json(nullptr) }) } };
 }
 
 Json nn_to_json(const material::NnCorrection& c) {
@@ -134,7 +138,8 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
 std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "energy_kernels", "epsilon", "centres", "weights", "own_slope",
       "other_slope", "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes",
-      "damping_slope", "damping_constant", "damping_quadratic", "damping_floor" });
+      "damping_slope", "damping_constant", "damping_quadratic", "damping_floor",
+      "trusted_stretches" });
   material::RbfCorrection::Parameters p;
   p.energy_kernels = o.boolean("energy_kernels", false); // absent: the stress kernels
   p.epsilon = o.number("epsilon");
@@ -167,6 +172,17 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
     p.damping_quadratic = read_vector(o, "damping_quadratic", 3);
   if (o.has("damping_floor") && !o.json().at("damping_floor").is_null())
     p.damping_floor = o.number("damping_floor");
+  if (o.has("trusted_stretches")) { // absent (older files): unbounded
+    const Json& t = o.json().at("trusted_stretches");
+    if (!t.is_array() || t.size() != 2 || !std::all_of(t.begin(), t.end(), [](const Json& v) {
+          return v.is_null() || v.is_number();
+        }))
+      o.fail("trusted_stretches", "expected [min, max] (numbers, or null for an unbounded end)");
+    if (!t[0].is_null())
+      p.trusted_min = t[0].get<double>();
+    if (!t[1].is_null())
+      p.trusted_max = t[1].get<double>();
+  }
   return construct(
       o, [&] { return std::make_shared<const material::RbfCorrection>(std::move(p)); });
 }

@@ -20,7 +20,6 @@
 /// The validation choice is what makes the result never worse than fitting parameters on data
 /// nobody tuned the recipe for: the fitted nominal is always a candidate.
 #include <elastolearn/learn/learning_loop.hpp>
-#include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/network_distillation.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
@@ -70,8 +69,6 @@ struct LargerMotionCheck {
   bool checked = false; ///< false for the nominals (no correction: nothing to check)
   bool completed = true; ///< every amplified held-out motion simulated to its end
   std::string message; ///< why one diverged (names the motion and frame); empty if none did
-  StabilityReport stability; ///< at the stretches the runs reached
-  bool passed() const { return completed && stability.stable(); }
 };
 
 /// What the validation compares.
@@ -94,8 +91,8 @@ struct Candidate {
   ErrorSummary validation; ///< at the held-out observations [m]
   /// Whether its material survives a larger motion of the same kind: every held-out motion's
   /// scene driven kLargerMotion times as hard (sim::amplified_scene) must simulate to its end,
-  /// and the material must be stable (material_stability) at every stretch those runs reach. A
-  /// user's next motion is rarely the one recorded. Not checked (passed) for the nominals.
+  /// as the fitted nominal's does. A user's next motion is rarely the one recorded. Not checked
+  /// (passed) for the nominals.
   LargerMotionCheck larger_motion;
   /// At the training observations [m] (the loop's own signal); NaN for a network (not simulated
   /// on the training data).
@@ -107,7 +104,7 @@ struct Candidate {
   /// the reference itself.
   double significance = 0;
   /// Eligible for the choice: its validation completed and it survives a larger motion.
-  bool eligible() const { return completed && larger_motion.passed(); }
+  bool eligible() const { return completed && larger_motion.completed; }
 };
 
 /// Everything the recipe decided and measured.

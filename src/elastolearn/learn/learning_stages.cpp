@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <string>
 
 namespace elastolearn::learn {
@@ -112,6 +113,16 @@ MatX trajectory_stretches(std::span<const ReconstructionMesh> meshes,
     rows += part.rows();
   }
   return stacked;
+}
+
+/// The corrections' trusted interval (material::RbfCorrection::Parameters::trusted_min/max):
+/// every principal stretch of `stretches`, the trajectories a correction is learned from. With
+/// energy kernels a correction continues beyond it with the stiffness at its edge; stress kernels
+/// are not continued.
+std::pair<double, double> trusted_interval(const MatX& stretches, const RbfFitOptions& rbf) {
+  if (!rbf.energy_kernels || stretches.size() == 0)
+    return { -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity() };
+  return { stretches.minCoeff(), stretches.maxCoeff() };
 }
 
 /// RBF centres: k-means over the stretch views of `stretches` (at most options.centres).
@@ -241,7 +252,9 @@ Reconstruction reconstruct_correction(std::span<const ReconstructionMesh> meshes
         { meshes[i], m.physics.dofs(), m.positions, m.velocities, m.targets, m.projection });
   }
   const MatX stretches = trajectory_stretches(meshes, trajectories, options);
-  const RbfDesign design(rbf_centres(stretches, options, seed), options.rbf);
+  const auto [trusted_min, trusted_max] = trusted_interval(stretches, options.rbf);
+  const RbfDesign design(
+      rbf_centres(stretches, options, seed), options.rbf, trusted_min, trusted_max);
   const StressReconstructionResult reconstructed
       = reconstruct_rbf_correction(blocks, design, reconstruction);
   Reconstruction out;
@@ -278,7 +291,11 @@ ForwardFitStart forward_fit_start(std::span<const Motion> motions,
   const MatX stretches = trajectory_stretches(meshes, trajectories, options);
   const MatX centres
       = best ? MatX(best->parameters().centres) : rbf_centres(stretches, options, options.seed);
-  RbfDesign design(centres, options.rbf);
+  // The best correction's own trusted interval, so that the design expresses it exactly.
+  const auto [trusted_min, trusted_max] = best
+      ? std::pair(best->parameters().trusted_min, best->parameters().trusted_max)
+      : trusted_interval(stretches, options.rbf);
+  RbfDesign design(centres, options.rbf, trusted_min, trusted_max);
   VecX start = best ? design.unknowns(*best) : VecX(VecX::Zero(design.num_unknowns()));
   ForwardFitOptions fit_options = options.forward_fit;
   fit_options.max_iterations = remaining_steps;

@@ -33,9 +33,16 @@ void RbfFitOptions::validate() const {
     fail("damping_quadratic_tail", "needs damping_polynomial (the linear tail)");
 }
 
-RbfDesign::RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options)
-    : m_options(options) {
+RbfDesign::RbfDesign(
+    ConstRef<MatX> centres, const RbfFitOptions& options, double trusted_min, double trusted_max)
+    : m_options(options)
+    , m_trusted_min(trusted_min)
+    , m_trusted_max(trusted_max) {
   options.validate();
+  if (std::isnan(trusted_min) || std::isnan(trusted_max) || !(trusted_min <= trusted_max))
+    fail("trusted_stretches", "must be an interval [min, max] with min ≤ max");
+  if (!options.energy_kernels && (std::isfinite(trusted_min) || std::isfinite(trusted_max)))
+    fail("trusted_stretches", "needs energy kernels (stress kernels have no energy to continue)");
   if (centres.rows() < 1 || centres.cols() != 3)
     fail("centres",
         "expected m × 3 with m ≥ 1, got " + to_text(centres.rows()) + " × "
@@ -85,6 +92,15 @@ const Eigen::Matrix<double, 4, 3>& energy_tail_map() {
 } // namespace
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
+  const Vec3 c = stretches.cwiseMax(m_trusted_min).cwiseMin(m_trusted_max);
+  if (c != stretches) {
+    // Outside the trusted interval (energy kernels only): the continuation needs ∂A/∂σ. Per
+    // thread, sized once per design size: no allocation in the per-element loops.
+    thread_local OutputGradient gradient;
+    gradient.resize(9, out.cols());
+    output_matrix(stretches, out, gradient);
+    return;
+  }
   if (m_options.energy_kernels)
     for (Eigen::Index i = 0; i < m_centres.rows(); ++i)
       out.col(i) = material::energy_kernel_gradient(
@@ -121,6 +137,18 @@ void RbfDesign::view_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out
 }
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
+    Eigen::Ref<OutputGradient> gradient) const {
+  const Vec3 c = stretches.cwiseMax(m_trusted_min).cwiseMin(m_trusted_max);
+  formula_matrix(c, out, gradient);
+  if (c == stretches)
+    return;
+  const Vec3 d = stretches - c;
+  for (int j = 0; j < 3; ++j)
+    for (int k = 0; k < 3; ++k)
+      out.row(k) += d[j] * gradient.row(3 * j + k);
+}
+
+void RbfDesign::formula_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
     Eigen::Ref<OutputGradient> gradient) const {
   view_columns(stretches, out);
   gradient.setZero();
@@ -198,6 +226,8 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
   p.centres = m_centres;
   p.epsilon = m_options.epsilon;
   p.energy_kernels = m_options.energy_kernels;
+  p.trusted_min = m_trusted_min;
+  p.trusted_max = m_trusted_max;
   p.weights = x.head(m);
   p.constant = -p.weights.dot(m_rest_kernels); // N(1) = 0 under stress_free_rest
   if (m_options.elastic_polynomial) {
@@ -230,8 +260,10 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   const auto& p = c.parameters();
   const Eigen::Index m = m_centres.rows();
   if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon
-      || p.energy_kernels != m_options.energy_kernels)
-    fail("correction", "its centres, kernel smoothing or kernel kind differ from the design's");
+      || p.energy_kernels != m_options.energy_kernels || p.trusted_min != m_trusted_min
+      || p.trusted_max != m_trusted_max)
+    fail("correction",
+        "its centres, kernel smoothing, kernel kind or trusted stretches differ from the design's");
   const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();
   const bool has_damping_tail
       = !p.damping_slopes.isZero(0) || p.damping_constant != 0 || !p.damping_quadratic.isZero(0);

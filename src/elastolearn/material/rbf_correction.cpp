@@ -135,6 +135,11 @@ RbfCorrection::RbfCorrection(Parameters p)
   if (!std::isfinite(m_p.epsilon) || m_p.epsilon < 0) {
     fail("epsilon", "must be finite and ≥ 0, got " + to_text(m_p.epsilon));
   }
+  if (std::isnan(m_p.trusted_min) || std::isnan(m_p.trusted_max)
+      || !(m_p.trusted_min <= m_p.trusted_max))
+    fail("trusted_stretches", "must be an interval [min, max] with min ≤ max");
+  if (!m_p.energy_kernels && (std::isfinite(m_p.trusted_min) || std::isfinite(m_p.trusted_max)))
+    fail("trusted_stretches", "needs energy kernels (stress kernels have no energy to continue)");
   if (m_p.energy_kernels && !is_energy_quadratic_tail(m_p.quadratic))
     fail("quadratic",
         "is not the gradient of an energy (energy kernels need quadratic[1] = 2 quadratic[2])");
@@ -210,6 +215,15 @@ Vec3 RbfCorrection::energy_kernels_sum(const Vec3& stretches, Mat3* hessian) con
 double RbfCorrection::elastic_energy(const Vec3& stretches) const {
   if (!m_p.energy_kernels)
     fail("energy_kernels", "the correction is not an energy (stress kernels)");
+  const Vec3 c = trusted_point(stretches);
+  if (c == stretches)
+    return formula_energy(stretches);
+  Mat3 hessian;
+  const Vec3 n = formula(c, &hessian), d = stretches - c;
+  return formula_energy(c) + n.dot(d) + 0.5 * d.dot(hessian * d);
+}
+
+double RbfCorrection::formula_energy(const Vec3& stretches) const {
   const Vec3 e = stretches - Vec3::Ones();
   const double p1 = e.sum(), p2 = e.squaredNorm(), p3 = e.array().cube().sum();
   double psi = 0;
@@ -327,6 +341,20 @@ Vec3 RbfCorrection::correction(const Vec3& stretches, const Vec3& /*stretch_rate
 
 Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& /*stretch_rates*/,
     Mat3& d_stretches, Mat3& d_stretch_rates) const {
+  d_stretch_rates.setZero();
+  const Vec3 c = trusted_point(stretches);
+  const Vec3 n = formula(c, &d_stretches);
+  return c == stretches ? n : Vec3(n + d_stretches * (stretches - c));
+}
+
+Vec3 RbfCorrection::formula(const Vec3& stretches, Mat3* d_stretches) const {
+  if (d_stretches == nullptr) {
+    Mat3 y;
+    for (int k = 0; k < 3; ++k)
+      y.col(k) = stretch_view(stretches, k);
+    const Vec3 n = elastic_views(y, nullptr);
+    return m_p.energy_kernels ? Vec3(n + energy_kernels_sum(stretches, nullptr)) : n;
+  }
   std::array<std::array<int, 3>, 3> views;
   Mat3 y, d_y;
   for (int k = 0; k < 3; ++k) {
@@ -334,13 +362,12 @@ Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& 
     y.col(k) = Vec3(stretches[views[k][0]], stretches[views[k][1]], stretches[views[k][2]]);
   }
   Vec3 n = elastic_views(y, &d_y);
-  d_stretches.setZero();
+  d_stretches->setZero();
   for (int k = 0; k < 3; ++k)
     for (int c = 0; c < 3; ++c)
-      d_stretches(k, views[k][c]) += d_y(c, k);
+      (*d_stretches)(k, views[k][c]) += d_y(c, k);
   if (m_p.energy_kernels)
-    n += energy_kernels_sum(stretches, &d_stretches);
-  d_stretch_rates.setZero();
+    n += energy_kernels_sum(stretches, d_stretches);
   return n;
 }
 
@@ -354,11 +381,12 @@ std::unique_ptr<Correction> RbfCorrection::clone() const {
 }
 
 Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
-  Mat3 y;
-  for (int k = 0; k < 3; ++k)
-    y.col(k) = stretch_view(stretches, k);
-  const Vec3 n = elastic_views(y, nullptr);
-  return m_p.energy_kernels ? Vec3(n + energy_kernels_sum(stretches, nullptr)) : n;
+  const Vec3 c = trusted_point(stretches);
+  if (c == stretches)
+    return formula(stretches, nullptr);
+  Mat3 hessian;
+  const Vec3 n = formula(c, &hessian);
+  return n + hessian * (stretches - c);
 }
 
 bool RbfCorrection::has_damping() const {
