@@ -255,6 +255,7 @@ TEST(MaterialFile, EnergyNnRoundTripIsBitExact) {
   MaterialFile f;
   f.material = k_nominal;
   material::NnCorrection::Parameters parameters = energy_nn_parameters(4);
+  parameters.trusted = { 0.8 + 1e-15 / 3, 1.3 };
   parameters.damping = std::make_shared<const material::RbfCorrection>(
       material::damping_part(material::RbfCorrection(rbf_parameters(4, 2))));
   const auto original = std::make_shared<material::NnCorrection>(parameters);
@@ -269,6 +270,8 @@ TEST(MaterialFile, EnergyNnRoundTripIsBitExact) {
   EXPECT_EQ(q.input_mean, parameters.input_mean);
   EXPECT_EQ(q.input_scale, parameters.input_scale);
   EXPECT_EQ(q.polynomial, parameters.polynomial);
+  EXPECT_EQ(q.trusted.min, parameters.trusted.min);
+  EXPECT_EQ(q.trusted.max, parameters.trusted.max);
   ASSERT_EQ(q.layers.size(), parameters.layers.size());
   for (std::size_t k = 0; k < q.layers.size(); ++k) {
     EXPECT_EQ(q.layers[k].weight, parameters.layers[k].weight) << "layer " << k;
@@ -507,7 +510,7 @@ TEST(MaterialFile, RbfTrustedStretchesRoundTrip) {
   auto p = rbf_parameters(3, 9);
   p.energy_kernels = true;
   p.quadratic[1] = 2 * p.quadratic[2];
-  p.trusted_min = 0.85;
+  p.trusted.min = 0.85;
   MaterialFile f;
   f.material = k_nominal;
   f.correction = std::make_shared<material::RbfCorrection>(p);
@@ -516,8 +519,8 @@ TEST(MaterialFile, RbfTrustedStretchesRoundTrip) {
   EXPECT_TRUE(j["correction"]["trusted_stretches"][1].is_null());
   const MaterialFile g = parse_material_file(Json::parse(j.dump()), "f.json");
   const auto& q = dynamic_cast<const material::RbfCorrection&>(*g.correction).parameters();
-  EXPECT_EQ(q.trusted_min, 0.85);
-  EXPECT_EQ(q.trusted_max, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(q.trusted.min, 0.85);
+  EXPECT_EQ(q.trusted.max, std::numeric_limits<double>::infinity());
   for (const Vec3& s : { Vec3(1.1, 1.0, 0.9), Vec3(1.2, 0.8, 0.6) })
     EXPECT_EQ(f.correction->correction(s, Vec3::Zero()), g.correction->correction(s, Vec3::Zero()));
   Json bad = j;

@@ -212,7 +212,7 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
   const Candidate& teacher = r.candidates[static_cast<size_t>(network.teacher)];
   EXPECT_NE(dynamic_cast<const material::RbfCorrection*>(teacher.correction.get()), nullptr);
   EXPECT_EQ(network.iteration, teacher.iteration);
-  EXPECT_LT(r.network->validation_rms, 0.05 * r.network->teacher_rms) << "distillation error";
+  EXPECT_LT(r.network->validation_rms, 0.05 * r.network->teacher_rms) << r.network->describe();
   EXPECT_EQ(r.choice().kind, CandidateKind::Network);
   EXPECT_LE(network.validation.rms, (1 + kNetworkTolerance) * teacher.validation.rms);
   // 60 frames: the last 12 held out, 48 trained on.

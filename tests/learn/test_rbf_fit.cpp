@@ -381,15 +381,15 @@ TEST(RbfDesign, BeyondTheTrustedStretchesTheDesignContinuesAsTheCorrection) {
   options.energy_kernels = true;
   options.neo_hookean_tail = true;
   options.epsilon = 0.03;
-  const RbfDesign design(centres, options, 0.9, 1.15);
+  const RbfDesign design(centres, options, { 0.9, 1.15 });
   std::mt19937 rng(5);
   std::normal_distribution<double> g(0.0, 1e3);
   VecX x(design.num_unknowns());
   for (auto& v : x)
     v = g(rng);
   const material::RbfCorrection n = design.correction(x);
-  EXPECT_EQ(n.parameters().trusted_min, 0.9);
-  EXPECT_EQ(n.parameters().trusted_max, 1.15);
+  EXPECT_EQ(n.parameters().trusted.min, 0.9);
+  EXPECT_EQ(n.parameters().trusted.max, 1.15);
   EXPECT_LE((design.unknowns(n) - x).norm(), 1e-12 * x.norm());
   const int u = design.elastic_unknowns();
   RbfDesign::OutputMatrix a(3, u), b(3, u);
@@ -409,5 +409,5 @@ TEST(RbfDesign, BeyondTheTrustedStretchesTheDesignContinuesAsTheCorrection) {
   EXPECT_THROW(RbfDesign(centres, options).unknowns(n), InputError) << "another interval";
   RbfFitOptions stress = options;
   stress.energy_kernels = false;
-  EXPECT_THROW(RbfDesign(centres, stress, 0.9, 1.15), InputError);
+  EXPECT_THROW(RbfDesign(centres, stress, { 0.9, 1.15 }), InputError);
 }

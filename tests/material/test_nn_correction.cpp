@@ -528,3 +528,36 @@ TEST(NnCorrection, StressNetworkActivationsHaveExactGradients) {
     }
   }
 }
+
+TEST(NnCorrectionEnergy, BeyondItsTrustedStretchesItKeepsTheStiffnessOfTheEdge) {
+  // The same continuation as an RBF teacher's (material/trusted_stretches.hpp): the network
+  // itself inside, its second-order expansion at the nearest trusted point outside.
+  const NnCorrection unbounded(energy_parameters({ 8, 8 }));
+  NnCorrection::Parameters p = energy_parameters({ 8, 8 });
+  p.trusted = { 0.9, 1.2 };
+  const NnCorrection n(p);
+  const Vec3 inside(1.1, 1.0, 0.95);
+  EXPECT_EQ(n.correction(inside, Vec3::Zero()), unbounded.correction(inside, Vec3::Zero()));
+  for (const Vec3& s : { Vec3(1.5, 1.0, 0.95), Vec3(0.7, 1.1, 1.6) }) {
+    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+    const Vec3 c = s.cwiseMax(0.9).cwiseMin(1.2);
+    Mat3 h, ds, unused;
+    unbounded.correction_gradient(c, Vec3::Zero(), h, unused);
+    const Vec3 expected = unbounded.correction(c, Vec3::Zero()) + h * (s - c);
+    const Vec3 got = n.correction_with_gradient(s, Vec3::Zero(), ds, unused);
+    EXPECT_LE((got - expected).norm(), 1e-12 * expected.norm());
+    EXPECT_LE((n.correction(s, Vec3::Zero()) - expected).norm(), 1e-12 * expected.norm());
+    EXPECT_LE((ds - h).norm(), 1e-12 * h.norm());
+  }
+  // Where every stretch is beyond the same end, N is the gradient of the continued energy.
+  const Vec3 s(1.5, 1.35, 1.25);
+  Eigen::MatrixXd stress(1, 3);
+  stress.row(0) = n.correction(s, Vec3::Zero()).transpose();
+  const FdFunction energy = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+    return Eigen::VectorXd::Constant(1, n.elastic_energy(y.head<3>()));
+  };
+  expect_jacobian_matches(stress, energy, Eigen::VectorXd(s), 1e-7, 1e-4);
+  NnCorrection::Parameters stress_network = test_parameters();
+  stress_network.trusted = { 0.9, 1.2 };
+  EXPECT_THROW(NnCorrection { stress_network }, InputError);
+}

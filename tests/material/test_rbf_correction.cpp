@@ -400,8 +400,8 @@ namespace {
 /// energy_correction() trusted in [0.9, 1.2] only.
 RbfCorrection trusted_energy_correction() {
   RbfCorrection::Parameters p = energy_correction().parameters();
-  p.trusted_min = 0.9;
-  p.trusted_max = 1.2;
+  p.trusted.min = 0.9;
+  p.trusted.max = 1.2;
   return RbfCorrection(std::move(p));
 }
 
@@ -464,10 +464,10 @@ TEST(RbfCorrectionEnergy, OutsideItsTrustedStretchesItIsStillAnEnergy) {
 
 TEST(RbfCorrectionEnergy, RejectsAnInvalidTrustedInterval) {
   RbfCorrection::Parameters p = energy_correction().parameters();
-  p.trusted_min = 1.2;
-  p.trusted_max = 0.9;
+  p.trusted.min = 1.2;
+  p.trusted.max = 0.9;
   EXPECT_THROW(RbfCorrection { p }, InputError);
   RbfCorrection::Parameters stress = test_parameters(0.03);
-  stress.trusted_max = 1.2;
+  stress.trusted.max = 1.2;
   EXPECT_THROW(RbfCorrection { stress }, InputError) << "stress kernels have no energy";
 }

@@ -7,6 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 using namespace elastolearn;
 
 namespace {
@@ -74,7 +77,8 @@ TEST(AmplifiedScene, ScalesKeyframesAndARecordedInitialState) {
   EXPECT_LT(linear_scaling_error(once, amplified, flat_rest(scene), 1.5), 1e-4);
 }
 
-TEST(AmplifiedScene, RefusesAFactorThatIsNotPositive) {
-  EXPECT_THROW(sim::amplified_scene(stiff_bar(), 0), InputError);
+TEST(AmplifiedScene, RefusesAFactorThatIsNotFinite) {
   EXPECT_THROW(sim::amplified_scene(stiff_bar(), std::nan("")), InputError);
+  EXPECT_THROW(
+      sim::amplified_scene(stiff_bar(), std::numeric_limits<double>::infinity()), InputError);
 }

@@ -39,6 +39,29 @@ template <typename Derived> Json vector_to_json(const Eigen::MatrixBase<Derived>
   return out;
 }
 
+/// [min, max], null for an unbounded end (JSON has no infinity).
+Json trusted_to_json(const material::TrustedStretches& t) {
+  return Json::array({ std::isfinite(t.min) ? Json(t.min) : Json(nullptr),
+      std::isfinite(t.max) ? Json(t.max) : Json(nullptr) });
+}
+
+/// A correction's "trusted_stretches"; absent (older files): unbounded.
+material::TrustedStretches trusted_from_json(const JsonObject& o) {
+  material::TrustedStretches t;
+  if (!o.has("trusted_stretches"))
+    return t;
+  const Json& j = o.json().at("trusted_stretches");
+  if (!j.is_array() || j.size() != 2 || !std::all_of(j.begin(), j.end(), [](const Json& v) {
+        return v.is_null() || v.is_number();
+      }))
+    o.fail("trusted_stretches", "expected [min, max] (numbers, or null for an unbounded end)");
+  if (!j[0].is_null())
+    t.min = j[0].get<double>();
+  if (!j[1].is_null())
+    t.max = j[1].get<double>();
+  return t;
+}
+
 Json rbf_to_json(const material::RbfCorrection& c) {
   const auto& p = c.parameters();
   // JSON has no infinity: "no floor" (−∞) is written as null.
@@ -52,9 +75,7 @@ Json rbf_to_json(const material::RbfCorrection& c) {
     { "damping_constant", p.damping_constant },
     { "damping_quadratic", vector_to_json(p.damping_quadratic) }, { "damping_floor", floor },
     // [min, max]; null for an unbounded end (JSON has no infinity)
-    { "trusted_stretches",
-        Json::array({ std::isfinite(p.trusted_min) ? Json(p.trusted_min) : Json(nullptr),
-            std::isfinite(p.trusted_max) ? Json(p.trusted_max) : Json(nullptr) }) } };
+    { "trusted_stretches", trusted_to_json(p.trusted) } };
 }
 
 Json nn_to_json(const material::NnCorrection& c) {
@@ -68,8 +89,10 @@ Json nn_to_json(const material::NnCorrection& c) {
     { "input_mean", vector_to_json(p.input_mean) },
     { "input_scale", vector_to_json(p.input_scale) }, { "output_mean", p.output_mean },
     { "output_scale", p.output_scale }, { "layers", std::move(layers) } };
-  if (p.kind == material::NnKind::Energy)
+  if (p.kind == material::NnKind::Energy) {
     out["polynomial"] = vector_to_json(p.polynomial);
+    out["trusted_stretches"] = trusted_to_json(p.trusted);
+  }
   if (p.damping)
     out["damping"] = rbf_to_json(*p.damping);
   return out;
@@ -172,24 +195,14 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
     p.damping_quadratic = read_vector(o, "damping_quadratic", 3);
   if (o.has("damping_floor") && !o.json().at("damping_floor").is_null())
     p.damping_floor = o.number("damping_floor");
-  if (o.has("trusted_stretches")) { // absent (older files): unbounded
-    const Json& t = o.json().at("trusted_stretches");
-    if (!t.is_array() || t.size() != 2 || !std::all_of(t.begin(), t.end(), [](const Json& v) {
-          return v.is_null() || v.is_number();
-        }))
-      o.fail("trusted_stretches", "expected [min, max] (numbers, or null for an unbounded end)");
-    if (!t[0].is_null())
-      p.trusted_min = t[0].get<double>();
-    if (!t[1].is_null())
-      p.trusted_max = t[1].get<double>();
-  }
+  p.trusted = trusted_from_json(o);
   return construct(
       o, [&] { return std::make_shared<const material::RbfCorrection>(std::move(p)); });
 }
 
 std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "kind", "activation", "input_mean", "input_scale", "output_mean",
-      "output_scale", "polynomial", "layers", "damping" });
+      "output_scale", "polynomial", "layers", "damping", "trusted_stretches" });
   material::NnCorrection::Parameters p;
   // Absent: the stress network with ELU (files written before the energy network).
   p.kind = o.has("kind") && o.choice("kind", { "stress", "energy" }) == "energy"
@@ -205,6 +218,7 @@ std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
     p.polynomial = read_vector(o, "polynomial", 6);
   else if (o.has("polynomial"))
     o.fail("polynomial", "is only for \"kind\": \"energy\"");
+  p.trusted = trusted_from_json(o); // a stress network refuses a bounded one
   // Scalars: one network g shared by the three principal directions (NnCorrection).
   p.output_mean = o.number("output_mean");
   p.output_scale = o.number("output_scale");

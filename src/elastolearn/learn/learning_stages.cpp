@@ -115,13 +115,13 @@ MatX trajectory_stretches(std::span<const ReconstructionMesh> meshes,
   return stacked;
 }
 
-/// The corrections' trusted interval (material::RbfCorrection::Parameters::trusted_min/max):
-/// every principal stretch of `stretches`, the trajectories a correction is learned from. With
-/// energy kernels a correction continues beyond it with the stiffness at its edge; stress kernels
-/// are not continued.
-std::pair<double, double> trusted_interval(const MatX& stretches, const RbfFitOptions& rbf) {
+/// The corrections' trusted stretches (material/trusted_stretches.hpp): the interval of every
+/// principal stretch of `stretches`, the trajectories a correction is learned from. With energy
+/// kernels a correction continues beyond it with the stiffness at its edge; stress kernels are
+/// not continued.
+material::TrustedStretches trusted_interval(const MatX& stretches, const RbfFitOptions& rbf) {
   if (!rbf.energy_kernels || stretches.size() == 0)
-    return { -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity() };
+    return {};
   return { stretches.minCoeff(), stretches.maxCoeff() };
 }
 
@@ -252,9 +252,8 @@ Reconstruction reconstruct_correction(std::span<const ReconstructionMesh> meshes
         { meshes[i], m.physics.dofs(), m.positions, m.velocities, m.targets, m.projection });
   }
   const MatX stretches = trajectory_stretches(meshes, trajectories, options);
-  const auto [trusted_min, trusted_max] = trusted_interval(stretches, options.rbf);
   const RbfDesign design(
-      rbf_centres(stretches, options, seed), options.rbf, trusted_min, trusted_max);
+      rbf_centres(stretches, options, seed), options.rbf, trusted_interval(stretches, options.rbf));
   const StressReconstructionResult reconstructed
       = reconstruct_rbf_correction(blocks, design, reconstruction);
   Reconstruction out;
@@ -292,10 +291,8 @@ ForwardFitStart forward_fit_start(std::span<const Motion> motions,
   const MatX centres
       = best ? MatX(best->parameters().centres) : rbf_centres(stretches, options, options.seed);
   // The best correction's own trusted interval, so that the design expresses it exactly.
-  const auto [trusted_min, trusted_max] = best
-      ? std::pair(best->parameters().trusted_min, best->parameters().trusted_max)
-      : trusted_interval(stretches, options.rbf);
-  RbfDesign design(centres, options.rbf, trusted_min, trusted_max);
+  RbfDesign design(centres, options.rbf,
+      best ? best->parameters().trusted : trusted_interval(stretches, options.rbf));
   VecX start = best ? design.unknowns(*best) : VecX(VecX::Zero(design.num_unknowns()));
   ForwardFitOptions fit_options = options.forward_fit;
   fit_options.max_iterations = remaining_steps;

@@ -46,8 +46,13 @@ NetworkDistillation distil_network(const sim::Scene& scene, const material::RbfC
   options.validate();
   NetworkDistillation d;
   const auto start = Clock::now();
+  // Within the teacher's trusted stretches: beyond them it is the continuation of its edge.
+  DistillationSampleOptions sampling = options.samples;
+  const material::TrustedStretches& trusted = teacher.parameters().trusted;
+  sampling.stretch_min = std::max(sampling.stretch_min, trusted.min);
+  sampling.stretch_max = std::min(sampling.stretch_max, trusted.max);
   const StressSamples samples
-      = distillation_samples(scene, options.motion_scales, teacher, options.samples, &d.sampled);
+      = distillation_samples(scene, options.motion_scales, teacher, sampling, &d.sampled);
   d.seconds_sampling = seconds_since(start);
   d.motions = static_cast<int>(options.motion_scales.size());
   d.kind = options.kind.value_or(
@@ -59,8 +64,11 @@ NetworkDistillation distil_network(const sim::Scene& scene, const material::RbfC
   if (d.kind == material::NnKind::Energy)
     training.energy_polynomial = rbf_energy_polynomial(teacher);
   const NnDistillationResult r = distill_nn_correction(samples, training);
-  d.correction
-      = std::make_shared<const material::NnCorrection>(with_teacher_damping(r.correction, teacher));
+  material::NnCorrection::Parameters network
+      = with_teacher_damping(r.correction, teacher).parameters();
+  if (d.kind == material::NnKind::Energy)
+    network.trusted = trusted; // continued beyond the teacher's data like the teacher
+  d.correction = std::make_shared<const material::NnCorrection>(std::move(network));
   d.training_states = r.training_samples;
   d.validation_states = r.validation_samples;
   d.epochs = r.training.epochs;

@@ -3,12 +3,14 @@
 #include <elastolearn/fem/tet_element.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/material/principal_stress.hpp>
+#include <elastolearn/sim/amplified_scene.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 namespace elastolearn::learn {
 
@@ -85,6 +87,8 @@ void DistillationSampleOptions::validate() const {
     fail("stretch_jitter", "must be finite and ≥ 0, got " + to_text(stretch_jitter));
   if (!std::isfinite(rate_jitter) || rate_jitter < 0)
     fail("rate_jitter", "must be finite and ≥ 0, got " + to_text(rate_jitter));
+  if (std::isnan(stretch_min) || std::isnan(stretch_max) || !(stretch_min <= stretch_max))
+    fail("stretch_min", "must be ≤ stretch_max");
 }
 
 void NnDistillationOptions::validate() const {
@@ -110,6 +114,7 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   std::mt19937_64 rng(o.seed);
   long seen = 0;
   const std::shared_ptr<const material::Correction> shared_teacher = teacher.clone();
+  const bool bounded = std::isfinite(o.stretch_min) || std::isfinite(o.stretch_max);
 
   for (const sim::Scene& original : scenes) {
     sim::Scene scene = original;
@@ -121,20 +126,26 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
     const sim::FrameSink sink = [&](int frame, double, const VecX& x, const VecX& v) {
       if (frame % o.frame_stride != 0)
         return;
-      for (Eigen::Index e = 0; e < tets.rows(); ++e, ++seen) {
-        Eigen::Index slot = seen;
-        if (seen >= k) {
-          slot = static_cast<Eigen::Index>(uniform01(rng) * double(seen + 1));
+      for (Eigen::Index e = 0; e < tets.rows(); ++e) {
+        const Eigen::Vector4i tet = tets.row(e).transpose();
+        const auto& r = rest[static_cast<std::size_t>(e)];
+        std::optional<material::PrincipalFrame> pf;
+        if (bounded) { // the interval needs every state's stretches, not only the kept ones'
+          pf = material::principal_frame(fem::deformation_gradient(fem::gather_tet(x, tet), r));
+          if (pf->stretches.minCoeff() < o.stretch_min || pf->stretches.maxCoeff() > o.stretch_max)
+            continue;
+        }
+        Eigen::Index slot = seen++;
+        if (slot >= k) {
+          slot = static_cast<Eigen::Index>(uniform01(rng) * double(slot + 1));
           if (slot >= k)
             continue;
         }
-        const Eigen::Vector4i tet = tets.row(e).transpose();
-        const auto& r = rest[static_cast<std::size_t>(e)];
-        const Mat3 F = fem::deformation_gradient(fem::gather_tet(x, tet), r);
+        if (!pf)
+          pf = material::principal_frame(fem::deformation_gradient(fem::gather_tet(x, tet), r));
         const Mat3 F_rate = fem::deformation_gradient(fem::gather_tet(v, tet), r);
-        const material::PrincipalFrame pf = material::principal_frame(F);
-        stretches.row(slot) = pf.stretches.transpose();
-        rates.row(slot) = material::stretch_rates(pf, F_rate).transpose();
+        stretches.row(slot) = pf->stretches.transpose();
+        rates.row(slot) = material::stretch_rates(*pf, F_rate).transpose();
       }
     };
     const sim::SimulationReport run = sim::run_simulation(scene, sink);
@@ -162,7 +173,8 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   for (Eigen::Index j = recorded; j < total; ++j) {
     const Eigen::Index src = j % recorded;
     for (int i = 0; i < 3; ++i) {
-      out.stretches(j, i) = stretches(src, i) + o.stretch_jitter * standard_normal(rng);
+      out.stretches(j, i) = std::clamp(stretches(src, i) + o.stretch_jitter * standard_normal(rng),
+          o.stretch_min, o.stretch_max);
       out.stretch_rates(j, i) = rates(src, i) + rate_sigma * standard_normal(rng);
     }
   }
@@ -213,25 +225,8 @@ std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const 
   for (double a : scales) {
     if (!std::isfinite(a))
       fail("motion_scales", "contains a non-finite factor " + to_text(a));
-    sim::Scene s = scene;
+    sim::Scene s = sim::amplified_scene(scene, a);
     s.name = scene.name + "_x" + to_text(a);
-    s.gravity *= a;
-    s.initial.velocity *= a;
-    s.initial.angular_velocity *= a;
-    for (auto& l : s.initial.static_loads)
-      l.total_force *= a;
-    if (s.initial.kind == sim::InitialCondition::Kind::Recorded) {
-      const Positions& rest = s.mesh.rest_positions();
-      s.initial.positions = rest + a * (s.initial.positions - rest);
-      s.initial.velocities *= a;
-    }
-    for (auto& l : s.loads)
-      l.total_force *= a;
-    for (auto& m : s.keyframes) {
-      m.amplitude *= a;
-      for (Vec3& offset : m.offsets)
-        offset *= a;
-    }
     out.push_back(std::move(s));
   }
   return out;

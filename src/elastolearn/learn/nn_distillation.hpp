@@ -16,6 +16,7 @@
 #include <elastolearn/sim/scene.hpp>
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -38,12 +39,18 @@ struct DistillationSampleOptions {
   /// (docs/learning.md: 0.25 made Newton fail at the first step, 10 at a faster test motion).
   double rate_jitter = 50;
   std::uint64_t seed = 1; ///< subsampling and jitter (same seed, same samples)
+  /// Only element states whose principal stretches all lie in [stretch_min, stretch_max] are
+  /// sampled, and jittered copies are clamped into it: the teacher's trusted stretches, beyond
+  /// which teacher and network are both continued from the edge (material/trusted_stretches.hpp)
+  /// and a larger motion's far states would only crowd the fit. Default: every state.
+  double stretch_min = -std::numeric_limits<double>::infinity();
+  double stretch_max = std::numeric_limits<double>::infinity();
   /// Throws InputError("distillation.<field>", ...) for an out-of-range field.
   void validate() const;
 };
 
 struct DistillationSampleReport {
-  long states_seen = 0; ///< element states over all recorded frames of all scenes
+  long states_seen = 0; ///< element states in the stretch interval over all recorded frames
   int recorded = 0; ///< kept after subsampling
   int jittered = 0; ///< jittered samples added
   int scenes_completed = 0; ///< simulations that ran all their frames

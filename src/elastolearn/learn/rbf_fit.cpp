@@ -34,14 +34,12 @@ void RbfFitOptions::validate() const {
 }
 
 RbfDesign::RbfDesign(
-    ConstRef<MatX> centres, const RbfFitOptions& options, double trusted_min, double trusted_max)
+    ConstRef<MatX> centres, const RbfFitOptions& options, material::TrustedStretches trusted)
     : m_options(options)
-    , m_trusted_min(trusted_min)
-    , m_trusted_max(trusted_max) {
+    , m_trusted(trusted) {
   options.validate();
-  if (std::isnan(trusted_min) || std::isnan(trusted_max) || !(trusted_min <= trusted_max))
-    fail("trusted_stretches", "must be an interval [min, max] with min ≤ max");
-  if (!options.energy_kernels && (std::isfinite(trusted_min) || std::isfinite(trusted_max)))
+  trusted.validate("rbf_fit.trusted_stretches");
+  if (!options.energy_kernels && trusted.bounded())
     fail("trusted_stretches", "needs energy kernels (stress kernels have no energy to continue)");
   if (centres.rows() < 1 || centres.cols() != 3)
     fail("centres",
@@ -92,8 +90,7 @@ const Eigen::Matrix<double, 4, 3>& energy_tail_map() {
 } // namespace
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
-  const Vec3 c = stretches.cwiseMax(m_trusted_min).cwiseMin(m_trusted_max);
-  if (c != stretches) {
+  if (m_trusted.nearest(stretches) != stretches) {
     // Outside the trusted interval (energy kernels only): the continuation needs ∂A/∂σ. Per
     // thread, sized once per design size: no allocation in the per-element loops.
     thread_local OutputGradient gradient;
@@ -138,7 +135,7 @@ void RbfDesign::view_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
     Eigen::Ref<OutputGradient> gradient) const {
-  const Vec3 c = stretches.cwiseMax(m_trusted_min).cwiseMin(m_trusted_max);
+  const Vec3 c = m_trusted.nearest(stretches);
   formula_matrix(c, out, gradient);
   if (c == stretches)
     return;
@@ -226,8 +223,7 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
   p.centres = m_centres;
   p.epsilon = m_options.epsilon;
   p.energy_kernels = m_options.energy_kernels;
-  p.trusted_min = m_trusted_min;
-  p.trusted_max = m_trusted_max;
+  p.trusted = m_trusted;
   p.weights = x.head(m);
   p.constant = -p.weights.dot(m_rest_kernels); // N(1) = 0 under stress_free_rest
   if (m_options.elastic_polynomial) {
@@ -260,8 +256,8 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   const auto& p = c.parameters();
   const Eigen::Index m = m_centres.rows();
   if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon
-      || p.energy_kernels != m_options.energy_kernels || p.trusted_min != m_trusted_min
-      || p.trusted_max != m_trusted_max)
+      || p.energy_kernels != m_options.energy_kernels || p.trusted.min != m_trusted.min
+      || p.trusted.max != m_trusted.max)
     fail("correction",
         "its centres, kernel smoothing, kernel kind or trusted stretches differ from the design's");
   const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();

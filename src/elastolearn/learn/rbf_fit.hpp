@@ -63,13 +63,12 @@ struct RbfFitOptions {
 class RbfDesign {
   public:
   using OutputMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic>;
-  /// `centres` m × 3 (m ≥ 1, finite). With energy kernels, [trusted_min, trusted_max] is the
-  /// corrections' trusted interval of stretches (material::RbfCorrection::Parameters): A(σ)
-  /// continues there as N does, A(c) + ∂A/∂σ(c)(σ − c) with c = clamp(σ), so that N = A x holds
-  /// everywhere. Throws InputError for invalid options, centres or interval.
+  /// `centres` m × 3 (m ≥ 1, finite). With energy kernels, `trusted` is the corrections' trusted
+  /// stretches (material/trusted_stretches.hpp): A(σ) continues beyond them as N does,
+  /// A(c) + ∂A/∂σ(c)(σ − c), so that N = A x holds everywhere. Throws InputError for invalid
+  /// options, centres or interval.
   RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options,
-      double trusted_min = -std::numeric_limits<double>::infinity(),
-      double trusted_max = std::numeric_limits<double>::infinity());
+      material::TrustedStretches trusted = {});
   int num_centres() const { return static_cast<int>(m_centres.rows()); }
   /// m (+ 2 or 3 with the tail, + 4 quadratic, or 3 with energy kernels, + 2 neo-Hookean)
   int elastic_unknowns() const { return m_elastic; }
@@ -96,8 +95,7 @@ class RbfDesign {
   /// prestress N(1) ≠ 0 under stress_free_rest).
   VecX unknowns(const material::RbfCorrection& correction) const;
 
-  double trusted_min() const { return m_trusted_min; }
-  double trusted_max() const { return m_trusted_max; }
+  const material::TrustedStretches& trusted() const { return m_trusted; }
 
   private:
   /// A(σ) and its derivative, without the continuation.
@@ -114,7 +112,7 @@ class RbfDesign {
   int m_neo_hookean = -1; ///< first column of r, or −1
   int m_elastic = 0;
   int m_damping = 0;
-  double m_trusted_min, m_trusted_max;
+  material::TrustedStretches m_trusted;
 };
 
 /// Stress samples: row j is one element at one frame.

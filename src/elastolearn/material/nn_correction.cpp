@@ -321,6 +321,9 @@ NnCorrection::NnCorrection(Parameters p)
     fail("polynomial", "contains a non-finite value");
   if (m_p.kind == NnKind::Stress && !m_p.polynomial.isZero(0))
     fail("polynomial", "is only for an energy network; a stress network's must be zero");
+  m_p.trusted.validate("nn_correction.trusted_stretches");
+  if (m_p.kind == NnKind::Stress && m_p.trusted.bounded())
+    fail("trusted_stretches", "is only for an energy network (a stress network has no energy)");
   if (m_p.layers.empty())
     fail("layers",
         "is empty; at least the output layer (1 × " + std::to_string(inputs) + ") is required");
@@ -680,6 +683,12 @@ Vec3 NnCorrection::energy_chain(
 double NnCorrection::elastic_energy(const Vec3& stretches) const {
   if (m_p.kind != NnKind::Energy)
     fail("kind", "a stress network has no energy");
+  return continued_energy(
+      m_p.trusted, stretches, [&](const Vec3& s) { return formula_energy(s); },
+      [&](const Vec3& s, Mat3* h) { return energy_correction(s, h); });
+}
+
+double NnCorrection::formula_energy(const Vec3& stretches) const {
   const Vec3 p = power_sums(stretches), x = energy_input(stretches);
   std::array<double, k_max> a;
   int width = 3;
@@ -709,7 +718,8 @@ double NnCorrection::elastic_energy(const Vec3& stretches) const {
 
 Vec3 NnCorrection::correction(const Vec3& stretches, const Vec3& stretch_rates) const {
   if (m_p.kind == NnKind::Energy)
-    return energy_correction(stretches, nullptr);
+    return continued_correction(m_p.trusted, stretches, nullptr,
+        [&](const Vec3& s, Mat3* h) { return energy_correction(s, h); });
   return stress_correction(stretches, stretch_rates, nullptr, nullptr);
 }
 
@@ -717,7 +727,8 @@ Vec3 NnCorrection::correction_with_gradient(
     const Vec3& s, const Vec3& f, Mat3& d_stretches, Mat3& d_stretch_rates) const {
   if (m_p.kind == NnKind::Energy) {
     d_stretch_rates.setZero();
-    return energy_correction(s, &d_stretches);
+    return continued_correction(m_p.trusted, s, &d_stretches,
+        [&](const Vec3& c, Mat3* h) { return energy_correction(c, h); });
   }
   return stress_correction(s, f, &d_stretches, &d_stretch_rates);
 }

@@ -122,6 +122,9 @@ class NnCorrection final : public Correction {
     /// elastic part enough that its simulations diverged (docs/learning.md). Null = no damping
     /// correction. Its elastic part must be zero.
     std::shared_ptr<const RbfCorrection> damping;
+    /// Energy kind: the stretches it was learned from (its teacher's); beyond them ΔΨ is
+    /// continued by its second-order expansion at the edge (material/trusted_stretches.hpp).
+    TrustedStretches trusted;
   };
 
   /// Throws InputError("nn_correction.<field>", ...) — e.g. "nn_correction.layers[1].weight" —
@@ -159,7 +162,9 @@ class NnCorrection final : public Correction {
   Eigen::Array4d stress_lanes(const Eigen::Array4d* x, Eigen::Array4d* d_x) const;
   /// Stress kind: N and, if wanted, its gradients.
   Vec3 stress_correction(const Vec3& s, const Vec3& f, Mat3* d_stretches, Mat3* d_rates) const;
-  /// Energy kind: N = ∇ΔΨ and, if `hessian` is non-null, ∇²ΔΨ.
+  /// Energy kind: ΔΨ(σ) without the continuation.
+  double formula_energy(const Vec3& stretches) const;
+  /// Energy kind: N = ∇ΔΨ and, if `hessian` is non-null, ∇²ΔΨ (without the continuation).
   Vec3 energy_correction(const Vec3& s, Mat3* hessian) const;
   /// Energy kind: ∇_x g of the MLP part at x = energy_input(σ) and, if `hessian_x` is
   /// non-null, ∇²_x g (any architecture; the common ones run fixed-size kernels instead).

@@ -135,10 +135,8 @@ RbfCorrection::RbfCorrection(Parameters p)
   if (!std::isfinite(m_p.epsilon) || m_p.epsilon < 0) {
     fail("epsilon", "must be finite and ≥ 0, got " + to_text(m_p.epsilon));
   }
-  if (std::isnan(m_p.trusted_min) || std::isnan(m_p.trusted_max)
-      || !(m_p.trusted_min <= m_p.trusted_max))
-    fail("trusted_stretches", "must be an interval [min, max] with min ≤ max");
-  if (!m_p.energy_kernels && (std::isfinite(m_p.trusted_min) || std::isfinite(m_p.trusted_max)))
+  m_p.trusted.validate("rbf_correction.trusted_stretches");
+  if (!m_p.energy_kernels && m_p.trusted.bounded())
     fail("trusted_stretches", "needs energy kernels (stress kernels have no energy to continue)");
   if (m_p.energy_kernels && !is_energy_quadratic_tail(m_p.quadratic))
     fail("quadratic",
@@ -215,12 +213,9 @@ Vec3 RbfCorrection::energy_kernels_sum(const Vec3& stretches, Mat3* hessian) con
 double RbfCorrection::elastic_energy(const Vec3& stretches) const {
   if (!m_p.energy_kernels)
     fail("energy_kernels", "the correction is not an energy (stress kernels)");
-  const Vec3 c = trusted_point(stretches);
-  if (c == stretches)
-    return formula_energy(stretches);
-  Mat3 hessian;
-  const Vec3 n = formula(c, &hessian), d = stretches - c;
-  return formula_energy(c) + n.dot(d) + 0.5 * d.dot(hessian * d);
+  return continued_energy(
+      m_p.trusted, stretches, [&](const Vec3& s) { return formula_energy(s); },
+      [&](const Vec3& s, Mat3* h) { return formula(s, h); });
 }
 
 double RbfCorrection::formula_energy(const Vec3& stretches) const {
@@ -342,9 +337,8 @@ Vec3 RbfCorrection::correction(const Vec3& stretches, const Vec3& /*stretch_rate
 Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& /*stretch_rates*/,
     Mat3& d_stretches, Mat3& d_stretch_rates) const {
   d_stretch_rates.setZero();
-  const Vec3 c = trusted_point(stretches);
-  const Vec3 n = formula(c, &d_stretches);
-  return c == stretches ? n : Vec3(n + d_stretches * (stretches - c));
+  return continued_correction(
+      m_p.trusted, stretches, &d_stretches, [&](const Vec3& s, Mat3* h) { return formula(s, h); });
 }
 
 Vec3 RbfCorrection::formula(const Vec3& stretches, Mat3* d_stretches) const {
@@ -381,12 +375,8 @@ std::unique_ptr<Correction> RbfCorrection::clone() const {
 }
 
 Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
-  const Vec3 c = trusted_point(stretches);
-  if (c == stretches)
-    return formula(stretches, nullptr);
-  Mat3 hessian;
-  const Vec3 n = formula(c, &hessian);
-  return n + hessian * (stretches - c);
+  return continued_correction(
+      m_p.trusted, stretches, nullptr, [&](const Vec3& s, Mat3* h) { return formula(s, h); });
 }
 
 bool RbfCorrection::has_damping() const {

@@ -3,6 +3,7 @@
 /// an isotropic elastic RBF in the principal stretches plus a stretch-dependent correction Δα₁
 /// of the Rayleigh stiffness-damping coefficient. Rationale and conventions: docs/learning.md.
 #include <elastolearn/material/correction.hpp>
+#include <elastolearn/material/trusted_stretches.hpp>
 
 #include <array>
 #include <cmath>
@@ -114,17 +115,10 @@ class RbfCorrection final : public Correction {
     /// the quadratic tail in the energy subspace (is_energy_quadratic_tail); the linear and
     /// neo-Hookean tails are gradients already.
     bool energy_kernels = false;
-    /// The stretches the correction was learned from, [trusted_min, trusted_max] for every
-    /// principal stretch (energy kernels only). Outside, ΔΨ is continued by its second-order
-    /// Taylor expansion at the nearest trusted point c = clamp(σ): N(σ) = N(c) + H(c)(σ − c),
-    /// H = ∇²ΔΨ, so the correction's stiffness stays what it is at the edge of its data instead of
-    /// following its polynomial tails or kernels where no data constrained them (a cubic tail
-    /// fitted to a droop turned a corrected material unstable by s₁ ≈ 1.5 and let elements of a
-    /// droop driven 1.5× as hard stretch to 3.6; docs/learning_recipe.md). C¹ across the edge (N
-    /// and, up to H's variation, ∂N/∂σ continuous); symmetric in σ like ΔΨ. The default
-    /// (−∞, ∞) evaluates ΔΨ everywhere.
-    double trusted_min = -std::numeric_limits<double>::infinity();
-    double trusted_max = std::numeric_limits<double>::infinity();
+    /// The stretches the correction was learned from (energy kernels only): beyond them ΔΨ is
+    /// continued by its second-order expansion at the edge (material/trusted_stretches.hpp). The
+    /// default (−∞, ∞) evaluates ΔΨ everywhere.
+    TrustedStretches trusted;
   };
 
   /// Throws InputError("rbf_correction.<field>", ...) if sizes disagree (weights ≠ m entries,
@@ -161,10 +155,6 @@ class RbfCorrection final : public Correction {
   Vec3 formula(const Vec3& stretches, Mat3* d_stretches) const;
   /// ΔΨ(σ) without the continuation (energy kernels).
   double formula_energy(const Vec3& stretches) const;
-  /// The nearest trusted point clamp(σ, trusted_min, trusted_max); equal to σ inside.
-  Vec3 trusted_point(const Vec3& stretches) const {
-    return stretches.cwiseMax(m_p.trusted_min).cwiseMin(m_p.trusted_max);
-  }
   /// The tails' part of h(y) (all but the kernels) and, if d_y is non-null, its ∂/∂y.
   double elastic_tail(const Vec3& y, Vec3* d_y) const;
   /// h(y_k) of the three views y_k = column k of `y` and, if d_y is non-null, column k of *d_y =

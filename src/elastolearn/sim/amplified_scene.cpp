@@ -7,8 +7,8 @@
 namespace elastolearn::sim {
 
 Scene amplified_scene(Scene scene, double factor) {
-  if (!(factor > 0 && std::isfinite(factor)))
-    throw InputError("factor", "must be positive and finite, got " + to_text(factor));
+  if (!std::isfinite(factor))
+    throw InputError("factor", "must be finite, got " + to_text(factor));
   scene.gravity *= factor;
   for (PointLoad& load : scene.loads)
     load.total_force *= factor;

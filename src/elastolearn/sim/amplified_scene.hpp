@@ -11,8 +11,8 @@ namespace elastolearn::sim {
 /// displacement from rest and its velocities, and the keyframes' amplitudes and offsets, each
 /// scaled by `factor`. Every drive of a scene is linear in these, so for a linear material (or
 /// any material at small strain) the displacements from rest scale by `factor`; for a nonlinear
-/// one it is the larger motion of the same kind. Throws InputError("factor", ...) unless factor
-/// is positive and finite.
+/// one it is the larger motion of the same kind (a negative factor mirrors the drive, 0 leaves
+/// the object at rest). Throws InputError("factor", ...) unless factor is finite.
 Scene amplified_scene(Scene scene, double factor);
 
 } // namespace elastolearn::sim
