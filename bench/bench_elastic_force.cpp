@@ -1,6 +1,7 @@
-// The per-element stress and damping kernel (fem/element_stress.hpp) through its three callers,
-// on the clamped bar of bench_fem_step at 1.5k / 12k tets (E = 3e5, ν = 0.4, Rayleigh α₀ = 0.2,
-// α₁ = 0.005) at one smoothly deformed, rotated and moving state (stretches about 1 ± 0.1):
+// The per-element stress and damping kernel (material/element_stress.hpp) through its three
+// callers, on the clamped bar of bench_fem_step at 1.5k / 12k tets (E = 3e5, ν = 0.4, Rayleigh
+// α₀ = 0.2, α₁ = 0.005) at one smoothly deformed, rotated and moving state (stretches about
+// 1 ± 0.1):
 //   ElasticForce/<material>: fem::ElasticForce::add_force, the simulator's hot path (forces and
 //     the cache add_jacobian reuses). Materials: nominal; scaled = nominal with a per-element
 //     stiffness scale in [0.5, 2]; rbf = nominal + the 40-centre RBF with damping of
