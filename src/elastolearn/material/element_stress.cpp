@@ -23,19 +23,16 @@ ElementStress element_stress(
     out.nominal.stress *= material.stiffness_scale;
     out.nominal.d_stretches *= material.stiffness_scale;
   }
-  if (correction != nullptr) {
+  if (correction != nullptr)
     out.correction = correction->correction_with_gradient(
         stretches, stretch_rates, out.correction_d_stretches, out.correction_d_rates);
-  } else {
-    out.correction.setZero();
-    out.correction_d_stretches.setZero();
-    out.correction_d_rates.setZero();
-  }
   if (elastic != nullptr)
     out.alpha1_change
         = corrected_stiffness_damping(out.alpha.alpha1, correction, stretches) - out.alpha.alpha1;
+  if (correction == nullptr)
+    return out;
   // N(σ, 0) only where something damps it: a rate-dependent correction is evaluated again.
-  if (correction != nullptr && out.has_damping()) {
+  if (out.has_damping()) {
     if (correction->depends_on_rates()) {
       Mat3 unused;
       out.correction_elastic.stress = correction->correction_with_gradient(

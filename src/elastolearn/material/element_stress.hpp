@@ -43,14 +43,14 @@ struct ElementMaterial {
 struct ElementStress {
   StressPair nominal; ///< s P̂(σ), s ∂P̂/∂σ (zero without an elastic model)
   bool has_correction = false; ///< whether the material has a correction (else N ≡ 0, Δα₁ = 0)
-  // The correction's fields are set by element_stress (zero without a correction), not zeroed
-  // by default: the simulator's element loop should not write them twice.
+  // The correction's fields are valid only if has_correction (left unset otherwise: the
+  // simulator's element loop without a correction should not write them).
   Vec3 correction {}; ///< N(σ, ḟ) [Pa]
   Mat3 correction_d_stretches {}; ///< ∂N/∂σ at (σ, ḟ)
   Mat3 correction_d_rates {}; ///< ∂N/∂ḟ at (σ, ḟ) [Pa·s]
   /// N(σ, 0) and ∂N/∂σ there: the correction's share of the stiffness α₁ damps (the damping
-  /// tangent of a rate-dependent N would blow up where σᵢ ≈ σⱼ but ḟᵢ ≠ ḟⱼ). Zero unless
-  /// has_correction and has_damping().
+  /// tangent of a rate-dependent N would blow up where σᵢ ≈ σⱼ but ḟᵢ ≠ ḟⱼ). Zero if nothing
+  /// damps it (has_damping() false).
   StressPair correction_elastic { Vec3 {}, Mat3 {} };
   RayleighCoefficients alpha; ///< the damping model's α₀ [1/s], α₁ [s] at σ₀ (0 without one)
   double alpha1_change = 0; ///< Δα₁ as applied: (α₁ + Δα₁)⁺ − α₁ ≥ −α₁ [s]
@@ -70,6 +70,8 @@ struct ElementStress {
   const StressPair& damped_per_alpha1_change() const { return nominal; }
   /// α₁ N(σ, 0) + Δα₁ s P̂: damped() with the correction minus damped() without it.
   StressPair damped_by_correction() const {
+    if (!has_correction)
+      return {};
     const double weight = correction_damping_weight();
     const StressPair& per_change = damped_per_alpha1_change();
     return { weight * correction_elastic.stress + alpha1_change * per_change.stress,
