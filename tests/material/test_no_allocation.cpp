@@ -3,6 +3,7 @@
 #include "model_zoo.hpp"
 
 #include <elastolearn/material/analytic_correction.hpp>
+#include <elastolearn/material/element_stress.hpp>
 #include <elastolearn/material/nn_correction.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/material/stretch_dependent_rayleigh.hpp>
@@ -86,8 +87,13 @@ TEST(NoAllocation, PerElementMaterialFunctionsDoNotAllocate) {
       const Mat3 P = first_piola(frame, cs.stress);
       const Mat9 D = first_piola_derivative(frame, cs.stress, cs.d_stretches, true);
       const Mat9 Dr = first_piola_rate_derivative(frame, cs.d_stretch_rates);
+      // The element kernel as fem::ElasticForce runs it (rate-dependent N, damping, a scale).
+      const ElementStress es
+          = element_stress({ model.get(), &correction, &damping, 1.5 }, frame.stretches, rates);
+      const PrincipalTangent Td = damping_tangent(frame, es.damped(), DampingTangent::FlipFree);
+      const Mat3 Pe = element_first_piola(frame, es.corrected().stress, &Td, F_rate);
       sink += P.sum() + D.sum() + Dr.sum() + model->energy(frame.stretches)
-          + damping.coefficients(frame.stretches[0]).alpha1;
+          + damping.coefficients(frame.stretches[0]).alpha1 + Pe.sum();
     }
   }
   counting = false;

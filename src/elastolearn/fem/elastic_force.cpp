@@ -1,6 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/fem/elastic_force.hpp>
-#include <elastolearn/material/principal_stress.hpp>
+#include <elastolearn/material/element_stress.hpp>
 
 #include <tbb/parallel_for.h>
 
@@ -60,63 +60,44 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
   if (m_cache.size() != static_cast<size_t>(m))
     m_cache.resize(m);
 
+  const material::ElementMaterial homogeneous { elastic, correction, damping, 1.0 };
+  const bool need_rate = correction != nullptr || damping != nullptr;
+  const bool need_rates = correction != nullptr && correction->depends_on_rates();
+
   tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
+    material::ElementMaterial element = homogeneous;
     for (int e = r.begin(); e < r.end(); ++e) {
       const TetRestData& rest = m_rest[e];
       ElementCache& c = m_cache[e];
-      const double scale = scales ? scales[e] : 1.0;
+      if (scales)
+        element.stiffness_scale = scales[e];
       const Eigen::Vector4i tet = m_tets.row(e).transpose();
       const auto xe = gather_tet(state.x, tet);
       const auto ve = gather_tet(state.v, tet);
       c.frame = material::principal_frame(deformation_gradient(xe, rest));
-      const Vec3& stretches = c.frame.stretches;
-      Vec3 rates = Vec3::Zero();
-      const bool need_rate = correction || (damping != nullptr);
       Mat3 F_rate;
       if (need_rate)
         F_rate = deformation_gradient(ve, rest);
-      if (correction && correction->depends_on_rates())
-        rates = material::stretch_rates(c.frame, F_rate);
-      c.stress
-          = material::corrected_principal_stress(*elastic, correction, stretches, rates, scale);
-      Mat3 P = material::first_piola(c.frame, c.stress.stress);
-      c.alpha = damping ? damping->coefficients(stretches[0]) : material::RayleighCoefficients {};
-      // A learned Δα₁ scales the nominal stiffness (paper Eq. 13); the total never turns negative.
-      c.alpha1_change = material::corrected_stiffness_damping(c.alpha.alpha1, correction, stretches)
-          - c.alpha.alpha1;
-      c.has_damping = c.alpha.alpha1 != 0 || c.alpha1_change != 0;
-      if (c.has_damping) {
-        // Stiffness damping −(α₁ K_e + Δα₁ K_e^nom) v_e = −vol (dP_d/dF : Ḟ) G: a directional
-        // derivative, no 9×9 or 12×12. K_e is the corrected model's damping stiffness, the learned
-        // Δα₁ acts on the nominal one (see the class comment). Unprojected: the PSD projection is
-        // Newton's device (add_jacobian), and the damping force must stay linear in the
-        // correction.
-        material::CorrectedStress scratch;
-        const material::CorrectedStress& elastic_stress
-            = material::elastic_part(*elastic, correction, stretches, c.stress, scratch, scale);
-        if (c.alpha1_change == 0) {
-          c.damping = material::damping_tangent(
-              c.frame, elastic_stress.stress, elastic_stress.d_stretches, m_damping_tangent);
-          c.damping_scale = c.alpha.alpha1;
-        } else {
-          // One tangent of the weighted stresses instead of two tangents weighted.
-          const double a1 = c.alpha.alpha1, da1 = scale * c.alpha1_change;
-          c.damping = material::damping_tangent(c.frame,
-              a1 * elastic_stress.stress + da1 * elastic->principal_stress(stretches),
-              a1 * elastic_stress.d_stretches
-                  + da1 * elastic->principal_stress_derivative(stretches),
-              m_damping_tangent);
-          c.damping_scale = 1;
-        }
-        P += c.damping_scale * material::first_piola_differential(c.frame, c.damping, F_rate);
-      }
+      const Vec3 rates = need_rates ? material::stretch_rates(c.frame, F_rate) : Vec3::Zero();
+      // The element's stress and stiffness damping (material::element_stress states which
+      // stiffness α₁ and Δα₁ damp); the damping tangent is unprojected: the PSD projection is
+      // Newton's device (add_jacobian), and the damping force must stay linear in the correction.
+      const material::ElementStress stress
+          = material::element_stress(element, c.frame.stretches, rates);
+      c.stress = stress.corrected();
+      c.alpha0 = stress.alpha.alpha0;
+      c.has_damping = stress.has_damping();
+      if (c.has_damping)
+        c.damping = material::damping_tangent(c.frame, stress.damped(), m_damping_tangent);
+      const Mat3 P = material::element_first_piola(
+          c.frame, c.stress.stress, c.has_damping ? &c.damping : nullptr, F_rate);
       Eigen::Map<Eigen::Matrix<double, 3, 4>> force(m_force_buffer.data() + 12 * e);
       force.noalias() = -rest.volume * P * rest.gradients;
-      if (c.alpha.alpha0 != 0) {
+      if (c.alpha0 != 0) {
         if (m_mass == MassType::Lumped) {
-          force -= c.alpha.alpha0 * (density * rest.volume / 4.0) * ve;
+          force -= c.alpha0 * (density * rest.volume / 4.0) * ve;
         } else {
-          Eigen::Map<Vec12>(force.data()) -= c.alpha.alpha0
+          Eigen::Map<Vec12>(force.data()) -= c.alpha0
               * (consistent_mass_block(rest.volume, density) * Eigen::Map<const Vec12>(ve.data()));
         }
       }
@@ -151,17 +132,17 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
           c.frame, c.stress.stress, c.stress.d_stretches, m_project_tangent);
     } else {
       tangent = weighted_sum(c_x,
-          material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, false),
-          c_v * c.damping_scale, c.damping);
+          material::principal_tangent(c.frame, c.stress.stress, c.stress.d_stretches, false), c_v,
+          c.damping);
       if (m_project_tangent)
         tangent = material::projected(tangent);
     }
     J = element_stiffness(c.frame, tangent, rest, c.has_damping ? 1.0 : c_x);
-    if (c.alpha.alpha0 != 0) {
+    if (c.alpha0 != 0) {
       if (m_mass == MassType::Lumped) {
-        J.diagonal().array() += c_v * c.alpha.alpha0 * density * rest.volume / 4.0;
+        J.diagonal().array() += c_v * c.alpha0 * density * rest.volume / 4.0;
       } else {
-        J += c_v * c.alpha.alpha0 * consistent_mass_block(rest.volume, density);
+        J += c_v * c.alpha0 * consistent_mass_block(rest.volume, density);
       }
     }
     if (correction && c_v != 0 && !c.stress.d_stretch_rates.isZero(0)) {
@@ -170,7 +151,7 @@ void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v,
       // separately would overstate the damping and stall Newton.
       Mat3 rayleigh = Mat3::Zero();
       if (c.has_damping)
-        rayleigh = c.damping_scale * c.damping.block;
+        rayleigh = c.damping.block;
       if (m_project_tangent)
         rayleigh = material::symmetric_psd(rayleigh);
       const Mat3 d_rates = m_project_tangent

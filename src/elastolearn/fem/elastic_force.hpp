@@ -7,7 +7,7 @@
 #include <elastolearn/material/correction.hpp>
 #include <elastolearn/material/damping_model.hpp>
 #include <elastolearn/material/elastic_model.hpp>
-#include <elastolearn/material/principal_stress.hpp>
+#include <elastolearn/material/element_stress.hpp>
 #include <elastolearn/mesh/tet_mesh.hpp>
 
 #include <memory>
@@ -30,23 +30,21 @@ struct MaterialModel {
 
 /// Elastic (+correction) and Rayleigh damping forces of all tets, with their Jacobians.
 ///
-/// Per element: F = Σ x_a g_aᵀ, SVD F = U F̂ Vᵀ, P = U (s_e P̂ + N) Vᵀ, f_a = −vol P g_a (s_e the
-/// element's stiffness scale, 1 for a homogeneous material; P̂ below stands for s_e P̂);
-/// K_e = vol Bᵀ (dP/dF) B of the corrected model (clamped PSD in the Jacobian); damping force
-///   −α₁ K_e^d v_e − Δα₁ K_e^nom,d v_e − α₀ M_e v_e
-/// with (α₀, α₁) the damping model's, from the element's largest stretch, and M_e the element's
-/// lumped or consistent mass (the scene's). K_e^d is the damping stiffness the damping model
-/// names (material::DampingTangent: the exact tangent, or the exact tangent without its flip
-/// part), unprojected (a projected one would make the force nonlinear in the correction:
-/// docs/learning.md, "Damping part") and evaluated at the end-of-step state, of the *corrected*
-/// stress P̂ + N(σ, 0): a material whose elasticity is learned right is damped as its own Rayleigh
-/// damping would. The learned Δα₁ = Correction::stiffness_damping(F̂) (paper Eq. 13; α₁ + Δα₁
-/// kept ≥ 0) scales the same kind of tangent of the nominal P̂ (independent of the correction's
-/// unknowns), so that the damping force stays linear in them (learn::reconstruct_rbf_correction)
-/// and, where N = 0, a learned Δα₁ is exactly a change of α₁. The correction's rate dependence
-/// adds D_e = vol Bᵀ ∂P/∂Ḟ B (symmetrised, clamped PSD). The Jacobian drops ∂K/∂x·v (Rayleigh)
-/// and the variation of Ḟ̂ through U, V (correction), and projects c_x K_e + c_v (α₁ K_e^d +
-/// Δα₁ K_e^nom,d) as a whole: standard, and the residual is still exact.
+/// Per element: F = Σ x_a g_aᵀ, SVD F = U F̂ Vᵀ, and the element's stress from the one kernel
+/// material::element_stress (which states the physics: docs/learning.md, "Damping part"):
+///   P = U (s_e P̂ + N) Vᵀ + (dP_d/dF : Ḟ),   f_a = −vol P g_a − α₀ (M_e v_e)_a
+/// with s_e the element's stiffness scale (1 for a homogeneous material), (α₀, α₁) the damping
+/// model's, from the element's largest stretch, M_e the element's lumped or consistent mass (the
+/// scene's) and dP_d/dF = α₁ K^d(s_e P̂ + N(σ, 0)) + Δα₁ K^d(s_e P̂), K^d the damping tangent the
+/// damping model names (material::DampingTangent), unprojected and evaluated at the end-of-step
+/// state: the nominal α₁ damps the *corrected* stiffness, the learned Δα₁ =
+/// Correction::stiffness_damping(F̂) (paper Eq. 13; α₁ + Δα₁ kept ≥ 0) the nominal one, so that
+/// the damping force stays linear in the correction's unknowns (learn::correction_force and
+/// learn::CorrectionForceJacobian apply the correction's part of the same kernel).
+/// K_e = vol Bᵀ (dP/dF) B of the corrected stress (clamped PSD in the Jacobian); the correction's
+/// rate dependence adds D_e = vol Bᵀ ∂P/∂Ḟ B (symmetrised, clamped PSD). The Jacobian drops
+/// ∂K/∂x·v (Rayleigh) and the variation of Ḟ̂ through U, V (correction), and projects c_x K_e +
+/// c_v vol Bᵀ (dP_d/dF) B as a whole: standard, and the residual is still exact.
 /// Element loops run in parallel (oneTBB): forces into per-element buffers gathered without
 /// locks, element matrices straight into the SystemMatrix (SystemMatrix::add_elements).
 class ElasticForce final : public ForceTerm {
@@ -75,16 +73,11 @@ class ElasticForce final : public ForceTerm {
   /// What the force pass leaves for the Jacobian pass, per element.
   struct ElementCache {
     material::PrincipalFrame frame;
-    material::CorrectedStress stress;
-    material::RayleighCoefficients alpha; ///< the damping model's (nominal) α₀, α₁
-    /// A correction's Δα₁ as applied: (α₁ + Δα₁)⁺ − α₁ ≥ −α₁ (0 without a correction).
-    double alpha1_change = 0;
-    /// The damping stiffness α₁ K_e^d + Δα₁ K_e^nom,d as damping_scale · damping (valid if
-    /// has_damping): without a Δα₁, damping = material::damping_tangent of P̂ + N and
-    /// damping_scale = α₁; with one, damping = the damping tangent of α₁ (P̂ + N) + Δα₁ P̂ (the
-    /// eigen-form is linear in the stress and its derivative) and damping_scale = 1.
+    material::CorrectedStress stress; ///< material::ElementStress::corrected
+    double alpha0 = 0; ///< the damping model's α₀ [1/s]
+    /// The stiffness-damping tangent dP_d/dF = α₁ K^d + Δα₁ K^nom,d: material::damping_tangent
+    /// of material::ElementStress::damped (valid if has_damping).
     material::PrincipalTangent damping;
-    double damping_scale = 0;
     bool has_damping = false;
   };
   bool cache_matches(const ForceState& state) const;

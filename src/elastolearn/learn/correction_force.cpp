@@ -2,6 +2,7 @@
 #include <elastolearn/core/format.hpp>
 #include <elastolearn/learn/correction_force.hpp>
 #include <elastolearn/learn/element_force_operator.hpp>
+#include <elastolearn/material/element_stress.hpp>
 
 #include <tbb/parallel_for.h>
 
@@ -26,9 +27,15 @@ std::vector<std::array<int, 12>> element_free_rows(
   return rows;
 }
 
-/// Nominal Rayleigh α₁ of an element (0 without a damping model).
-double nominal_alpha1(const ReconstructionMesh& mesh, const Vec3& stretches) {
-  return mesh.nominal.damping ? mesh.nominal.damping->coefficients(stretches[0]).alpha1 : 0.0;
+/// Element e's material for the kernel (material::element_stress): the nominal one of `mesh`
+/// with `correction` (may be null). Without a nominal elastic model the correction contributes
+/// its N term only: no nominal stress and no damping.
+material::ElementMaterial element_material(
+    const ReconstructionMesh& mesh, const material::Correction* correction, int e) {
+  const fem::MaterialModel& nominal = mesh.nominal;
+  return { nominal.elastic.get(), correction,
+    nominal.elastic != nullptr ? nominal.damping.get() : nullptr,
+    nominal.stiffness_scale ? (*nominal.stiffness_scale)[e] : 1.0 };
 }
 
 /// The stiffness the nominal's damping scales (as fem::ElasticForce chooses it).
@@ -56,15 +63,21 @@ CorrectionForceJacobian::CorrectionForceJacobian(
 void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
     RbfDesign::OutputMatrix& outputs, RbfDesign::OutputGradient& gradients,
     Eigen::RowVectorXd& damping_row) const {
-  const material::ElasticModel* elastic = m_mesh.nominal.elastic.get();
   const int u = m_design.num_unknowns(), u_elastic = m_design.elastic_unknowns();
   const ElementState& st = m_states[e];
-  const Eigen::Matrix<double, 12, 3> G = element_force_operator(m_mesh.rest[e], st.frame);
-  const double alpha1 = elastic != nullptr ? nominal_alpha1(m_mesh, st.frame.stretches) : 0.0;
-  if (alpha1 != 0) {
+  const fem::TetRestData& rest = m_mesh.rest[e];
+  // The kernel without a correction gives how a correction's N and Δα₁ enter the element's
+  // damping (ElementStress::damped_by_correction = weight · [N; ∂N/∂σ] + Δα₁ · per-Δα₁ pair), and
+  // both are linear in the unknowns: N = A x_e, Δα₁ = d x_d.
+  const material::ElementStress nominal = material::element_stress(
+      element_material(m_mesh, nullptr, e), st.frame.stretches, Vec3::Zero());
+  const material::DampingTangent kind = nominal_damping_tangent(m_mesh);
+  const Eigen::Matrix<double, 12, 3> G = element_force_operator(rest, st.frame);
+  const double weight = nominal.correction_damping_weight();
+  if (weight != 0) {
     m_design.output_matrix(st.frame.stretches, outputs, gradients);
-    const Eigen::Matrix<double, 12, 12> D = alpha1
-        * element_stiffness_damping_operator(m_mesh.rest[e], st, nominal_damping_tangent(m_mesh));
+    const Eigen::Matrix<double, 12, 12> D
+        = weight * element_stiffness_damping_operator(rest, st, kind);
     rows.leftCols(u_elastic).noalias() = (G + D.leftCols<3>()) * outputs;
     rows.leftCols(u_elastic).noalias() += D.rightCols<9>() * gradients;
   } else {
@@ -73,8 +86,9 @@ void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
   }
   if (u > u_elastic) {
     m_design.damping_row(st.frame.stretches, damping_row);
-    rows.rightCols(u - u_elastic).noalias() = element_stiffness_damping_force(m_mesh.rest[e], st,
-                                                  *elastic, nominal_damping_tangent(m_mesh))
+    rows.rightCols(u - u_elastic).noalias()
+        = element_stiffness_damping_force(rest, st,
+              material::damping_tangent(st.frame, nominal.damped_per_alpha1_change(), kind))
         * damping_row;
   }
 }
@@ -110,42 +124,22 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
   std::vector<ElementState> states;
   compute_element_states(mesh, x, v, states);
   std::vector<Vec12> element_forces(m);
-  const material::ElasticModel* elastic = mesh.nominal.elastic.get();
   const material::DampingTangent kind = nominal_damping_tangent(mesh);
   tbb::parallel_for(tbb::blocked_range<int>(0, m, 256), [&](const tbb::blocked_range<int>& r) {
     for (int e = r.begin(); e < r.end(); ++e) {
       const ElementState& s = states[e];
-      if (elastic == nullptr) {
-        element_forces[e].noalias() = element_force_operator(mesh.rest[e], s.frame)
-            * correction.correction(s.frame.stretches, s.stretch_rates);
-        continue;
-      }
-      const material::CorrectedStress total = material::corrected_principal_stress(
-          *elastic, &correction, s.frame.stretches, s.stretch_rates);
-      const Vec3 nominal_stress = elastic->principal_stress(s.frame.stretches);
-      element_forces[e].noalias()
-          = element_force_operator(mesh.rest[e], s.frame) * (total.stress - nominal_stress);
-      // ElasticForce's damping with the correction minus without it: α₁ on the corrected minus
-      // the nominal stiffness, and the learned Δα₁ on the nominal one (same clamp α₁ + Δα₁ ≥ 0).
-      const double alpha1 = nominal_alpha1(mesh, s.frame.stretches);
-      const double change
-          = material::corrected_stiffness_damping(alpha1, &correction, s.frame.stretches) - alpha1;
-      if (alpha1 == 0 && change == 0)
-        continue;
-      if (alpha1 != 0) {
-        material::CorrectedStress scratch;
-        const material::CorrectedStress& elastic_stress
-            = material::elastic_part(*elastic, &correction, s.frame.stretches, total, scratch);
-        element_forces[e] += alpha1
-            * (element_stiffness_damping_force(mesh.rest[e], s,
-                   material::damping_tangent(
-                       s.frame, elastic_stress.stress, elastic_stress.d_stretches, kind))
-                - element_stiffness_damping_force(
-                    mesh.rest[e], s, material::damping_tangent(*elastic, s.frame, kind)));
-      }
-      if (change != 0)
-        element_forces[e]
-            += change * element_stiffness_damping_force(mesh.rest[e], s, *elastic, kind);
+      // fem::ElasticForce's element stress with the correction minus without it: the kernel's
+      // correction part, N and the damping it adds (one kernel evaluation, the nominal once).
+      const material::ElementStress stress = material::element_stress(
+          element_material(mesh, &correction, e), s.frame.stretches, s.stretch_rates);
+      material::PrincipalTangent damping;
+      const bool damped = stress.has_damping();
+      if (damped)
+        damping = material::damping_tangent(s.frame, stress.damped_by_correction(), kind);
+      const Mat3 P = material::element_first_piola(
+          s.frame, stress.correction, damped ? &damping : nullptr, s.deformation_rate);
+      Eigen::Map<Eigen::Matrix<double, 3, 4>>(element_forces[e].data()).noalias()
+          = -mesh.rest[e].volume * P * mesh.rest[e].gradients;
     }
   });
   VecX f = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));

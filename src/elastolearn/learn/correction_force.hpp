@@ -12,21 +12,25 @@
 namespace elastolearn::learn {
 
 /// Nodal forces [N] (flat 3n) of a correction: what fem::ElasticForce gives with it minus without
-/// it, f = Σ_e B_e N(σ_e, ḟ_e) + α₁ (−(K_e − K_e^d) v_e) + [(α₁ + Δα₁)⁺ − α₁] (−K_e^d v_e)
-/// with K_e, K_e^d the damping stiffness (material::damping_tangent) of the corrected and the
-/// nominal model (Eq. 1's N term, the nominal
-/// Rayleigh term on the corrected stiffness, and Eq. 13's damping term; α₁ from
-/// mesh.nominal.damping). Without mesh.nominal.elastic only the N term. Parallel over elements.
+/// it, from the correction's part of the one element kernel (material::element_stress): per
+/// element f_a = −vol P g_a with
+///   P = U diag(N(σ, ḟ)) Vᵀ + [α₁ K^d(N(σ, 0)) + Δα₁ K^d(s_e P̂)] : Ḟ
+/// (Eq. 1's N term; the nominal Rayleigh α₁ on the correction's share of the corrected damping
+/// stiffness and Eq. 13's Δα₁, kept α₁ + Δα₁ ≥ 0, on the nominal one: ElementStress::
+/// damped_by_correction), with α₁, the stiffness scale s_e and the damping tangent K^d of
+/// mesh.nominal. Without mesh.nominal.elastic only the N term. Parallel over elements.
 VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
     const VecX& x, const VecX& v);
 
 /// J of one frame: column i is the nodal force (free dofs) of RBF unknown i alone at a state
 /// (x, v), so that the correction's force there (correction_force, restricted) is J x: element e
 /// adds [B_e A_e + α₁ D_e [A_e; ∂A_e/∂σ], (−K_e^nom v_e) d_e] (RbfDesign's A, d; Eq. 13) to its
-/// free dofs' rows (exact up to Δα₁'s clamps). The element blocks are computed in parallel in
-/// batches and added in element order, so J does not depend on the thread count. Owns its work
-/// space (allocated once); one instance per concurrent caller. `mesh`, `dofs` and `design` must
-/// outlive it.
+/// free dofs' rows, the same decomposition of the element kernel (material::ElementStress:
+/// correction_damping_weight α₁, damped_per_alpha1_change s_e P̂ whose damping force is
+/// −K_e^nom v_e; D_e = element_stiffness_damping_operator), exact up to Δα₁'s clamp. The element
+/// blocks are computed in parallel in batches and added in element order, so J does not depend
+/// on the thread count. Owns its work space (allocated once); one instance per concurrent caller.
+/// `mesh`, `dofs` and `design` must outlive it.
 class CorrectionForceJacobian {
   public:
   /// Throws InputError if the design fits damping but mesh.nominal has no elastic model.

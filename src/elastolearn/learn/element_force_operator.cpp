@@ -23,12 +23,6 @@ Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const Elemen
   return f;
 }
 
-Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
-    const material::ElasticModel& elastic, material::DampingTangent kind) {
-  return element_stiffness_damping_force(
-      rest, state, material::damping_tangent(elastic, state.frame, kind));
-}
-
 Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
     const fem::TetRestData& rest, const ElementState& state, material::DampingTangent kind) {
   // The exact eigen-form tangent is linear in (p̂, ∂p̂/∂σ), and so is the force: its columns are

@@ -11,23 +11,18 @@ namespace elastolearn::learn {
 Eigen::Matrix<double, 12, 3> element_force_operator(
     const fem::TetRestData& rest, const material::PrincipalFrame& frame);
 
-/// The element's stiffness-damping force per unit Δα₁ [N·s]: −K_e v_e = −vol (dP/dF : Ḟ) g_a
-/// with dP/dF the damping tangent of kind `kind` (material::damping_tangent) of the nominal model
-/// `elastic`, exactly as fem::ElasticForce applies Δα₁. Local dofs ordered x0, y0, z0, x1, ….
-Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
-    const material::ElasticModel& elastic, material::DampingTangent kind);
-
-/// The element's stiffness-damping force per unit α₁ [N·s] of an eigen-form damping tangent
-/// dP/dF (material::damping_tangent): −vol (dP/dF : Ḟ) g_a. Local dofs ordered x0, y0, z0, x1, ….
+/// The element's stiffness-damping force [N/s] per unit coefficient (α₁ or Δα₁) of an eigen-form
+/// damping tangent dP/dF (material::damping_tangent): −vol (dP/dF : Ḟ) g_a. Local dofs ordered
+/// x0, y0, z0, x1, ….
 Vec12 element_stiffness_damping_force(const fem::TetRestData& rest, const ElementState& state,
     const material::PrincipalTangent& tangent);
 
 /// The element's stiffness-damping force per unit α₁ as a linear function of a principal stress
 /// and its stretch derivative: column c maps entry c of [p̂; vec(∂p̂/∂σ)] (3 + 9, column-major)
 /// to the nodal forces −vol (dP/dF : Ḟ) g_a of material::damping_tangent of p̂ (of kind `kind`)
-/// [N·s per Pa]. Applied
-/// to an RBF unknown's output and gradient (RbfDesign::output_matrix) it gives that unknown's share
-/// of the nominal α₁'s action on the corrected stiffness (fem::ElasticForce).
+/// [N/s per Pa]. Applied to an RBF unknown's output and gradient (RbfDesign::output_matrix) it
+/// gives that unknown's share of the nominal α₁'s action on the corrected stiffness
+/// (material::ElementStress::damped).
 Eigen::Matrix<double, 12, 12> element_stiffness_damping_operator(
     const fem::TetRestData& rest, const ElementState& state, material::DampingTangent kind);
 

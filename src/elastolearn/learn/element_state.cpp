@@ -26,13 +26,22 @@ void element_states_range(const ReconstructionMesh& mesh, const VecX& x, const V
   }
 }
 
+/// A stiffness scale, if any, has one entry per tet (its values fem::ElasticForce checks).
+void check_stiffness_scale(const fem::MaterialModel& nominal, Eigen::Index tets) {
+  if (nominal.stiffness_scale && Eigen::Index(nominal.stiffness_scale->size()) != tets)
+    fail("nominal.stiffness_scale",
+        to_text(nominal.stiffness_scale->size()) + " entries for " + to_text(tets) + " tets");
+}
+
 } // namespace
 
 ReconstructionMesh::ReconstructionMesh(const mesh::TetMesh& mesh, fem::MaterialModel nominal_model)
     : rest(fem::precompute_rest_data(mesh))
     , tets(mesh.tets())
     , num_vertices(mesh.num_vertices())
-    , nominal(std::move(nominal_model)) { }
+    , nominal(std::move(nominal_model)) {
+  check_stiffness_scale(nominal, tets.rows());
+}
 
 ReconstructionMesh::ReconstructionMesh(std::vector<fem::TetRestData> rest_data, Tets tet_indices,
     int n, fem::MaterialModel nominal_model)
@@ -44,6 +53,7 @@ ReconstructionMesh::ReconstructionMesh(std::vector<fem::TetRestData> rest_data, 
     fail("mesh", to_text(rest.size()) + " rest data for " + to_text(tets.rows()) + " tets");
   if (tets.size() > 0 && (tets.minCoeff() < 0 || tets.maxCoeff() >= n))
     fail("mesh", "a tet index is outside [0, " + to_text(n) + ")");
+  check_stiffness_scale(nominal, tets.rows());
 }
 
 void compute_element_states(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,

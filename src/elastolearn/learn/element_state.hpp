@@ -17,17 +17,21 @@ namespace elastolearn::learn {
 /// material whose Rayleigh damping the correction's Δα₁ adds to (Eq. 13). Its `elastic` may be
 /// null when no damping is fitted or evaluated (then corrections contribute their N term only).
 struct ReconstructionMesh {
-  /// From a rest mesh (computes fem::precompute_rest_data).
+  /// From a rest mesh (computes fem::precompute_rest_data). Throws InputError if `nominal` has a
+  /// stiffness scale whose length is not the number of tets.
   explicit ReconstructionMesh(const mesh::TetMesh& mesh, fem::MaterialModel nominal = {});
   /// From rest data already computed (e.g. fem::ElasticForce::rest_data() and tets()).
-  /// Throws InputError if `rest` and `tets` differ in length or an index is outside [0, n).
+  /// Throws InputError if `rest` and `tets` differ in length, an index is outside [0, n), or a
+  /// stiffness scale's length is not the number of tets.
   ReconstructionMesh(std::vector<fem::TetRestData> rest, Tets tets, int num_vertices,
       fem::MaterialModel nominal = {});
 
   std::vector<fem::TetRestData> rest; ///< m
   Tets tets; ///< m × 4
   int num_vertices = 0; ///< n
-  fem::MaterialModel nominal; ///< elastic model and Rayleigh damping (its correction is ignored)
+  /// Elastic model, Rayleigh damping and stiffness scale, applied as fem::ElasticForce does (its
+  /// correction is ignored).
+  fem::MaterialModel nominal;
 
   int num_tets() const { return static_cast<int>(tets.rows()); }
 };

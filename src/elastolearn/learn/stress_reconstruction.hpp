@@ -82,7 +82,8 @@ struct ReconstructionMotion {
 /// correction with unknowns x at frame t (= correction_force while α₁ + Δα₁ ≥ 0), and g_t
 /// (target_forces[t], flat 3n, only free dofs used) the force the new correction must produce
 /// (current correction force + control force). D_e is element_stiffness_damping_operator, K_e the
-/// nominal model's stiffness (element_stiffness_damping_force); both need `mesh.nominal.elastic`
+/// nominal model's damping stiffness (of material::ElementStress::damped_per_alpha1_change, the
+/// kernel fem::ElasticForce applies; see CorrectionForceJacobian); both need `mesh.nominal.elastic`
 /// (required when the design fits damping; without it the α₁ term is left out). Tikhonov:
 /// design.options().regularization on the Jacobi-scaled unknowns, as fit_rbf_correction.
 /// Method normal_equations: J_t (free dofs × q) is assembled per frame and JᵀJ accumulated by

@@ -183,13 +183,9 @@ Mat9 first_piola_rate_derivative(const PrincipalFrame& frame, const Mat3& d_stre
 }
 
 CorrectedStress corrected_principal_stress(const ElasticModel& model, const Correction* correction,
-    const Vec3& stretches, const Vec3& stretch_rates, double nominal_scale) {
+    const Vec3& stretches, const Vec3& stretch_rates) {
   CorrectedStress out { model.principal_stress(stretches),
     model.principal_stress_derivative(stretches), Mat3::Zero() };
-  if (nominal_scale != 1.0) {
-    out.stress *= nominal_scale;
-    out.d_stretches *= nominal_scale;
-  }
   if (correction != nullptr) {
     Mat3 dn_ds, dn_dr;
     out.stress += correction->correction_with_gradient(stretches, stretch_rates, dn_ds, dn_dr);
@@ -197,15 +193,6 @@ CorrectedStress corrected_principal_stress(const ElasticModel& model, const Corr
     out.d_stretch_rates = dn_dr;
   }
   return out;
-}
-
-const CorrectedStress& elastic_part(const ElasticModel& model, const Correction* correction,
-    const Vec3& stretches, const CorrectedStress& at_rates, CorrectedStress& scratch,
-    double nominal_scale) {
-  if (correction == nullptr || !correction->depends_on_rates())
-    return at_rates;
-  scratch = corrected_principal_stress(model, correction, stretches, Vec3::Zero(), nominal_scale);
-  return scratch;
 }
 
 Mat3 first_piola(const ElasticModel& model, const Mat3& F) {

@@ -80,19 +80,10 @@ struct CorrectedStress {
   Mat3 d_stretch_rates; ///< ∂N/∂Ḟ̂ (zero without a correction)
 };
 
-/// Evaluate s·P̂ + N at (σ, Ḟ̂). `correction` may be null. `nominal_scale` s > 0 multiplies the
-/// nominal model's stress (a heterogeneous material's per-element stiffness, fem::MaterialModel);
-/// the correction is not scaled.
+/// Evaluate P̂ + N at (σ, Ḟ̂). `correction` may be null. (An element's stress with its stiffness
+/// scale and damping: material::element_stress.)
 CorrectedStress corrected_principal_stress(const ElasticModel& model, const Correction* correction,
-    const Vec3& stretches, const Vec3& stretch_rates, double nominal_scale = 1.0);
-
-/// The elastic part P̂ + N(σ, 0) of a corrected stress evaluated at (σ, Ḟ̂): `at_rates` itself
-/// when N does not depend on the rates (Correction::depends_on_rates), else re-evaluated into
-/// `scratch`. The stress whose stiffness Rayleigh damping scales (fem::ElasticForce).
-/// `nominal_scale` as in corrected_principal_stress (the one `at_rates` was evaluated with).
-const CorrectedStress& elastic_part(const ElasticModel& model, const Correction* correction,
-    const Vec3& stretches, const CorrectedStress& at_rates, CorrectedStress& scratch,
-    double nominal_scale = 1.0);
+    const Vec3& stretches, const Vec3& stretch_rates);
 
 /// Convenience for tests and tools: P(F) of a model (no correction).
 Mat3 first_piola(const ElasticModel& model, const Mat3& F);
