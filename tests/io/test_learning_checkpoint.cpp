@@ -53,6 +53,21 @@ void expect_same(const material::RbfCorrection& a, const material::RbfCorrection
   EXPECT_EQ(a.parameters().damping_weights, b.parameters().damping_weights);
 }
 
+/// a and b are the same function to `relative_tolerance` (of the largest |N|) at stretches
+/// around rest, for corrections of different builds (their centres and weights then differ by
+/// rounding).
+void expect_close_function(
+    const material::RbfCorrection& a, const material::RbfCorrection& b, double relative_tolerance) {
+  double scale = 0, difference = 0;
+  for (const Vec3& s : { Vec3(1.02, 1.0, 0.99), Vec3(1.05, 0.98, 0.97), Vec3(0.97, 1.01, 1.0),
+           Vec3(1.1, 1.0, 0.9) }) {
+    const Vec3 na = a.correction(s, Vec3::Zero()), nb = b.correction(s, Vec3::Zero());
+    scale = std::max(scale, na.cwiseAbs().maxCoeff());
+    difference = std::max(difference, (na - nb).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(difference, relative_tolerance * scale);
+}
+
 /// Run f's learning whole, and interrupted after checkpoint `stop_after` then resumed from the
 /// file: both must reach the same history and the bit-identical correction.
 void expect_resume_equals_whole(Fixture& f, int stop_after) {
@@ -296,8 +311,10 @@ TEST(LearningCheckpoint, ReadsTheFlatRecordsOfVersion2) {
 TEST(LearningCheckpoint, ResumesACheckpointWrittenInVersion2) {
   // tests/data/io/learning_checkpoint_v2.json: this fixture's run (forward fit of 2 steps)
   // interrupted after checkpoint 4 (loop iterations 0–2, the first forward-fit step), written by
-  // the version-2 code. Resumed now, it reaches the uninterrupted run's history and correction
-  // bit for bit.
+  // the version-2 code. Resumed now, it reaches the uninterrupted run's history and correction.
+  // Its first steps were computed by that older build, whose element kernel rounded differently
+  // (the damping stress summed in another order): measured, the steps agree to ~2e-11 and the
+  // corrections' stresses to rounding amplified by the k-means and the fit, not bit for bit.
   Fixture f;
   f.options.forward_fit.max_iterations = 2;
   f.inputs.options = learning_options_to_json(f.options);
@@ -314,11 +331,11 @@ TEST(LearningCheckpoint, ResumesACheckpointWrittenInVersion2) {
   ASSERT_TRUE(learn::run_learning(f.nominal, f.observed, f.options, resumed));
   learn::LearningState whole;
   ASSERT_TRUE(learn::run_learning(f.nominal, f.observed, f.options, whole));
-  test::expect_same_steps(resumed.history, whole.history);
+  test::expect_same_steps(resumed.history, whole.history, 1e-9);
   EXPECT_EQ(resumed.best_iteration, whole.best_iteration);
-  EXPECT_EQ(resumed.best_error, whole.best_error);
+  EXPECT_NEAR(resumed.best_error, whole.best_error, 1e-9 * whole.best_error);
   ASSERT_TRUE(resumed.best && whole.best);
-  expect_same(*resumed.best, *whole.best);
+  expect_close_function(*resumed.best, *whole.best, 1e-6);
 }
 
 TEST(LearningCheckpoint, DefaultPathAndMissingCheckpoint) {
