@@ -95,6 +95,16 @@ Eigen::MatrixXd jacobian_at(
   return Eigen::MatrixXd(A.matrix());
 }
 
+/// −K is the finite-difference Jacobian of the force at (x, v), and the elastic energy's gradient
+/// is minus the force f there (central differences, h = 1e-6).
+void expect_consistent_stiffness_and_energy(fem::ElasticForce& term, const VecX& x, const VecX& v,
+    const Eigen::MatrixXd& K, const VecX& f) {
+  test::expect_jacobian_matches(
+      -K, [&](const VecX& y) { return force_at(term, y, v); }, x, 1e-6, 1e-6);
+  const VecX g = test::fd_gradient([&](const VecX& y) { return term.elastic_energy(y); }, x, 1e-6);
+  EXPECT_LT((g + f).cwiseAbs().maxCoeff(), 1e-6 * f.cwiseAbs().maxCoeff());
+}
+
 } // namespace
 
 class ElasticForceTest : public ::testing::TestWithParam<int> { };
@@ -149,11 +159,7 @@ TEST_P(ElasticForceTest, ExactStiffnessIsMinusForceDerivative) {
   A.set_zero();
   term.add_force_and_jacobian({ x, v, 0.0 }, 1.0, 0.0, f, A);
   const Eigen::MatrixXd K = Eigen::MatrixXd(A.matrix());
-  test::expect_jacobian_matches(
-      -K, [&](const VecX& y) { return force_at(term, y, v); }, x, 1e-6, 1e-6);
-  // Also: the energy's gradient is minus the force.
-  const VecX g = test::fd_gradient([&](const VecX& y) { return term.elastic_energy(y); }, x, 1e-6);
-  EXPECT_LT((g + f).cwiseAbs().maxCoeff(), 1e-6 * f.cwiseAbs().maxCoeff());
+  expect_consistent_stiffness_and_energy(term, x, v, K, f);
 }
 
 TEST_P(ElasticForceTest, ProjectedStiffnessIsPositiveSemiDefinite) {
@@ -367,10 +373,7 @@ TEST(StiffnessScale, ScaledStiffnessIsMinusForceDerivativeAndEnergyGradient) {
   VecX f;
   const Eigen::MatrixXd K = jacobian_at(term, x, v, 1.0, 0.0, f);
   ASSERT_GT((f - force_at(plain, x, v)).norm(), 0.5 * f.norm());
-  test::expect_jacobian_matches(
-      -K, [&](const VecX& y) { return force_at(term, y, v); }, x, 1e-6, 1e-6);
-  const VecX g = test::fd_gradient([&](const VecX& y) { return term.elastic_energy(y); }, x, 1e-6);
-  EXPECT_LT((g + f).cwiseAbs().maxCoeff(), 1e-6 * f.cwiseAbs().maxCoeff());
+  expect_consistent_stiffness_and_energy(term, x, v, K, f);
 }
 
 TEST(StiffnessScale, RayleighDampingScalesTheScaledStiffness) {

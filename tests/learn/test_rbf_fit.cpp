@@ -271,22 +271,44 @@ TEST(RbfDesign, OutputGradientMatchesFiniteDifferences) {
   }
 }
 
-TEST(RbfDesign, EnergyKernelsRoundTripAndMatchTheCorrection) {
-  // A x is the correction built from x (what the reconstruction fits is what the simulator
-  // evaluates), unknowns() inverts correction(), and the correction is an energy.
+namespace {
+
+/// Three energy-kernel centres around rest.
+MatX energy_centres() {
   MatX centres(3, 3);
   centres << 1.1, 1.0, 0.9, 1.0, 0.95, 0.9, 1.2, 1.1, 0.8;
+  return centres;
+}
+
+/// Energy kernels (ε = 0.03) with the linear, cubic and neo-Hookean tails.
+RbfFitOptions energy_options() {
   RbfFitOptions options;
   options.energy_kernels = true;
   options.neo_hookean_tail = true;
   options.epsilon = 0.03;
-  const RbfDesign design(centres, options);
-  EXPECT_EQ(design.elastic_unknowns(), 3 + 2 + 3 + 2); // kernels, a b, 3 cubic energies, r
-  std::mt19937 rng(11);
+  return options;
+}
+
+/// Unknowns of `design` drawn from N(0, 10⁶) with `seed`.
+VecX random_unknowns(const RbfDesign& design, unsigned seed) {
+  std::mt19937 rng(seed);
   std::normal_distribution<double> g(0.0, 1e3);
   VecX x(design.num_unknowns());
   for (auto& v : x)
     v = g(rng);
+  return x;
+}
+
+} // namespace
+
+TEST(RbfDesign, EnergyKernelsRoundTripAndMatchTheCorrection) {
+  // A x is the correction built from x (what the reconstruction fits is what the simulator
+  // evaluates), unknowns() inverts correction(), and the correction is an energy.
+  const MatX centres = energy_centres();
+  const RbfFitOptions options = energy_options();
+  const RbfDesign design(centres, options);
+  EXPECT_EQ(design.elastic_unknowns(), 3 + 2 + 3 + 2); // kernels, a b, 3 cubic energies, r
+  const VecX x = random_unknowns(design, 11);
   const material::RbfCorrection n = design.correction(x);
   EXPECT_TRUE(n.parameters().energy_kernels);
   EXPECT_LE((design.unknowns(n) - x).norm(), 1e-12 * x.norm());
@@ -375,18 +397,10 @@ TEST(RbfFit, NeoHookeanTailExtrapolatesNeoHookeanMinusCorotatedIntoStrongCompres
 TEST(RbfDesign, BeyondTheTrustedStretchesTheDesignContinuesAsTheCorrection) {
   // A x = N everywhere, also where the correction continues beyond its trusted interval, and
   // the design's derivative is the correction's tangent there (the forward fit's Jacobian).
-  MatX centres(3, 3);
-  centres << 1.1, 1.0, 0.9, 1.0, 0.95, 0.9, 1.2, 1.1, 0.8;
-  RbfFitOptions options;
-  options.energy_kernels = true;
-  options.neo_hookean_tail = true;
-  options.epsilon = 0.03;
+  const MatX centres = energy_centres();
+  const RbfFitOptions options = energy_options();
   const RbfDesign design(centres, options, { 0.9, 1.15 });
-  std::mt19937 rng(5);
-  std::normal_distribution<double> g(0.0, 1e3);
-  VecX x(design.num_unknowns());
-  for (auto& v : x)
-    v = g(rng);
+  const VecX x = random_unknowns(design, 5);
   const material::RbfCorrection n = design.correction(x);
   EXPECT_EQ(n.parameters().trusted.min, 0.9);
   EXPECT_EQ(n.parameters().trusted.max, 1.15);

@@ -313,23 +313,27 @@ RbfCorrection energy_correction() {
   return RbfCorrection(std::move(p));
 }
 
+/// N = ∇ΔΨ at s by 4th-order central differences of elastic_energy (h = 1e-4: truncation
+/// ~ (h/ε)⁴ ≈ 1e-10 relative; round-off 1e-16·|Ψ| / h with |Ψ| ~ 1e4 J/m³: 1e-8 Pa).
+void expect_stress_is_energy_gradient(const RbfCorrection& n, const Vec3& s) {
+  Eigen::MatrixXd stress(1, 3);
+  stress.row(0) = n.elastic_correction(s).transpose();
+  const FdFunction energy = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+    return Eigen::VectorXd::Constant(1, n.elastic_energy(y.head<3>()));
+  };
+  expect_jacobian_matches(stress, energy, Eigen::VectorXd(s), 1e-7, 1e-4);
+}
+
 const std::vector<Vec3> k_energy_states { Vec3(1.15, 0.97, 0.88), Vec3(1.4, 1.2, 0.6),
   Vec3(0.9, 1.25, 1.02), Vec3(1.05, 1.05, 0.9) /* a tie */, Vec3(1.0, 1.0, 1.0) };
 
 } // namespace
 
 TEST(RbfCorrectionEnergy, StressIsTheGradientOfTheEnergy) {
-  // N = ∇ΔΨ by 4th-order central differences of elastic_energy (h = 1e-4: truncation
-  // ~ (h/ε)⁴ ≈ 1e-10 relative; round-off 1e-16·|Ψ| / h with |Ψ| ~ 1e4 J/m³: 1e-8 Pa).
   const RbfCorrection n = energy_correction();
   for (const Vec3& s : k_energy_states) {
     SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
-    Eigen::MatrixXd stress(1, 3);
-    stress.row(0) = n.elastic_correction(s).transpose();
-    const FdFunction energy = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-      return Eigen::VectorXd::Constant(1, n.elastic_energy(y.head<3>()));
-    };
-    expect_jacobian_matches(stress, energy, Eigen::VectorXd(s), 1e-7, 1e-4);
+    expect_stress_is_energy_gradient(n, s);
   }
 }
 
@@ -452,12 +456,7 @@ TEST(RbfCorrectionEnergy, OutsideItsTrustedStretchesItIsStillAnEnergy) {
   const RbfCorrection n = trusted_energy_correction();
   for (const Vec3& s : { Vec3(1.5, 1.35, 1.25), Vec3(0.8, 0.7, 0.85) }) {
     SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
-    Eigen::MatrixXd stress(1, 3);
-    stress.row(0) = n.elastic_correction(s).transpose();
-    const FdFunction energy = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-      return Eigen::VectorXd::Constant(1, n.elastic_energy(y.head<3>()));
-    };
-    expect_jacobian_matches(stress, energy, Eigen::VectorXd(s), 1e-7, 1e-4);
+    expect_stress_is_energy_gradient(n, s);
     expect_gradient_matches_fd(n, s, Vec3::Zero(), 1e-7);
   }
 }

@@ -44,6 +44,28 @@ learn::ErrorSummary read_error(const JsonObject& o) {
   return e;
 }
 
+/// A loop record's trajectory stages; `seconds` holds their times. Versions 1 and 2 (`flat`) may
+/// lack "stability" and "step_kept" (0: not checked, 1: all kept).
+learn::SpaceTimeStages read_stages(
+    const JsonObject& o, const JsonObject& seconds, bool flat = false) {
+  learn::SpaceTimeStages t;
+  t.modes = o.integer("modes");
+  t.control_force_rms = o.number("control_force_rms");
+  t.space_time_initial = o.number("space_time_initial");
+  t.space_time_objective = o.number("space_time_objective");
+  t.space_time_iterations = o.integer("space_time_iterations");
+  t.centres = o.integer("centres");
+  t.correction_misfit = o.number("correction_misfit");
+  t.correction_target = o.number("correction_target");
+  t.stability = flat ? o.number("stability", 0.0) : o.number("stability");
+  t.step_kept = flat ? o.number("step_kept", 1.0) : o.number("step_kept");
+  t.seconds_pod = seconds.number("pod");
+  t.seconds_constrained = seconds.number("constrained");
+  t.seconds_space_time = seconds.number("space_time");
+  t.seconds_reconstruction = seconds.number("reconstruction");
+  return t;
+}
+
 /// A record of a version-1 or -2 checkpoint: one flat object with flags for the kind of step
 /// ("forward_fit", "forward_completed", "forward_unstable", "damped_update") and every field,
 /// zero where it was not measured. A loop iteration ran the trajectory stages when it has modes
@@ -65,22 +87,7 @@ learn::IterationRecord read_flat_record(const JsonObject& o) {
     if (o.boolean("damped_update", false))
       next = learn::DampedUpdate {};
   } else if (o.integer("modes") > 0 || o.integer("centres") > 0) {
-    learn::SpaceTimeStages t;
-    t.modes = o.integer("modes");
-    t.control_force_rms = o.number("control_force_rms");
-    t.space_time_initial = o.number("space_time_initial");
-    t.space_time_objective = o.number("space_time_objective");
-    t.space_time_iterations = o.integer("space_time_iterations");
-    t.centres = o.integer("centres");
-    t.correction_misfit = o.number("correction_misfit");
-    t.correction_target = o.number("correction_target");
-    t.stability = o.number("stability", 0.0);
-    t.step_kept = o.number("step_kept", 1.0);
-    t.seconds_pod = s.number("pod");
-    t.seconds_constrained = s.number("constrained");
-    t.seconds_space_time = s.number("space_time");
-    t.seconds_reconstruction = s.number("reconstruction");
-    next = t;
+    next = read_stages(o, s, true);
   }
   return learn::LoopRecord { iteration, forward, next };
 }
@@ -114,25 +121,6 @@ nlohmann::json stages_json(const learn::SpaceTimeStages& t) {
     { "space_time_iterations", t.space_time_iterations }, { "centres", t.centres },
     { "correction_misfit", t.correction_misfit }, { "correction_target", t.correction_target },
     { "stability", t.stability }, { "step_kept", t.step_kept } };
-}
-
-learn::SpaceTimeStages read_stages(const JsonObject& o, const JsonObject& seconds) {
-  learn::SpaceTimeStages t;
-  t.modes = o.integer("modes");
-  t.control_force_rms = o.number("control_force_rms");
-  t.space_time_initial = o.number("space_time_initial");
-  t.space_time_objective = o.number("space_time_objective");
-  t.space_time_iterations = o.integer("space_time_iterations");
-  t.centres = o.integer("centres");
-  t.correction_misfit = o.number("correction_misfit");
-  t.correction_target = o.number("correction_target");
-  t.stability = o.number("stability");
-  t.step_kept = o.number("step_kept");
-  t.seconds_pod = seconds.number("pod");
-  t.seconds_constrained = seconds.number("constrained");
-  t.seconds_space_time = seconds.number("space_time");
-  t.seconds_reconstruction = seconds.number("reconstruction");
-  return t;
 }
 
 /// The names of LoopNext's alternatives (a loop record's "next").

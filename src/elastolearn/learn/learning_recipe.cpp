@@ -206,11 +206,15 @@ template <typename Dense> Dense stacked_rows(const std::vector<Dense>& parts) {
 VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
   std::vector<ErrorSummary> errors;
   std::vector<VecX> predictions;
-  for (const HeldOut& piece : split.validation) {
-    sim::Scene scene = piece.motion.scene;
+  // The held-out motion's scene (driven `factor` times as hard) with the candidate's material.
+  const auto with_candidate = [&](const HeldOut& piece, double factor) {
+    sim::Scene scene = sim::amplified_scene(piece.motion.scene, factor);
     scene.material = nominal;
     scene.material.correction = c.correction;
-    const sim::ForwardRun run = sim::simulate_positions(scene);
+    return scene;
+  };
+  for (const HeldOut& piece : split.validation) {
+    const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece, 1));
     c.completed = run.completed;
     if (!run.completed)
       return {};
@@ -224,10 +228,7 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
     LargerMotionCheck& larger = c.larger_motion;
     larger.checked = true;
     for (const HeldOut& piece : split.validation) {
-      sim::Scene scene = sim::amplified_scene(piece.motion.scene, kLargerMotion);
-      scene.material = nominal;
-      scene.material.correction = c.correction;
-      const sim::ForwardRun run = sim::simulate_positions(scene);
+      const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece, kLargerMotion));
       if (!run.completed) {
         larger.completed = false;
         larger.message = piece.motion.name + ": " + run.message;
