@@ -26,6 +26,7 @@
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
@@ -452,6 +453,10 @@ struct RandomRow {
   double train_deformation = 0, test_deformation = 0; ///< % of the diagonal
   double err_nominal = -1, err_fit = -1, err_learned = -1; ///< test err_L [%] (−1: diverged)
   double learn_seconds = 0, fit_seconds = 0;
+  /// The fitted nominal's training RMS error over the noise's own (√3 σ for a 3-D position;
+  /// +∞ without noise). Near 1 the four parameters already explain the training data to the
+  /// noise: nothing in it tells a correction from chance, whatever the learner.
+  double fit_over_noise = 0;
   int fit_diverged = 0, loop_diverged = 0, validation_diverged = 0; ///< in learning
   int test_diverged = 0; ///< of the fitted and learned test simulations
   std::string chosen;
@@ -573,6 +578,9 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
   row.learn_seconds = seconds_since(t0);
   row.fit_seconds = result.parameter_fit.seconds;
   row.fit_diverged = result.parameter_fit.diverged;
+  const double noise_rms = std::sqrt(3.0) * o.noise_percent / 100 * o.diagonal;
+  row.fit_over_noise = noise_rms > 0 ? result.parameter_fit.final_rms / noise_rms
+                                     : std::numeric_limits<double>::infinity();
   for (const auto& r : result.loop.history)
     row.loop_diverged += diverged(r) ? 1 : 0;
   for (const auto& c : result.candidates)
@@ -582,11 +590,12 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
     row.chosen += " " + std::to_string(result.choice().iteration);
   const auto& p = result.parameter_fit.fitted;
   std::printf("   learned in %.1f s (parameter fit %.1f s: E %.4g, ν %.3f, α₀ %.3g, α₁ %.3g, "
-              "observation rms %.3f %% -> %.3f %% of the diagonal, %s); chosen: %s; divergences "
-              "in learning: %d in the fit, %d in the loop, %d in validation\n",
+              "observation rms %.3f %% -> %.3f %% of the diagonal = %.3g × the noise's, %s); "
+              "chosen: %s; divergences in learning: %d in the fit, %d in the loop, %d in "
+              "validation\n",
       row.learn_seconds, row.fit_seconds, p.young, p.poisson, p.alpha0, p.alpha1,
       100 * result.parameter_fit.initial_rms / o.diagonal,
-      100 * result.parameter_fit.final_rms / o.diagonal,
+      100 * result.parameter_fit.final_rms / o.diagonal, row.fit_over_noise,
       learn::to_string(result.parameter_fit.stop).c_str(), row.chosen.c_str(), row.fit_diverged,
       row.loop_diverged, row.validation_diverged);
   std::fflush(stdout);
@@ -616,31 +625,45 @@ double learned_ratio(const RandomRow& r) {
   return r.err_fit > 0 ? r.err_learned / r.err_fit : (r.err_learned > 0 ? 1e9 : 1.0);
 }
 
+/// A fitted nominal whose training error is within this factor of the noise's RMS leaves the
+/// data nothing a correction could be validated on (the diagnostic of target 2).
+constexpr double kAboveNoise = 1.1;
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
 /// The table and issue 19's targets, each PASS or FAIL.
 void print_random_summary(const std::vector<RandomRow>& rows, int failed) {
   std::printf(
       "\n| case | tets | truth in family | observed | noise %% | deform. train/test %% | "
-      "err_L nominal %% | err_L fit %% | err_L learned %% | learned/fit | chosen | learn s | "
-      "fit s | diverged (fit/loop/validation/test) |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "fit rms / noise rms | err_L nominal %% | err_L fit %% | err_L learned %% | learned/fit | "
+      "chosen | learn s | fit s | diverged (fit/loop/validation/test) |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& r : rows)
     std::printf(
-        "| %d | %d | %s | %d (%.0f %%) | %.1f | %.1f / %.1f | %s | %s | %s | %.3f | %s | %.1f "
-        "| %.1f | %d / %d / %d / %d |\n",
+        "| %d | %d | %s | %d (%.0f %%) | %.1f | %.1f / %.1f | %.3g | %s | %s | %s | %.3f | %s | "
+        "%.1f | %.1f | %d / %d / %d / %d |\n",
         r.index, r.tets, r.in_family ? "yes" : "no", r.observed, 100 * r.visible, r.noise,
-        r.train_deformation, r.test_deformation, err(r.err_nominal).c_str(), err(r.err_fit).c_str(),
-        err(r.err_learned).c_str(), learned_ratio(r), r.chosen.c_str(), r.learn_seconds,
-        r.fit_seconds, r.fit_diverged, r.loop_diverged, r.validation_diverged, r.test_diverged);
+        r.train_deformation, r.test_deformation, r.fit_over_noise, err(r.err_nominal).c_str(),
+        err(r.err_fit).c_str(), err(r.err_learned).c_str(), learned_ratio(r), r.chosen.c_str(),
+        r.learn_seconds, r.fit_seconds, r.fit_diverged, r.loop_diverged, r.validation_diverged,
+        r.test_diverged);
 
   std::string violators;
-  std::vector<double> ratios;
+  std::vector<double> ratios, ratios_above_noise;
   int learning_divergences = 0, test_divergences = 0;
   for (const auto& r : rows) {
     const double ratio = learned_ratio(r);
     if (!(ratio <= 1.05) && !std::isnan(ratio))
       violators += " " + std::to_string(r.index);
-    if (!r.in_family && !std::isnan(ratio))
+    if (!r.in_family && !std::isnan(ratio)) {
       ratios.push_back(ratio);
+      if (r.fit_over_noise > kAboveNoise)
+        ratios_above_noise.push_back(ratio);
+    }
     learning_divergences += r.learning_divergences();
     test_divergences += r.test_diverged;
   }
@@ -652,12 +675,14 @@ void print_random_summary(const std::vector<RandomRow>& rows, int failed) {
     std::printf("target 2: median(learned / fit) ≤ 1/3 over truths outside the nominal's family: "
                 "n/a (no such case)\n");
   else {
-    std::sort(ratios.begin(), ratios.end());
-    const size_t n = ratios.size();
-    const double median = n % 2 ? ratios[n / 2] : 0.5 * (ratios[n / 2 - 1] + ratios[n / 2]);
+    const double m = median(ratios);
     std::printf("target 2: median(learned / fit) ≤ 1/3 over truths outside the nominal's family: "
                 "%s (median %.3f over %zu case(s))\n",
-        median <= 1.0 / 3 ? "PASS" : "FAIL", median, n);
+        m <= 1.0 / 3 ? "PASS" : "FAIL", m, ratios.size());
+    std::printf("  (diagnostic, not a target: median %.3f over the %zu of them whose fitted "
+                "nominal leaves more than %.2f × the noise's RMS error in the training data)\n",
+        ratios_above_noise.empty() ? std::nan("") : median(ratios_above_noise),
+        ratios_above_noise.size(), kAboveNoise);
   }
   std::printf("target 3: no divergence in learning or in the test simulations: %s (%d in "
               "learning, %d in the fitted and learned test simulations)\n",

@@ -24,13 +24,11 @@
 #include <elastolearn/core/progress.hpp>
 #include <elastolearn/learn/forward_fit.hpp>
 #include <elastolearn/learn/iteration_record.hpp>
-#include <elastolearn/learn/kmeans.hpp>
 #include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/pod_basis.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
 #include <elastolearn/learn/space_time.hpp>
 #include <elastolearn/learn/stress_reconstruction.hpp>
-#include <elastolearn/learn/trajectory_error.hpp>
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>
 

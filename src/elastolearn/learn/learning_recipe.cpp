@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
+#include <elastolearn/core/stacked_rows.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/cloud_motion.hpp>
 #include <elastolearn/learn/element_state.hpp>
@@ -183,20 +184,6 @@ VecX flat_positions(const observe::Observation& o) {
       if (o.is_valid(t, static_cast<int>(j)))
         out.segment<3>((static_cast<Eigen::Index>(t) * k + j) * 3)
             = o.positions[static_cast<size_t>(t)].row(j).transpose();
-  return out;
-}
-
-/// `parts` one below the other (VecX or MatX of equal column counts).
-template <typename Dense> Dense stacked_rows(const std::vector<Dense>& parts) {
-  Eigen::Index rows = 0;
-  for (const Dense& p : parts)
-    rows += p.rows();
-  Dense out(rows, parts.empty() ? 1 : parts.front().cols());
-  rows = 0;
-  for (const Dense& p : parts) {
-    out.middleRows(rows, p.rows()) = p;
-    rows += p.rows();
-  }
   return out;
 }
 

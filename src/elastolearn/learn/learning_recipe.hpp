@@ -23,6 +23,7 @@
 #include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/network_distillation.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
+#include <elastolearn/learn/trajectory_error.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>

@@ -1,3 +1,4 @@
+#include <elastolearn/core/stacked_rows.hpp>
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/kmeans.hpp>
 #include <elastolearn/learn/learning_stages.hpp>
@@ -101,18 +102,9 @@ MatX trajectory_stretches(std::span<const ReconstructionMesh> meshes,
     const std::vector<const std::vector<VecX>*>& trajectories, const LearningOptions& options) {
   std::vector<MatX> parts;
   parts.reserve(trajectories.size());
-  Eigen::Index rows = 0;
-  for (size_t i = 0; i < trajectories.size(); ++i) {
+  for (size_t i = 0; i < trajectories.size(); ++i)
     parts.push_back(collect_stretches(meshes[i], *trajectories[i], options.stretch_samples));
-    rows += parts.back().rows();
-  }
-  MatX stacked(rows, 3);
-  rows = 0;
-  for (const MatX& part : parts) {
-    stacked.middleRows(rows, part.rows()) = part;
-    rows += part.rows();
-  }
-  return stacked;
+  return stacked_rows(parts, 3);
 }
 
 /// The corrections' trusted stretches (material/trusted_stretches.hpp): the interval of every
