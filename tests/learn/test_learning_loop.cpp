@@ -84,7 +84,7 @@ TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   const double learned_error = swing_error(
       bar_scene(truth, true), sim::with_correction(bar_scene(nominal, true), state.best));
   // Stored regression figures (Release build, this configuration): nominal 4.450 %, learned
-  // 0.0312 % (140× lower; how each change of the loop moved them: docs/benchmarks_learning.md).
+  // 0.0312 % (140× lower).
   // The issue asks for ≥ 5× below the nominal; the test asserts that, and that the learned figure
   // stays within 2× of the stored one (a compiler's different rounding moves it a little; a
   // broken stage moves it by orders of magnitude).

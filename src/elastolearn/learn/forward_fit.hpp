@@ -70,8 +70,8 @@ struct ForwardFitOptions {
   double damping = 1e-2;
   /// The step Jacobian of the sensitivities. Projected (the simulator's) by default: with the
   /// exact one, steps the projected one takes on the sphere-compression case are rejected and
-  /// the fit stalls (docs/benchmarks_learning.md, "the forward fit"); the exact one is the
-  /// derivative the tests check.
+  /// the fit stalls (docs/learning.md, "Forward fit"); the exact one is the derivative the tests
+  /// check.
   Sensitivities sensitivities = Sensitivities::projected;
   /// Weight ρ_d of a Tikhonov prior on the damping unknowns (Δα₁): the fit minimises
   /// E(w) + ρ_d Σ_{i damping} (s_i w_i)², s_i = √(JᵀJ)_ii of the current accepted pass, so ρ_d is

@@ -47,8 +47,8 @@ struct LearningOptions {
   /// Divergences in a row that are halved towards the best correction without counting against
   /// patience: a step that overshoots is shortened to ½, ¼, … of itself before the loop gives up
   /// on its direction, because a correction whose whole and half steps diverge can still learn
-  /// at a quarter (the full-size sphere-tension case does: docs/benchmarks_learning.md). Each
-  /// halving still counts as an iteration.
+  /// at a quarter (on the full-size sphere-tension case: docs/design_notes.md). Each halving
+  /// still counts as an iteration.
   int free_halvings = 2;
   PodOptions pod; ///< reduced basis (max_modes, frame window and stride)
   /// POD snapshots from the constrained simulation too, not only the forward one, so that span Φ

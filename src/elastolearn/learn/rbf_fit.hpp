@@ -28,10 +28,10 @@ struct RbfFitOptions {
   bool quadratic_tail = true;
   /// Also fit the neo-Hookean tail r (material::neo_hookean_tail_basis; needs elastic_polynomial).
   /// Off by default: it makes the end-to-end regression case (tests/learn/test_learning_loop.cpp)
-  /// and its distilled network learn worse. The sphere cases turn it on, together with a prior
-  /// on Δα₁ in the forward fit (ForwardFitOptions::damping_prior): alone the tail keeps the
-  /// quick sphere-compression test simulation from diverging but tests above the nominal there
-  /// (docs/learning.md, "Neo-Hookean tail"; docs/benchmarks_learning.md).
+  /// and its distilled network learn worse. Together with a prior on Δα₁ in the forward fit
+  /// (ForwardFitOptions::damping_prior) it keeps the sphere-compression test simulation from
+  /// diverging; alone it does so on the quick mesh but tests above the nominal there
+  /// (docs/learning.md, "Neo-Hookean tail").
   bool neo_hookean_tail = false;
   /// Fit the stiffness-damping RBF Δα₁(σ) (only the stress reconstruction can: it needs the
   /// elements' damping forces, which principal stress samples do not carry).
