@@ -31,6 +31,7 @@
 #include <cstdio>
 #include <limits>
 #include <span>
+#include <stdexcept>
 #include <thread>
 
 namespace {
@@ -470,6 +471,12 @@ struct RandomRow {
 constexpr int kMotionAttempts = 6;
 constexpr double kInformative = 0.25; ///< [% of the rest bounding-box diagonal]
 
+/// A drawn object none of whose motions makes a case (the truth cannot follow them, or they cannot
+/// tell it from the nominal): the benchmark skips it, it is no learning failure.
+struct Undrawable : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// Print case `index` of `seed`; with `run`, simulate its truth, learn with the recipe (default
 /// options), and measure nominal / fitted / learned on the test motion.
 RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, bool run) {
@@ -498,8 +505,8 @@ RandomRow run_random_case(std::uint64_t seed, int index, const fs::path& data, b
   double scale = 1;
   for (int attempt = 0;; ++attempt) {
     if (attempt == kMotionAttempts)
-      throw InputError("random case " + std::to_string(index),
-          "no drawn motion passed (" + std::to_string(kMotionAttempts) + " attempts)");
+      throw Undrawable("no drawn motion passed (" + std::to_string(kMotionAttempts)
+          + " attempts): the truth cannot follow them or they cannot tell it from the nominal");
     motions = draw_random_motions(o, attempt, scale);
     std::printf("   motions (attempt %d): train: %s\n                        test: %s\n", attempt,
         motions.train_label.c_str(), motions.test_label.c_str());
@@ -690,8 +697,9 @@ void print_random_summary(const std::vector<RandomRow>& rows, int failed) {
       test_divergences);
 }
 
-/// --random N / --random-case I: the cases, then the summary (unless draw_only). Non-zero exit
-/// status only if a case failed to run.
+/// --random N / --random-case I: the cases, then the summary (unless draw_only). An undrawable
+/// case (Undrawable) is skipped and, with --random N, replaced by the next index, so that N cases
+/// run. Non-zero exit status only if a case failed to run.
 int run_random(int count, int only, const fs::path& data, bool draw_only) {
   const std::uint64_t seed
       = g_seed >= 0 ? static_cast<std::uint64_t>(g_seed) : std::random_device {}() & 0x7fffffffu;
@@ -700,23 +708,29 @@ int run_random(int count, int only, const fs::path& data, bool draw_only) {
       only >= 0 ? (" --random-case " + std::to_string(only)).c_str() : "",
       std::thread::hardware_concurrency());
   std::vector<RandomRow> rows;
-  int failed = 0;
-  const int first = only >= 0 ? only : 0, last = only >= 0 ? only + 1 : count;
-  for (int index = first; index < last; ++index) {
+  std::string skipped;
+  int failed = 0, index = only >= 0 ? only : 0;
+  const int last_index = only >= 0 ? only + 1 : 3 * count; // a bound on replacements
+  for (; index < last_index && static_cast<int>(rows.size()) + failed < count; ++index) {
     try {
       rows.push_back(run_random_case(seed, index, data, !draw_only));
-      if (!draw_only && index + 1 < last)
+      if (!draw_only && static_cast<int>(rows.size()) + failed < count)
         print_random_summary(rows, failed);
+    } catch (const Undrawable& e) {
+      std::printf("   SKIPPED (undrawable, not counted): %s\n", e.what());
+      skipped += " " + std::to_string(index);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "random case %d failed: %s\n", index, e.what());
       std::printf("   FAILED TO RUN: %s\n", e.what());
       ++failed;
     }
   }
+  if (!skipped.empty())
+    std::printf("\nundrawable cases skipped:%s\n", skipped.c_str());
   if (!draw_only) {
     std::printf("\n== summary of seed %llu, %s\n", static_cast<unsigned long long>(seed),
         only >= 0 ? ("case " + std::to_string(only)).c_str()
-                  : ("cases 0–" + std::to_string(count - 1)).c_str());
+                  : ("cases 0–" + std::to_string(index - 1)).c_str());
     print_random_summary(rows, failed);
   }
   return failed > 0 ? 1 : 0;
