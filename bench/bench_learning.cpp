@@ -711,10 +711,11 @@ int run_random(int count, int only, const fs::path& data, bool draw_only) {
   std::string skipped;
   int failed = 0, index = only >= 0 ? only : 0;
   const int last_index = only >= 0 ? only + 1 : 3 * count; // a bound on replacements
-  for (; index < last_index && static_cast<int>(rows.size()) + failed < count; ++index) {
+  const auto more = [&] { return only >= 0 || static_cast<int>(rows.size()) + failed < count; };
+  for (; index < last_index && more(); ++index) {
     try {
       rows.push_back(run_random_case(seed, index, data, !draw_only));
-      if (!draw_only && static_cast<int>(rows.size()) + failed < count)
+      if (!draw_only && only < 0 && more())
         print_random_summary(rows, failed);
     } catch (const Undrawable& e) {
       std::printf("   SKIPPED (undrawable, not counted): %s\n", e.what());
