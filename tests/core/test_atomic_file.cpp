@@ -4,12 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <string>
+#include <unistd.h>
 
 using namespace elastolearn;
 namespace fs = std::filesystem;
 
 TEST(AtomicFile, UncommittedWriteLeavesNothing) {
-  const fs::path dir = fs::temp_directory_path() / "elastolearn_atomic_test";
+  // Per process: another build's tests may run at the same time.
+  const fs::path dir
+      = fs::temp_directory_path() / ("elastolearn_atomic_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const fs::path target = dir / "out.txt";
   {

@@ -8,6 +8,7 @@
 #include <elastolearn/observe/visible_vertices.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
+#include "io_test_util.hpp"
 #include <support/bar_scene.hpp>
 #include <support/learning_history.hpp>
 
@@ -19,7 +20,7 @@ namespace elastolearn::io {
 namespace {
 
 sim::Scene bar(material::ElasticModelType type, double young) {
-  return test::bar_scene(
+  return elastolearn::test::bar_scene(
       { .model = type, .young = young, .poisson = 0.43, .alpha1 = 0.01, .dt = 4e-3, .frames = 40 });
 }
 
@@ -28,8 +29,9 @@ struct Fixture {
   observe::Observation observed;
   learn::LearningOptions options;
   LearningInputs inputs;
-  std::filesystem::path file
-      = std::filesystem::temp_directory_path() / "elastolearn_test_checkpoint.json";
+  // Each test its own directory: ctest runs the tests of this file in parallel processes.
+  test::ScratchDir scratch;
+  std::filesystem::path file = scratch / "checkpoint.json";
   Fixture() {
     const auto run = sim::simulate_positions(bar(material::ElasticModelType::NeoHookean, 1e6));
     std::vector<Positions> frames;
@@ -42,7 +44,6 @@ struct Fixture {
     options.pod.max_modes = 8;
     inputs = { "scene.json", "obs.h5", learning_options_to_json(options) };
   }
-  ~Fixture() { std::filesystem::remove(file); }
 };
 
 void expect_same(const material::RbfCorrection& a, const material::RbfCorrection& b) {
@@ -93,7 +94,7 @@ void expect_resume_equals_whole(Fixture& f, int stop_after) {
   EXPECT_EQ(resumed.best_iteration, whole.best_iteration);
   EXPECT_EQ(resumed.best_error, whole.best_error);
   EXPECT_EQ(resumed.forward_fit_steps, whole.forward_fit_steps);
-  test::expect_same_steps(resumed.history, whole.history);
+  elastolearn::test::expect_same_steps(resumed.history, whole.history);
   ASSERT_TRUE(resumed.best);
   expect_same(*resumed.best, *whole.best); // bit-identical: every stage is deterministic
 }
@@ -331,7 +332,7 @@ TEST(LearningCheckpoint, ResumesACheckpointWrittenInVersion2) {
   ASSERT_TRUE(learn::run_learning(f.nominal, f.observed, f.options, resumed));
   learn::LearningState whole;
   ASSERT_TRUE(learn::run_learning(f.nominal, f.observed, f.options, whole));
-  test::expect_same_steps(resumed.history, whole.history, 1e-9);
+  elastolearn::test::expect_same_steps(resumed.history, whole.history, 1e-9);
   EXPECT_EQ(resumed.best_iteration, whole.best_iteration);
   EXPECT_NEAR(resumed.best_error, whole.best_error, 1e-9 * whole.best_error);
   ASSERT_TRUE(resumed.best && whole.best);

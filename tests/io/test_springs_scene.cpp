@@ -1,6 +1,8 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/io/springs_scene.hpp>
 
+#include "io_test_util.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -88,10 +90,10 @@ TEST(SpringsScene, LearnedSpringRoundTrips) {
   springs::LearnOptions o;
   o.features.degree = 3;
   const springs::LearnedSpring spring = springs::learn_spring(t, o);
-  const auto path = std::filesystem::temp_directory_path() / "elastolearn_test_learned_spring.json";
+  const io::test::ScratchDir scratch;
+  const auto path = scratch / "learned_spring.json";
   io::write_learned_spring(path, spring, &t.law);
   const springs::LearnedSpring back = io::read_learned_spring(path);
-  std::filesystem::remove(path);
   EXPECT_EQ(back.features().degree, 3);
   EXPECT_DOUBLE_EQ(back.dt(), spring.dt());
   // JSON numbers round-trip doubles exactly (nlohmann writes 17 significant digits).
