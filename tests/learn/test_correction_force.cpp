@@ -6,11 +6,12 @@
 #include <elastolearn/fem/elastic_force.hpp>
 #include <elastolearn/learn/correction_force.hpp>
 #include <elastolearn/learn/element_state.hpp>
-#include <elastolearn/material/analytic_correction.hpp>
 #include <elastolearn/material/corotated.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
 #include <elastolearn/material/rbf_correction.hpp>
 #include <elastolearn/mesh/primitives.hpp>
+
+#include <support/damped_analytic_correction.hpp>
 
 #include <gtest/gtest.h>
 
@@ -29,28 +30,11 @@ mesh::TetMesh small_mesh() {
   return mesh::make_box_bar(Vec3(0.3, 0.1, 0.1), { 3, 2, 2 }); // 72 tets
 }
 
-/// N = AnalyticCorrection (a cubic in the stretches plus a stretch-dependent viscous term, so
-/// N depends on the rates) and Δα₁(σ) = δ + γ (σ₀ − 1).
-class ViscousCorrection final : public material::Correction {
-  public:
-  ViscousCorrection(double delta, double gamma)
-      : m_n({ 1e5, 200.0, 3.0 })
-      , m_delta(delta)
-      , m_gamma(gamma) { }
-  std::string name() const override { return "viscous"; }
-  Vec3 correction(const Vec3& s, const Vec3& r) const override { return m_n.correction(s, r); }
-  void correction_gradient(const Vec3& s, const Vec3& r, Mat3& ds, Mat3& dr) const override {
-    m_n.correction_gradient(s, r, ds, dr);
-  }
-  double stiffness_damping(const Vec3& s) const override { return m_delta + m_gamma * (s[0] - 1); }
-  std::unique_ptr<Correction> clone() const override {
-    return std::make_unique<ViscousCorrection>(*this);
-  }
-
-  private:
-  material::AnalyticCorrection m_n;
-  double m_delta, m_gamma;
-};
+/// N = AnalyticCorrection (a cubic in the stretches plus a stretch-rate viscous term, so N
+/// depends on the rates) and Δα₁(σ) = δ + γ (σ₀ − 1).
+test::DampedAnalyticCorrection viscous_correction(double delta, double gamma) {
+  return { { 1e5, 200.0, 3.0 }, delta, gamma };
+}
 
 /// A learned-type correction: 5 stress kernels near rest with a tail, and a damping part.
 material::RbfCorrection rbf_correction() {
@@ -143,7 +127,7 @@ TEST(CorrectionForce, IsTheElasticForceWithTheCorrectionMinusWithout) {
   const mesh::TetMesh mesh = small_mesh();
   const int m = mesh.num_tets();
   const auto scales = random_scales(m);
-  const ViscousCorrection viscous(-0.01, -0.1);
+  const auto viscous = viscous_correction(-0.01, -0.1);
   const material::RbfCorrection rbf = rbf_correction();
   const State s = random_state(mesh, 3);
   const State still { s.x, VecX::Zero(s.v.size()) };
@@ -178,11 +162,11 @@ TEST(CorrectionForce, WithoutANominalElasticModelIsTheCorrectionStressAlone) {
   // No nominal model: B N(σ, ḟ) only (no damping, no Δα₁), i.e. ElasticForce's difference with
   // the nominal and the Rayleigh damping switched off.
   const mesh::TetMesh mesh = small_mesh();
-  const ViscousCorrection viscous(0.01, 0.0);
+  const auto viscous = viscous_correction(0.01, 0.0);
   const State s = random_state(mesh, 4);
   fem::MaterialModel undamped = nominal(material::DampingTangent::FlipFree, nullptr);
   undamped.damping = nullptr;
-  const ViscousCorrection no_delta(0.0, 0.0);
+  const auto no_delta = viscous_correction(0.0, 0.0);
   const VecX expected = elastic_force_difference(mesh, undamped, no_delta, s);
   const VecX f = correction_force(ReconstructionMesh(mesh), viscous, s.x, s.v);
   EXPECT_LE((f - expected).lpNorm<Eigen::Infinity>(), 1e-10 * expected.lpNorm<Eigen::Infinity>());

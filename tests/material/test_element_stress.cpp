@@ -2,11 +2,11 @@
 // damps the corrected elastic stress at zero rate, a learned Δα₁ damps the nominal stress (so
 // that where N = 0 it is exactly a change of α₁) and is clamped at α₁ + Δα₁ ≥ 0, and the
 // correction's share of the damping is the damping with it minus without it.
-#include <elastolearn/material/analytic_correction.hpp>
 #include <elastolearn/material/corotated.hpp>
 #include <elastolearn/material/element_stress.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
 
+#include <support/damped_analytic_correction.hpp>
 #include <support/material_states.hpp>
 
 #include <gtest/gtest.h>
@@ -18,30 +18,7 @@ namespace {
 
 const CorotatedModel kNominal(Lame::from_young_poisson(5e4, 0.4));
 
-/// N = AnalyticCorrection(a, b, c) (rate-dependent iff b ≠ 0) and Δα₁(σ) = δ + γ (σ₀ − 1).
-class TestCorrection final : public Correction {
-  public:
-  TestCorrection(AnalyticCorrection::Parameters n, double delta, double gamma)
-      : m_n(n)
-      , m_rates(n.b != 0)
-      , m_delta(delta)
-      , m_gamma(gamma) { }
-  std::string name() const override { return "test"; }
-  Vec3 correction(const Vec3& s, const Vec3& r) const override { return m_n.correction(s, r); }
-  void correction_gradient(const Vec3& s, const Vec3& r, Mat3& ds, Mat3& dr) const override {
-    m_n.correction_gradient(s, r, ds, dr);
-  }
-  bool depends_on_rates() const override { return m_rates; }
-  double stiffness_damping(const Vec3& s) const override { return m_delta + m_gamma * (s[0] - 1); }
-  std::unique_ptr<Correction> clone() const override {
-    return std::make_unique<TestCorrection>(*this);
-  }
-
-  private:
-  AnalyticCorrection m_n;
-  bool m_rates;
-  double m_delta, m_gamma;
-};
+using TestCorrection = test::DampedAnalyticCorrection;
 
 const Vec3 kStretches(1.2, 0.95, 0.8), kRates(0.4, -0.3, 0.1);
 
