@@ -109,6 +109,19 @@ TEST(SceneFile, RefusesANonPositiveScaleNamingTheField) {
   expect_input_error([&] { parse(j, dir.path()); }, { "scene.json: mesh.rotate_deg" });
 }
 
+TEST(SceneFile, SolverStepHalvingsAreReadAndOutOfRangeIsAnErrorNamingTheField) {
+  ScratchDir dir;
+  EXPECT_EQ(parse(bar_scene(), dir.path()).scene.newton.max_step_halvings, 3);
+  Json j = bar_scene();
+  j["solver"] = { { "max_step_halvings", 0 } };
+  EXPECT_EQ(parse(j, dir.path()).scene.newton.max_step_halvings, 0);
+  for (int bad : { -1, 11 }) {
+    j["solver"]["max_step_halvings"] = bad;
+    expect_input_error([&] { parse(j, dir.path()); },
+        { "scene.json: solver.max_step_halvings: must be in [0, 10]" });
+  }
+}
+
 // --- selections -------------------------------------------------------------------------------
 
 TEST(SceneFile, EverySelectionThatSelectsNoVertexIsAnErrorNamingIt) {

@@ -103,6 +103,35 @@ TEST(Newton, JacobianIsRefreshedWhenAChordStepContractsLittle) {
   EXPECT_LE(reuse.iterations, full.iterations + 3);
 }
 
+TEST(Newton, ASolveTheProjectedTangentCannotFinishIsRetriedWithTheExactOne) {
+  // The large-droop static solve: elements in compression have indefinite tangents, whose PSD
+  // projection slows Newton to linear convergence near the solution. With one iteration fewer
+  // than the projected solve needs, the retry with the exact tangent (quadratic near the
+  // solution, where the assembled exact Jacobian is positive definite) must reach the same
+  // equilibrium; without the retry the solve fails.
+  auto s = test::bar_scene({ .young = 2e4, .poisson = 0.3 });
+  s.newton.relative_tolerance = 1e-10;
+  s.newton.jacobian_reuse_contraction = 0;
+  s.newton.retry_exact_tangent = false;
+  sim::Simulator projected(s);
+  const auto reference = projected.solve_static(1);
+  ASSERT_TRUE(reference.converged) << reference.message;
+  std::printf("  projected tangent: %d iterations\n", reference.iterations);
+  ASSERT_GE(reference.iterations, 3);
+
+  s.newton.max_iterations = reference.iterations - 1;
+  sim::Simulator strict(s);
+  EXPECT_FALSE(strict.solve_static(1).converged);
+  s.newton.retry_exact_tangent = true;
+  sim::Simulator retried(s);
+  const auto report = retried.solve_static(1);
+  ASSERT_TRUE(report.converged) << report.message;
+  std::printf("  retried: %d iterations in all\n", report.iterations);
+  const double droop = -mean_tip_y(s.mesh, projected.positions());
+  EXPECT_GT(droop, 0.05);
+  EXPECT_LE((retried.positions() - projected.positions()).cwiseAbs().maxCoeff(), 1e-8 * droop);
+}
+
 TEST(Statics, CantileverTipDeflectionConvergesToBeamTheory) {
   // Cantilever L = 1, square section a = 0.1 (L/a = 10), ν = 0 (no Poisson stiffening), under
   // its own weight q = ρ g a²: δ = q L⁴/(8 E I) (Euler–Bernoulli) + q L²/(2 κ G A) (Timoshenko
@@ -272,6 +301,7 @@ TEST(Divergence, StopsWithAMessageNamingTheFrameAndKeepsEarlierFrames) {
   auto s = test::bar_scene({ .young = 3e5 });
   s.newton.max_iterations = 1;
   s.newton.relative_tolerance = 1e-12;
+  s.newton.max_step_halvings = 0; // substeps would not help either, but cost 15× the time
   s.frames = 50;
   int frames_seen = 0;
   const auto report
@@ -280,4 +310,70 @@ TEST(Divergence, StopsWithAMessageNamingTheFrameAndKeepsEarlierFrames) {
   EXPECT_NE(report.message.find("frame 1"), std::string::npos) << report.message;
   EXPECT_EQ(frames_seen, report.frames_written);
   EXPECT_EQ(frames_seen, 1);
+}
+
+TEST(Substeps, AStepNewtonCannotSolveWholeIsBackwardEulerInEqualSubsteps) {
+  // Three Newton iterations to a 1e-10 relative tolerance on a soft bar falling under gravity:
+  // some step fails whole (measured: the first before frame 40) and converges in substeps, whose
+  // problems are closer to linear. The state after it must be that of a simulator with the
+  // substep length run from the same state for as many steps, and the step must end on the
+  // frame's time.
+  auto s = test::bar_scene({ .size = { 0.2, 0.04, 0.04 },
+      .cells = { 10, 2, 2 },
+      .young = 1e5,
+      .poisson = 0.3,
+      .dt = 2e-3 });
+  s.newton.max_iterations = 3;
+  s.newton.relative_tolerance = 1e-10;
+  s.newton.jacobian_reuse_contraction = 0;
+  s.newton.retry_exact_tangent = false; // substeps alone
+  sim::Simulator whole(s);
+  sim::NewtonReport report;
+  VecX x_before, v_before;
+  double t_before = 0;
+  for (int i = 0; i < 60 && report.substeps == 1; ++i) {
+    x_before = whole.positions();
+    v_before = whole.velocities();
+    t_before = whole.time();
+    report = whole.step();
+    ASSERT_TRUE(report.converged) << "step " << i << ": " << report.message;
+  }
+  ASSERT_GT(report.substeps, 1) << "no step needed substeps: the test no longer tests them";
+  EXPECT_NEAR(whole.time(), whole.step_index() * s.dt, 1e-15);
+
+  auto fine = s;
+  fine.dt = s.dt / report.substeps;
+  fine.newton.max_step_halvings = 0;
+  sim::Simulator reference(fine);
+  reference.set_state(x_before, v_before, t_before);
+  for (int i = 0; i < report.substeps; ++i)
+    ASSERT_TRUE(reference.step().converged);
+  // Both solve the same equations to the same tolerance (1e-10 of each substep's residual).
+  const double scale = reference.positions().cwiseAbs().maxCoeff();
+  EXPECT_LE((whole.positions() - reference.positions()).cwiseAbs().maxCoeff(), 1e-9 * scale);
+  EXPECT_LE((whole.velocities() - reference.velocities()).cwiseAbs().maxCoeff(),
+      1e-6 * reference.velocities().cwiseAbs().maxCoeff());
+
+  // Without the retry the same step fails and leaves the state where it was.
+  auto strict_scene = s;
+  strict_scene.newton.max_step_halvings = 0;
+  sim::Simulator strict(strict_scene);
+  strict.set_state(x_before, v_before, t_before);
+  EXPECT_FALSE(strict.step().converged);
+  EXPECT_EQ(strict.positions(), x_before);
+  EXPECT_EQ(strict.time(), t_before);
+}
+
+TEST(Substeps, AStepThatConvergesWholeIsNeverSplit) {
+  const auto s = test::bar_scene({ .young = 3e5 });
+  auto strict = s;
+  strict.newton.max_step_halvings = 0;
+  sim::Simulator a(s), b(strict);
+  for (int i = 0; i < 20; ++i) {
+    const auto r = a.step();
+    ASSERT_TRUE(r.converged);
+    EXPECT_EQ(r.substeps, 1);
+    ASSERT_TRUE(b.step().converged);
+  }
+  EXPECT_EQ(a.positions(), b.positions());
 }

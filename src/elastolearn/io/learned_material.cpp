@@ -48,6 +48,8 @@ nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
         { "larger_motion", larger_motion_to_json(c.larger_motion) }, { "eligible", c.eligible() },
         // null: infinite (noise σ = 0), its sign that of the validation errors' difference
         { "significance", finite_or_null(c.significance) } });
+    if (!c.completed)
+      candidates.back()["failure"] = c.failure;
     if (c.kind == learn::CandidateKind::Network) {
       candidates.back()["teacher"] = c.teacher;
       candidates.back()["gain_over_teacher"] = finite_or_null(c.gain_over_teacher);

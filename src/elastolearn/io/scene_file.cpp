@@ -315,14 +315,17 @@ SceneFile parse_scene(
     time.fail("frames", "must be at least 1");
   if (root.has("solver")) {
     const JsonObject solver = root.object("solver");
-    solver.reject_unknown_keys(
-        { "linear", "newton_tolerance", "max_newton_iterations", "reuse_jacobian" });
+    solver.reject_unknown_keys({ "linear", "newton_tolerance", "max_newton_iterations",
+        "reuse_jacobian", "max_step_halvings" });
     s.linear_solver = sim::linear_solver_type_from_string(
         solver.choice("linear", { "cholmod", "cg", "eigen-ldlt" }, "cholmod"));
     s.newton.relative_tolerance = solver.positive("newton_tolerance", s.newton.relative_tolerance);
     s.newton.max_iterations = solver.integer("max_newton_iterations", s.newton.max_iterations);
     if (!solver.boolean("reuse_jacobian", true))
       s.newton.jacobian_reuse_contraction = 0;
+    s.newton.max_step_halvings = solver.integer("max_step_halvings", s.newton.max_step_halvings);
+    if (s.newton.max_step_halvings < 0 || s.newton.max_step_halvings > 10)
+      solver.fail("max_step_halvings", "must be in [0, 10]");
   }
   if (root.has("output")) {
     const JsonObject o = root.object("output");

@@ -203,8 +203,10 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
   for (const HeldOut& piece : split.validation) {
     const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece, 1));
     c.completed = run.completed;
-    if (!run.completed)
+    if (!run.completed) {
+      c.failure = piece.motion.name + ": " + run.message;
       return {};
+    }
     const std::vector<VecX> compared(
         run.positions.begin() + piece.first_frame, run.positions.end());
     errors.push_back(observation_error(compared, piece.motion.observed));
@@ -471,7 +473,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
         "candidate " + to_string(kind) + (iteration >= 0 ? " " + std::to_string(iteration) : "")
             + (c.completed ? format(": validation error rms %.4f %%, max %.4f %%",
                    100 * c.validation.rms / size, 100 * c.validation.max / size)
-                           : ": its simulation of the held-out data diverged")
+                           : ": its simulation of the held-out data diverged (" + c.failure + ")")
             + (c.completed ? describe_larger_motion(c.larger_motion) : ""));
     result.candidates.push_back(std::move(c));
   };

@@ -89,6 +89,7 @@ struct Candidate {
   int teacher = -1;
   double gain_over_teacher = 0;
   bool completed = false; ///< the validation simulation completed
+  std::string failure; ///< why it did not (names the motion and the frame); empty if it did
   ErrorSummary validation; ///< at the held-out observations [m]
   /// Whether its material survives a larger motion of the same kind: every held-out motion's
   /// scene driven kLargerMotion times as hard (sim::amplified_scene) must simulate to its end,

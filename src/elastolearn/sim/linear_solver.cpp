@@ -59,6 +59,12 @@ constexpr Eigen::Index kThreadedBlasMinUnknowns = 20000;
 template <typename Factorization, LinearSolverType Type>
 class DirectSolver final : public LinearSolver {
   public:
+  DirectSolver() {
+    // A matrix that is not positive definite is a result (factorize returns false and the caller
+    // reports it), not something for CHOLMOD to print on stderr.
+    if constexpr (Type == LinearSolverType::Cholmod)
+      m_factor.cholmod().print = 0;
+  }
   void analyze(const fem::SparseMatrix& A) override {
     m_threaded_blas = A.rows() >= kThreadedBlasMinUnknowns;
     m_factor.analyzePattern(A);

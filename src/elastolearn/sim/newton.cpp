@@ -16,6 +16,9 @@ void NewtonOptions::validate() const {
     throw InputError("newton.max_iterations", "must be >= 1");
   if (max_line_search < 0)
     throw InputError("newton.max_line_search", "must be >= 0");
+  if (max_step_halvings < 0 || max_step_halvings > 10)
+    throw InputError(
+        "newton.max_step_halvings", "must be in [0, 10], got " + std::to_string(max_step_halvings));
   if (!(jacobian_reuse_contraction == 0 || jacobian_reuse_contraction > 1))
     throw InputError("newton.jacobian_reuse_contraction", "must be 0 (off) or > 1");
 }
@@ -25,6 +28,13 @@ SolverTimings& SolverTimings::operator+=(const SolverTimings& o) {
   factorization += o.factorization;
   solve += o.solve;
   return *this;
+}
+
+void NewtonReport::add_work(const NewtonReport& other) {
+  iterations += other.iterations;
+  jacobians += other.jacobians;
+  linear_iterations += other.linear_iterations;
+  timings += other.timings;
 }
 
 NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatrix& A,

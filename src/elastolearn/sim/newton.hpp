@@ -26,6 +26,12 @@ struct NewtonOptions {
   /// the Jacobian has barely changed: reuse saves an assembly and a factorisation per step at
   /// the same convergence criterion. 0 turns reuse off (every iteration assembles).
   double jacobian_reuse_contraction = 10;
+  /// Time steps only (Simulator::step): a step whose Newton solve fails is retried as 2, 4, …,
+  /// 2^max_step_halvings substeps before the step counts as failed. 0: no retry.
+  int max_step_halvings = 3;
+  /// Simulator solves (time steps, static load steps): a solve that fails with the PSD-projected
+  /// tangent is retried from the same start with the exact one, before any substep.
+  bool retry_exact_tangent = true;
   /// Throws InputError naming the offending option.
   void validate() const;
 };
@@ -46,6 +52,11 @@ struct NewtonReport {
   double initial_residual = 0;
   double residual = 0;
   std::string message; ///< why it stopped when not converged
+  /// Equal substeps the time step took (Simulator::step): 1 unless the whole step failed and a
+  /// split of it converged.
+  int substeps = 1;
+  /// Adds another solve's iterations, Jacobians, linear iterations and timings to this one's.
+  void add_work(const NewtonReport& other);
   SolverTimings timings;
 };
 

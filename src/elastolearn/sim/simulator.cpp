@@ -102,9 +102,59 @@ void Simulator::sum_jacobians(const VecX& x, const VecX& v, double t, double c_x
 }
 
 NewtonReport Simulator::step() {
-  const double h = m_scene.dt;
   // From the step count rather than m_time + h, so that round-off does not accumulate.
-  const double t_next = m_start_time + (m_step + 1) * h;
+  const double t_next = m_start_time + (m_step + 1) * m_scene.dt;
+  NewtonReport report = advance(t_next, m_scene.dt);
+  if (!report.converged)
+    report = advance_in_substeps(t_next, std::move(report));
+  if (report.converged) {
+    m_time = t_next;
+    ++m_step;
+  }
+  return report;
+}
+
+NewtonReport Simulator::advance_in_substeps(double t_next, NewtonReport failed) {
+  // Backward Euler's step matrix is M/h² + K (+ D/h): halving h quadruples the mass term, so a
+  // step whose incremental problem Newton cannot solve (a material stiffening or softening
+  // sharply within the step, elements near inversion) becomes better conditioned and, for h
+  // small enough, convex. Each retry splits the whole step into twice as many equal substeps
+  // from the same start; a step that converges whole is never split, so results that did not
+  // need substeps are unchanged.
+  const int halvings = m_scene.newton.max_step_halvings;
+  if (halvings == 0)
+    return failed;
+  const VecX x_start = m_x, v_start = m_v; // allocated only on this (failure) path
+  const double t_start = t_next - m_scene.dt;
+  NewtonReport total = failed;
+  for (int level = 1; level <= halvings; ++level) {
+    const int substeps = 1 << level;
+    const double h = m_scene.dt / substeps;
+    m_x = x_start;
+    m_v = v_start;
+    bool converged = true;
+    for (int i = 1; i <= substeps && converged; ++i) {
+      const NewtonReport r = advance(i == substeps ? t_next : t_start + i * h, h);
+      total.add_work(r);
+      total.residual = r.residual;
+      converged = r.converged;
+      if (!converged)
+        total.message = failed.message + "; in " + std::to_string(substeps) + " substeps, substep "
+            + std::to_string(i) + ": " + r.message;
+    }
+    if (converged) {
+      total.converged = true;
+      total.substeps = substeps;
+      total.message.clear();
+      return total;
+    }
+  }
+  m_x = x_start;
+  m_v = v_start;
+  return total;
+}
+
+NewtonReport Simulator::advance(double t_next, double h) {
   // Unknowns: free end-of-step velocities. Prescribed velocities follow the keyframes; they are
   // set once per step here (free entries are overwritten by each Newton iterate).
   m_v_new = (prescribed_positions(t_next) - m_x) / h;
@@ -137,7 +187,7 @@ NewtonReport Simulator::step() {
   if (m_solver->type() == LinearSolverType::ConjugateGradient)
     problem.first_increment = &m_first_increment;
   VecX u = m_dofs.restrict(m_v);
-  NewtonReport report = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+  NewtonReport report = newton(problem, u);
   if (!report.converged)
     return report;
   state_from(u);
@@ -148,9 +198,31 @@ NewtonReport Simulator::step() {
   }
   m_x = m_x_new;
   m_v = m_v_new;
-  m_time = t_next;
-  ++m_step;
   return report;
+}
+
+NewtonReport Simulator::newton(const NewtonProblem& problem, VecX& u) {
+  if (!m_scene.newton.retry_exact_tangent)
+    return newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+  m_u_start = u;
+  NewtonReport projected = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+  if (projected.converged)
+    return projected;
+  // Newton's matrix projects every element's tangent to PSD, so it differs from the true
+  // Jacobian wherever an element's tangent is indefinite (compression, a learned correction that
+  // softens): Newton then converges only linearly and can stall just above its target. Near a
+  // stable solution the assembled exact Jacobian is positive definite even where element
+  // tangents are not, and Newton with it converges quadratically; where it is not, its
+  // factorisation fails and the solve stops.
+  u = m_u_start;
+  m_elastic->set_project_tangent(false);
+  NewtonReport exact = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+  m_elastic->set_project_tangent(true);
+  exact.add_work(projected);
+  exact.initial_residual = projected.initial_residual;
+  if (!exact.converged)
+    exact.message = projected.message + "; with the exact tangent: " + exact.message;
+  return exact;
 }
 
 VecX Simulator::total_force(const VecX& x, const VecX& v, double t) {
@@ -192,11 +264,8 @@ NewtonReport Simulator::solve_static(int load_steps) {
   total.converged = true;
   for (int k = 1; k <= load_steps; ++k) {
     m_loads->set_scale(double(k) / load_steps);
-    NewtonReport r = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
-    total.iterations += r.iterations;
-    total.jacobians += r.jacobians;
-    total.linear_iterations += r.linear_iterations;
-    total.timings += r.timings;
+    NewtonReport r = newton(problem, u);
+    total.add_work(r);
     total.residual = r.residual;
     if (k == 1)
       total.initial_residual = r.initial_residual;

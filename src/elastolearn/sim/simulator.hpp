@@ -29,8 +29,10 @@ class Simulator {
   /// report (converged = true for the other kinds).
   NewtonReport apply_initial_condition();
 
-  /// Advance one time step. On failure (Newton did not converge, non-finite state) the state is
-  /// left unchanged and the report says why.
+  /// Advance one time step. A step Newton cannot solve whole is retried as 2, 4, …
+  /// 2^NewtonOptions::max_step_halvings equal substeps (NewtonReport::substeps says how many
+  /// it took). On failure (no split converged, non-finite state) the state is left unchanged
+  /// and the report says why.
   NewtonReport step();
 
   /// Static equilibrium f(x) = 0 under the current loads scaled by 1/load_steps … 1 (load
@@ -62,6 +64,14 @@ class Simulator {
   VecX total_force(const VecX& x, const VecX& v, double t);
 
   private:
+  /// One backward Euler step of length h ending at t_next from the current state; the state
+  /// becomes its end on success (time and step count are the caller's).
+  NewtonReport advance(double t_next, double h);
+  /// step()'s retries after `failed`, the report of the whole step.
+  NewtonReport advance_in_substeps(double t_next, NewtonReport failed);
+  /// newton_solve on the scene's system, retried from the same start with the exact (unprojected)
+  /// tangent when it fails and NewtonOptions::retry_exact_tangent is set.
+  NewtonReport newton(const NewtonProblem& problem, VecX& u);
   void sum_forces(const VecX& x, const VecX& v, double t, VecX& f);
   void sum_jacobians(const VecX& x, const VecX& v, double t, double c_x, double c_v);
   void apply_mass(const VecX& dv, VecX& out) const; ///< out = M dv (full 3n)
@@ -83,6 +93,7 @@ class Simulator {
   int m_step = 0; ///< steps since m_start_time; step k ends at m_start_time + k·dt
   // Work vectors (no allocation per Newton iteration).
   VecX m_x_new, m_v_new, m_force, m_dv, m_mass_dv, m_x_prescribed;
+  VecX m_u_start; ///< Newton's start, kept for the exact-tangent retry
   VecX m_first_increment; ///< previous step's first Newton increment (warm start for CG)
 };
 
