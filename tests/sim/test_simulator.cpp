@@ -377,3 +377,25 @@ TEST(Substeps, AStepThatConvergesWholeIsNeverSplit) {
   }
   EXPECT_EQ(a.positions(), b.positions());
 }
+
+TEST(Substeps, ARunReportsTheFirstFrameThatNeededThem) {
+  // The soft bar of the test above: the run completes with substeps, and names the first frame
+  // that needed them, the frame at which the same run without them stops.
+  auto s = test::bar_scene({ .size = { 0.2, 0.04, 0.04 },
+      .cells = { 10, 2, 2 },
+      .young = 1e5,
+      .poisson = 0.3,
+      .dt = 2e-3 });
+  s.frames = 60;
+  s.newton.max_iterations = 3;
+  s.newton.relative_tolerance = 1e-10;
+  s.newton.jacobian_reuse_contraction = 0;
+  s.newton.retry_exact_tangent = false;
+  const auto run = sim::run_simulation(s, {});
+  ASSERT_TRUE(run.completed) << run.message;
+  ASSERT_GE(run.substepped_frames, 1);
+  s.newton.max_step_halvings = 0;
+  const auto strict = sim::run_simulation(s, {});
+  EXPECT_FALSE(strict.completed);
+  EXPECT_EQ(strict.frames_written, run.first_substepped_frame); // frames 0 .. first − 1
+}

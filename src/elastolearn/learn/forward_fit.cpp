@@ -54,10 +54,12 @@ void ForwardFitOptions::validate() const {
         "forward_fit.sensitivities", "the fit needs sensitivities (projected or exact)");
 }
 
-ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
-    const observe::Observation& observed, const ReconstructionMesh& mesh, const RbfDesign& design,
-    const VecX& unknowns, Sensitivities mode, const ProgressCallback& progress) {
-  const auto start = Clock::now();
+namespace {
+
+/// simulate_with_sensitivities of one motion, but for its `seconds`.
+ForwardSensitivityPass untimed_pass(const sim::Scene& scene, const observe::Observation& observed,
+    const ReconstructionMesh& mesh, const RbfDesign& design, const VecX& unknowns,
+    Sensitivities mode, const ProgressCallback& progress) {
   const bool sensitivities = mode != Sensitivities::none;
   ForwardSensitivityPass pass;
   const sim::Scene corrected = sim::with_correction(
@@ -170,6 +172,17 @@ ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
   pass.squared_error = pass.error.rms * pass.error.rms * double(pass.error.samples);
   if (sensitivities)
     pass.normal.triangularView<Eigen::StrictlyUpper>() = pass.normal.transpose();
+  return pass;
+}
+
+} // namespace
+
+ForwardSensitivityPass simulate_with_sensitivities(const sim::Scene& scene,
+    const observe::Observation& observed, const ReconstructionMesh& mesh, const RbfDesign& design,
+    const VecX& unknowns, Sensitivities mode, const ProgressCallback& progress) {
+  const auto start = Clock::now(); // a failed pass reports its time too
+  ForwardSensitivityPass pass
+      = untimed_pass(scene, observed, mesh, design, unknowns, mode, progress);
   pass.seconds = seconds_since(start);
   return pass;
 }

@@ -68,8 +68,10 @@ inline constexpr double kLargerMotion = 1.5;
 /// A candidate's run of the larger motion (Candidate::larger_motion).
 struct LargerMotionCheck {
   bool checked = false; ///< false for the nominals (no correction: nothing to check)
-  bool completed = true; ///< every amplified held-out motion simulated to its end
-  std::string message; ///< why one diverged (names the motion and frame); empty if none did
+  /// Every amplified held-out motion simulated to its end at the scene's time step (no step
+  /// needed substeps: Simulator::step).
+  bool completed = true;
+  std::string message; ///< why one failed (names the motion and frame); empty if none did
 };
 
 /// What the validation compares.
@@ -92,9 +94,9 @@ struct Candidate {
   std::string failure; ///< why it did not (names the motion and the frame); empty if it did
   ErrorSummary validation; ///< at the held-out observations [m]
   /// Whether its material survives a larger motion of the same kind: every held-out motion's
-  /// scene driven kLargerMotion times as hard (sim::amplified_scene) must simulate to its end,
-  /// as the fitted nominal's does. A user's next motion is rarely the one recorded. Not checked
-  /// (passed) for the nominals.
+  /// scene driven kLargerMotion times as hard (sim::amplified_scene) must simulate to its end
+  /// without substeps, as the fitted nominal's does. A user's next motion is rarely the one
+  /// recorded. Not checked (passed) for the nominals.
   LargerMotionCheck larger_motion;
   /// At the training observations [m] (the loop's own signal); NaN for a network (not simulated
   /// on the training data).

@@ -22,6 +22,7 @@ ForwardRun simulate_positions(const Scene& scene, const ProgressCallback& progre
       progress);
   run.completed = report.completed;
   run.message = report.message;
+  run.first_substepped_frame = report.first_substepped_frame;
   if (!run.completed)
     run.positions.clear();
   return run;

@@ -23,6 +23,8 @@ struct ForwardRun {
   VecX initial_velocity; ///< of frame 0, flat 3n [m/s] (empty if the initial condition failed)
   bool completed = false; ///< every frame simulated
   std::string message; ///< why the run stopped early (names the frame); empty when completed
+  /// The first frame whose step converged only in substeps (Simulator::step); 0: none did.
+  int first_substepped_frame = 0;
 };
 
 /// Simulate `scene` (run_simulation) and keep every state. A divergence is a result (completed

@@ -44,6 +44,8 @@ SimulationReport run_simulation(
           + " s): " + step.message + "; kept frames 0.." + std::to_string(frame - 1);
       break;
     }
+    if (step.substeps > 1 && report.substepped_frames++ == 0)
+      report.first_substepped_frame = frame;
     if (sink)
       sink(frame, simulator.time(), simulator.positions(), simulator.velocities());
     ++report.frames_written;

@@ -21,6 +21,10 @@ struct SimulationReport {
   long linear_iterations = 0;
   SolverTimings timings;
   NewtonReport initial; ///< the initial-condition solve (static load), if any
+  /// Steps that converged only in substeps (NewtonReport::substeps > 1), and the first of them
+  /// (0: none).
+  int substepped_frames = 0;
+  int first_substepped_frame = 0;
 };
 
 /// Simulate scene.frames steps from the scene's initial condition. Divergence (Newton failure,
