@@ -312,12 +312,9 @@ TEST(Divergence, StopsWithAMessageNamingTheFrameAndKeepsEarlierFrames) {
   EXPECT_EQ(frames_seen, 1);
 }
 
-TEST(Substeps, AStepNewtonCannotSolveWholeIsBackwardEulerInEqualSubsteps) {
-  // Three Newton iterations to a 1e-10 relative tolerance on a soft bar falling under gravity:
-  // some step fails whole (measured: the first before frame 40) and converges in substeps, whose
-  // problems are closer to linear. The state after it must be that of a simulator with the
-  // substep length run from the same state for as many steps, and the step must end on the
-  // frame's time.
+/// A soft bar falling under gravity with three Newton iterations to a 1e-10 relative tolerance
+/// and no exact-tangent retry: some step before frame 40 fails whole and converges in substeps.
+static sim::Scene soft_bar_needing_substeps() {
   auto s = test::bar_scene({ .size = { 0.2, 0.04, 0.04 },
       .cells = { 10, 2, 2 },
       .young = 1e5,
@@ -327,6 +324,16 @@ TEST(Substeps, AStepNewtonCannotSolveWholeIsBackwardEulerInEqualSubsteps) {
   s.newton.relative_tolerance = 1e-10;
   s.newton.jacobian_reuse_contraction = 0;
   s.newton.retry_exact_tangent = false; // substeps alone
+  return s;
+}
+
+TEST(Substeps, AStepNewtonCannotSolveWholeIsBackwardEulerInEqualSubsteps) {
+  // Three Newton iterations to a 1e-10 relative tolerance on a soft bar falling under gravity:
+  // some step fails whole (measured: the first before frame 40) and converges in substeps, whose
+  // problems are closer to linear. The state after it must be that of a simulator with the
+  // substep length run from the same state for as many steps, and the step must end on the
+  // frame's time.
+  auto s = soft_bar_needing_substeps();
   sim::Simulator whole(s);
   sim::NewtonReport report;
   VecX x_before, v_before;
@@ -381,16 +388,8 @@ TEST(Substeps, AStepThatConvergesWholeIsNeverSplit) {
 TEST(Substeps, ARunReportsTheFirstFrameThatNeededThem) {
   // The soft bar of the test above: the run completes with substeps, and names the first frame
   // that needed them, the frame at which the same run without them stops.
-  auto s = test::bar_scene({ .size = { 0.2, 0.04, 0.04 },
-      .cells = { 10, 2, 2 },
-      .young = 1e5,
-      .poisson = 0.3,
-      .dt = 2e-3 });
+  auto s = soft_bar_needing_substeps();
   s.frames = 60;
-  s.newton.max_iterations = 3;
-  s.newton.relative_tolerance = 1e-10;
-  s.newton.jacobian_reuse_contraction = 0;
-  s.newton.retry_exact_tangent = false;
   const auto run = sim::run_simulation(s, {});
   ASSERT_TRUE(run.completed) << run.message;
   ASSERT_GE(run.substepped_frames, 1);
