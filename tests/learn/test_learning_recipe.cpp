@@ -139,6 +139,15 @@ TEST(LearningRecipe, ACandidateReplacesTheFittedNominalOnlyBeyondNoise) {
     c[2].larger_motion.completed = false;
     EXPECT_EQ(choose_candidate(c, p, observed, 0, sigma), 0);
   }
+  {
+    // Nor one unstable where a motion of another kind may go.
+    auto c = candidates({ &fitted, &a, &b });
+    const std::vector<VecX> p { fitted, a, b };
+    c[2].stability.samples = 100;
+    c[2].stability.unstable_samples = 1;
+    EXPECT_FALSE(c[2].eligible());
+    EXPECT_EQ(choose_candidate(c, p, observed, 0, sigma), 0);
+  }
 }
 
 TEST(LearningRecipe, ANetworkReplacesItsTeacherOnlyWhenItValidatesAsWell) {
@@ -198,8 +207,11 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
     }
     if (!k.correction) {
       EXPECT_FALSE(k.larger_motion.checked) << "the nominals are not checked";
+      EXPECT_EQ(k.stability.samples, 0) << "the nominals are not checked";
     } else if (k.completed) {
       EXPECT_TRUE(k.larger_motion.checked);
+      // Checked where a motion of another kind may go (the fitted nominal's reachable grid).
+      EXPECT_GT(k.stability.samples, 0);
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);
@@ -252,9 +264,11 @@ TEST(LearningRecipe, ATrainingSetHoldsOutTheTailOfEveryMotion) {
       << r.validation_data;
   // Each candidate is compared at every observed vertex of both held-out tails.
   const long per_motion = 12 * static_cast<long>(motions[0].observed.num_observed());
-  for (const Candidate& k : r.candidates)
-    if (k.completed)
+  for (const Candidate& k : r.candidates) {
+    if (k.completed) {
       EXPECT_EQ(k.validation.samples, 2 * per_motion) << to_string(k.kind);
+    }
+  }
   // The given nominal's validation error is the two tails' errors combined.
   std::vector<ErrorSummary> tails;
   for (const Motion& m : motions) {

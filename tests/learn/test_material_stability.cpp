@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -114,6 +115,63 @@ TEST(MaterialStability, AmplifiedStretchesReachALargerMotionsInstability) {
   const StabilityReport r = material_stability(k_nominal, &local, amplified);
   EXPECT_FALSE(r.stable());
   EXPECT_GT(r.worst_stretches[0], 1.1);
+}
+
+TEST(MaterialStability, ReachableStretchesSpanOtherMotionsAtTheDatasStress) {
+  // A nearly incompressible nominal (ν 0.45) stretched uniaxially, σ = (s, s^-1/2, s^-1/2) for
+  // s ≤ 1.05: the reachable samples hold isochoric shears of the same magnitude (other kinds of
+  // motion at the same stress) but not a uniform expansion to the data's largest stretch, whose
+  // corotated stress λ(J − 1) ≈ 9μ · 0.125 is about 18 times the data's largest (≈ 2μ · 0.05).
+  const material::CorotatedModel nominal(material::Lame::from_young_poisson(1e5, 0.45));
+  MatX uniaxial(11, 3);
+  double largest = 0;
+  for (int i = 0; i <= 10; ++i) {
+    const double s = 1 + 0.005 * i;
+    uniaxial.row(i) << s, 1 / std::sqrt(s), 1 / std::sqrt(s);
+    largest = std::max(largest, nominal.principal_stress(uniaxial.row(i).transpose()).norm());
+  }
+  const double amplification = 1.25, spacing = 0.01;
+  const MatX r = reachable_stretches(nominal, uniaxial, amplification, 2, spacing);
+  ASSERT_GT(r.rows(), 0);
+  const double low = std::pow(uniaxial.minCoeff(), amplification);
+  const double high = std::pow(uniaxial.maxCoeff(), amplification);
+  for (Eigen::Index i = 0; i < r.rows(); ++i) {
+    const Vec3 s = r.row(i).transpose();
+    EXPECT_GE(s(0), s(1));
+    EXPECT_GE(s(1), s(2));
+    EXPECT_GE(s(2), low - 1e-12);
+    EXPECT_LE(s(0), high + 1e-12);
+    EXPECT_LE(nominal.principal_stress(s).norm(), 2 * largest);
+  }
+  // The nearest sample to a pure shear (1.03, 1, 1/1.03) and to a uniform expansion 1.04³.
+  const auto nearest = [&](const Vec3& target) {
+    double best = std::numeric_limits<double>::infinity();
+    for (Eigen::Index i = 0; i < r.rows(); ++i)
+      best = std::min(best, (r.row(i).transpose() - target).norm());
+    return best;
+  };
+  EXPECT_LT(nearest(Vec3(1.03, 1.0, 1 / 1.03)), spacing);
+  EXPECT_GT(nearest(Vec3(1.04, 1.04, 1.04)), 3 * spacing);
+  // A kernel softening at the isochoric biaxial state (1.015, 1.015, 1/1.015²), ≥ 0.05 = 5ε from
+  // every data sample: it removes about 0.7 of the nominal's stiffness there, 0.35 along the data.
+  // Stable where the data went, it is found unstable where another motion may go.
+  material::RbfCorrection::Parameters p;
+  p.energy_kernels = true;
+  p.epsilon = 0.01;
+  p.centres.resize(1, 3);
+  p.centres << 1.015, 1.015, 1 / (1.015 * 1.015);
+  p.weights.resize(1);
+  p.weights << -4e2;
+  const material::RbfCorrection biaxial_softening(std::move(p));
+  EXPECT_TRUE(material_stability(nominal, &biaxial_softening, uniaxial).stable());
+  const StabilityReport reach = material_stability(nominal, &biaxial_softening, r);
+  EXPECT_FALSE(reach.stable());
+  EXPECT_LT((reach.worst_stretches - Vec3(1.015, 1.015, 1 / (1.015 * 1.015))).norm(), 2 * spacing);
+  // Nothing to reach from no data, or from inverted elements only.
+  EXPECT_EQ(reachable_stretches(nominal, MatX(0, 3), amplification, 2, spacing).rows(), 0);
+  MatX inverted(1, 3);
+  inverted << 1.1, 1.0, -0.2;
+  EXPECT_EQ(reachable_stretches(nominal, inverted, amplification, 2, spacing).rows(), 0);
 }
 
 } // namespace

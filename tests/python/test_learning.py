@@ -61,6 +61,15 @@ def test_learn_fits_the_material_and_evaluate_measures_it(small_scene, truth, tm
         significant = c["significance"] is None or c["significance"] >= 2
         return c["completed"] and c["eligible"] and (c is fitted or significant)
 
+    # Every completed correction was checked where a motion of another kind may go; an eligible
+    # one is stable there. The nominals are not checked.
+    for c in recipe["candidates"]:
+        reach = c["reachable_stretches"]
+        if c["kind"] in ("nominal", "fitted nominal") or not c["completed"]:
+            assert reach is None
+        else:
+            assert reach["samples"] > 0 and len(reach["worst_stretches"]) == 3
+            assert not c["eligible"] or reach["unstable_samples"] == 0
     errors = [c["validation_rms_error_m"] for c in recipe["candidates"] if contends(c)]
     chosen = recipe["candidates"][recipe["chosen"]]
     assert chosen["eligible"]

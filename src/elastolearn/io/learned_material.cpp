@@ -36,6 +36,15 @@ nlohmann::json larger_motion_to_json(const learn::LargerMotionCheck& l) {
     { "message", l.message } };
 }
 
+/// null for a candidate not checked (the nominals, and a correction whose validation diverged).
+nlohmann::json stability_to_json(const learn::StabilityReport& s) {
+  if (s.samples == 0)
+    return nullptr;
+  return { { "samples", s.samples }, { "unstable_samples", s.unstable_samples },
+    { "min_relative_eigenvalue", s.min_relative_eigenvalue },
+    { "worst_stretches", { s.worst_stretches(0), s.worst_stretches(1), s.worst_stretches(2) } } };
+}
+
 } // namespace
 
 nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
@@ -45,7 +54,8 @@ nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
         { "completed", c.completed }, { "training_rms_error_m", finite_or_null(c.training.rms) },
         { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
         { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr },
-        { "larger_motion", larger_motion_to_json(c.larger_motion) }, { "eligible", c.eligible() },
+        { "larger_motion", larger_motion_to_json(c.larger_motion) },
+        { "reachable_stretches", stability_to_json(c.stability) }, { "eligible", c.eligible() },
         // null: infinite (noise σ = 0), its sign that of the validation errors' difference
         { "significance", finite_or_null(c.significance) } });
     if (!c.completed)

@@ -187,10 +187,18 @@ VecX flat_positions(const observe::Observation& o) {
   return out;
 }
 
+/// Which of the held-out runs' stretches place the reachable stretches (every frame; a cap
+/// keeps the min, max and largest stress of large meshes' runs representative and cheap).
+constexpr StretchSampleOptions kStretchSamples { 1, 100000 };
+
 /// The candidate's error on the held-out data (completed false if a simulation diverged) and,
 /// for a correction, its run of the larger motion. Returns its predictions of the held-out
 /// observations (at_observed_vertices, the pieces in order; empty if a simulation diverged).
-VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
+/// `stretches` (if non-null) receives the principal stretches of its held-out motions' runs
+/// (collect_stretches, stacked; empty if a simulation diverged).
+VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal,
+    MatX* stretches = nullptr) {
+  std::vector<MatX> run_stretches;
   std::vector<ErrorSummary> errors;
   std::vector<VecX> predictions;
   // The held-out motion's scene (driven `factor` times as hard) with the candidate's material.
@@ -207,12 +215,17 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
       c.failure = piece.motion.name + ": " + run.message;
       return {};
     }
+    if (stretches)
+      run_stretches.push_back(collect_stretches(
+          ReconstructionMesh(piece.motion.scene.mesh, nominal), run.positions, kStretchSamples));
     const std::vector<VecX> compared(
         run.positions.begin() + piece.first_frame, run.positions.end());
     errors.push_back(observation_error(compared, piece.motion.observed));
     predictions.push_back(at_observed_vertices(compared, piece.motion.observed));
   }
   c.validation = combined_error(errors);
+  if (stretches)
+    *stretches = stacked_rows(run_stretches, 3);
   if (c.correction) {
     LargerMotionCheck& larger = c.larger_motion;
     larger.checked = true;
@@ -240,6 +253,20 @@ std::string describe_larger_motion(const LargerMotionCheck& larger) {
     return {};
   return "; failed in the motion driven " + to_text(kLargerMotion) + "× as hard (" + larger.message
       + "): not eligible";
+}
+
+/// "; unstable at N of M stretches a motion of another kind may reach (...)" or "".
+std::string describe_instability(const StabilityReport& stability) {
+  if (stability.stable())
+    return {};
+  const Vec3& s = stability.worst_stretches;
+  char text[256];
+  std::snprintf(text, sizeof text,
+      "; unstable at %ld of %ld stretches a motion of another kind may reach (stiffness %.3g × "
+      "the nominal's at σ = (%.4f, %.4f, %.4f)): not eligible",
+      stability.unstable_samples, stability.samples, stability.min_relative_eigenvalue, s(0), s(1),
+      s(2));
+  return text;
 }
 
 void say(const RecipeCallbacks& callbacks, const std::string& line) {
@@ -466,6 +493,9 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
 
   // Stage 4: every candidate on the held-out data.
   std::vector<VecX> predictions; // per candidate, at_observed_vertices
+  const CandidateKind reference_kind
+      = options.fit_parameters ? CandidateKind::FittedNominal : CandidateKind::Nominal;
+  MatX reachable; // where a correction must be stable: around the reference's held-out runs
   auto add = [&](CandidateKind kind, int iteration,
                  std::shared_ptr<const material::Correction> correction, double training) {
     Candidate c;
@@ -473,14 +503,23 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     c.iteration = iteration;
     c.correction = std::move(correction);
     c.training.rms = training;
+    const fem::MaterialModel& material
+        = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
+    MatX reference_stretches;
     predictions.push_back(validate_candidate(
-        c, split, kind == CandidateKind::Nominal ? given : result.fitted_nominal));
+        c, split, material, kind == reference_kind ? &reference_stretches : nullptr));
+    if (kind == reference_kind)
+      reachable = reachable_stretches(*material.elastic, reference_stretches,
+          kReachableAmplification, kReachableStress, kReachableSpacing);
+    if (c.correction && c.completed)
+      c.stability = material_stability(*material.elastic, c.correction.get(), reachable);
     say(callbacks,
         "candidate " + to_string(kind) + (iteration >= 0 ? " " + std::to_string(iteration) : "")
             + (c.completed ? format(": validation error rms %.4f %%, max %.4f %%",
                    100 * c.validation.rms / size, 100 * c.validation.max / size)
                            : ": its simulation of the held-out data diverged (" + c.failure + ")")
-            + (c.completed ? describe_larger_motion(c.larger_motion) : ""));
+            + (c.completed ? describe_larger_motion(c.larger_motion) : "")
+            + describe_instability(c.stability));
     result.candidates.push_back(std::move(c));
   };
   add(CandidateKind::Nominal, -1, nullptr, result.parameter_fit.initial_rms);

@@ -20,6 +20,7 @@
 /// The validation choice is what makes the result never worse than fitting parameters on data
 /// nobody tuned the recipe for: the fitted nominal is always a candidate.
 #include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/network_distillation.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
@@ -98,6 +99,10 @@ struct Candidate {
   /// without substeps, as the fitted nominal's does. A user's next motion is rarely the one
   /// recorded. Not checked (passed) for the nominals.
   LargerMotionCheck larger_motion;
+  /// Its material at the stretches a motion of another kind may reach (reachable_stretches of
+  /// the fitted nominal's runs of the held-out motions): a correction must be stable there. Not
+  /// checked (stable) for the nominals.
+  StabilityReport stability;
   /// At the training observations [m] (the loop's own signal); NaN for a network (not simulated
   /// on the training data).
   ErrorSummary training;
@@ -107,8 +112,9 @@ struct Candidate {
   /// (the noise term of the difference, −2 nᵀ(c − r), has standard deviation 2σ‖c − r‖). 0 for
   /// the reference itself.
   double significance = 0;
-  /// Eligible for the choice: its validation completed and it survives a larger motion.
-  bool eligible() const { return completed && larger_motion.completed; }
+  /// Eligible for the choice: its validation completed, it survives a larger motion and it is
+  /// stable where a motion of another kind may go.
+  bool eligible() const { return completed && larger_motion.completed && stability.stable(); }
 };
 
 /// Everything the recipe decided and measured.

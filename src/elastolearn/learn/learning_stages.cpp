@@ -96,6 +96,17 @@ template <typename T> std::vector<T> without_first(const std::vector<T>& v) {
 /// the recipe's validation checks its candidates further out (learning_recipe.cpp).
 constexpr std::array<double, 2> kLoopAmplifications { 1.0, 1.25 };
 
+/// Every stability sample of the loop and the forward fit: the trajectory's stretches amplified
+/// (kLoopAmplifications) and the stretches a motion of another kind may reach (learn::
+/// reachable_stretches, with the same amplification and the recipe's kReachableStress).
+MatX stability_samples(const material::ElasticModel& nominal, const MatX& stretches) {
+  return stacked_rows(
+      std::vector<MatX> { amplified_stretches(stretches, kLoopAmplifications, 30000),
+          reachable_stretches(
+              nominal, stretches, kReachableAmplification, kReachableStress, kReachableSpacing) },
+      3);
+}
+
 /// The principal stretches of every motion's trajectory, stacked (options.stretch_samples caps
 /// each motion's samples): where the RBF centres go and where a correction must be stable.
 MatX trajectory_stretches(std::span<const ReconstructionMesh> meshes,
@@ -252,8 +263,8 @@ Reconstruction reconstruct_correction(std::span<const ReconstructionMesh> meshes
   out.centres = design.num_centres();
   out.misfit = reconstructed.misfit.rms_residual;
   out.target = reconstructed.misfit.rms_target;
-  stable_fraction(reconstructed.correction, nominal,
-      amplified_stretches(stretches, kLoopAmplifications, 30000), out);
+  stable_fraction(
+      reconstructed.correction, nominal, stability_samples(*nominal.elastic, stretches), out);
   return out;
 }
 
@@ -291,7 +302,8 @@ ForwardFitStart forward_fit_start(std::span<const Motion> motions,
   if (damping > 0)
     fit_options.damping = damping;
   if (stretches.rows() > 0)
-    fit_options.stability_stretches = amplified_stretches(stretches, kLoopAmplifications, 30000);
+    fit_options.stability_stretches
+        = stability_samples(*motions.front().scene.material.elastic, stretches);
   return { std::move(design), std::move(start), std::move(fit_options) };
 }
 

@@ -1,3 +1,4 @@
+#include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace elastolearn::learn {
 
@@ -86,6 +88,43 @@ MatX amplified_stretches(
     for (Eigen::Index i = 0; i < stretches.rows(); i += step, ++row)
       for (int c = 0; c < 3; ++c)
         out(row, c) = stretches(i, c) > 0 ? std::pow(stretches(i, c), a) : stretches(i, c);
+  return out;
+}
+
+MatX reachable_stretches(const material::ElasticModel& nominal, ConstRef<MatX> stretches,
+    double amplification, double stress_factor, double spacing) {
+  ELASTOLEARN_CHECK(spacing > 0 && amplification >= 1 && stress_factor > 0,
+      "reachable_stretches: needs spacing > 0, amplification ≥ 1, stress_factor > 0");
+  // Over the uninverted samples (σ₃ > 0): an inverted element says nothing about the stresses
+  // of the motion, and log-amplifying it is undefined.
+  double low = std::numeric_limits<double>::infinity(), high = 0, largest_stress = 0;
+  for (Eigen::Index i = 0; i < stretches.rows(); ++i) {
+    const Vec3 s = stretches.row(i).transpose();
+    if (!(s.minCoeff() > 0))
+      continue;
+    low = std::min(low, s.minCoeff());
+    high = std::max(high, s.maxCoeff());
+    largest_stress = std::max(largest_stress, nominal.principal_stress(s).norm());
+  }
+  if (!(high > 0))
+    return MatX(0, 3);
+  low = std::pow(low, amplification);
+  high = std::pow(high, amplification);
+  const double bound = stress_factor * largest_stress;
+  const int n = std::clamp(static_cast<int>(std::ceil((high - low) / spacing)) + 1,
+      kReachableMinPoints, kReachableMaxPoints);
+  const auto at = [&](int k) { return low + (high - low) * k / (n - 1); };
+  std::vector<Vec3> kept;
+  for (int i = 0; i < n; ++i) // σ₁ ≥ σ₂ ≥ σ₃: i ≥ j ≥ k
+    for (int j = 0; j <= i; ++j)
+      for (int k = 0; k <= j; ++k) {
+        const Vec3 s(at(i), at(j), at(k));
+        if (nominal.principal_stress(s).norm() <= bound)
+          kept.push_back(s);
+      }
+  MatX out(static_cast<Eigen::Index>(kept.size()), 3);
+  for (size_t r = 0; r < kept.size(); ++r)
+    out.row(static_cast<Eigen::Index>(r)) = kept[r].transpose();
   return out;
 }
 

@@ -40,4 +40,29 @@ StabilityReport material_stability(const material::ElasticModel& nominal,
 MatX amplified_stretches(
     ConstRef<MatX> stretches, std::span<const double> amplifications, Eigen::Index max_rows);
 
+/// Where a motion of another kind may go: the data of one motion constrain a correction only
+/// along the stretch combinations that motion visits (a droop's uniaxial states), yet a kernel or
+/// network correction takes values everywhere in between, and a swing or a twist reaches other
+/// combinations at the same stress. The samples: a grid of sorted principal stretches
+/// (σ₁ ≥ σ₂ ≥ σ₃) with spacing at most `spacing` (kReachableMinPoints to kReachableMaxPoints per
+/// axis) over [a, b] = [min, max] of `stretches` raised to `amplification` (beyond the data, as
+/// amplified_stretches), kept where the nominal's principal stress ‖P̂(σ)‖ is at most
+/// `stress_factor` times its largest over `stretches`: states the nominal reaches under loads of
+/// the data's order. (The grid's far corners, large volume changes of a nearly incompressible
+/// material, need stresses many times larger and are left out.) Inverted samples (σ₃ ≤ 0) are
+/// skipped; empty if no sample is left. Needs spacing > 0, amplification ≥ 1 and
+/// stress_factor > 0.
+MatX reachable_stretches(const material::ElasticModel& nominal, ConstRef<MatX> stretches,
+    double amplification, double stress_factor, double spacing);
+
+/// The recipe's reachable stretches (the loop, the forward fit and the validation choice): the
+/// nominal's stress up to twice the data's largest (a user's next motion of another kind at
+/// twice the load), on a grid a third as fine as the kernel smoothing of the recipe's RBF (0.03:
+/// a kernel correction varies on that scale).
+inline constexpr double kReachableStress = 2;
+inline constexpr double kReachableAmplification = 1.25; ///< as the loop's amplified stretches
+inline constexpr double kReachableSpacing = 0.01;
+inline constexpr int kReachableMinPoints = 9; ///< per axis, however small the data's range
+inline constexpr int kReachableMaxPoints = 25; ///< per axis: 2925 sorted samples at most
+
 } // namespace elastolearn::learn
