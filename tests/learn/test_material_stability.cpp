@@ -37,6 +37,16 @@ material::RbfCorrection lame_change(double d_mu, double d_lambda) {
   return material::RbfCorrection(std::move(p));
 }
 
+/// One energy kernel of weight w [Pa] and smoothing ε at `centre` (a softening for w < 0).
+material::RbfCorrection one_kernel(const Vec3& centre, double weight, double epsilon) {
+  material::RbfCorrection::Parameters p;
+  p.energy_kernels = true;
+  p.epsilon = epsilon;
+  p.centres = centre.transpose();
+  p.weights = VecX::Constant(1, weight);
+  return material::RbfCorrection(std::move(p));
+}
+
 TEST(MaterialStability, NominalAndMildCorrectionsAreStable) {
   const MatX grid = stretch_grid();
   const StabilityReport nominal = material_stability(k_nominal, nullptr, grid);
@@ -63,16 +73,9 @@ TEST(MaterialStability, FindsAShearInstability) {
 
 TEST(MaterialStability, FindsALocalSofteningWhereItActs) {
   // One energy kernel at stretch (1.2, 1.2, 1.2): a softening there, none near rest.
-  material::RbfCorrection::Parameters p;
-  p.energy_kernels = true;
-  p.epsilon = 0.03;
-  p.centres.resize(1, 3);
-  p.centres << 1.2, 1.2, 1.2;
-  p.weights.resize(1);
   // Curvature 6 w/ε = −4e5 Pa at the centre (the nominal's smallest is 2μ = 7.1e4 Pa) and of
   // order 6 w/r = −3.5e4 Pa at rest, r = 0.35 away: the multiquadric's curvature decays as 1/r.
-  p.weights << -2e3;
-  const material::RbfCorrection local(std::move(p));
+  const material::RbfCorrection local = one_kernel(Vec3(1.2, 1.2, 1.2), -2e3, 0.03);
   MatX near_rest(1, 3), near_centre(1, 3);
   near_rest << 1.0, 1.0, 1.0;
   near_centre << 1.2, 1.2, 1.2;
@@ -103,14 +106,8 @@ TEST(MaterialStability, AmplifiedStretchesReachALargerMotionsInstability) {
   // The row cap keeps every ⌈2 · 11 / 10⌉ = 3rd sample of each power.
   EXPECT_EQ(amplified_stretches(motion, powers, 10).rows(), 8);
 
-  material::RbfCorrection::Parameters p;
-  p.energy_kernels = true;
-  p.epsilon = 0.03;
-  p.centres.resize(1, 3);
-  p.centres << 1.2, 1 / std::sqrt(1.2), 1 / std::sqrt(1.2);
-  p.weights.resize(1);
-  p.weights << -2e3;
-  const material::RbfCorrection local(std::move(p));
+  const material::RbfCorrection local
+      = one_kernel(Vec3(1.2, 1 / std::sqrt(1.2), 1 / std::sqrt(1.2)), -2e3, 0.03);
   EXPECT_TRUE(material_stability(k_nominal, &local, motion).stable());
   const StabilityReport r = material_stability(k_nominal, &local, amplified);
   EXPECT_FALSE(r.stable());
@@ -155,14 +152,8 @@ TEST(MaterialStability, ReachableStretchesSpanOtherMotionsAtTheDatasStress) {
   // A kernel softening at the isochoric biaxial state (1.015, 1.015, 1/1.015²), ≥ 0.05 = 5ε from
   // every data sample: it removes about 0.7 of the nominal's stiffness there, 0.35 along the data.
   // Stable where the data went, it is found unstable where another motion may go.
-  material::RbfCorrection::Parameters p;
-  p.energy_kernels = true;
-  p.epsilon = 0.01;
-  p.centres.resize(1, 3);
-  p.centres << 1.015, 1.015, 1 / (1.015 * 1.015);
-  p.weights.resize(1);
-  p.weights << -4e2;
-  const material::RbfCorrection biaxial_softening(std::move(p));
+  const material::RbfCorrection biaxial_softening
+      = one_kernel(Vec3(1.015, 1.015, 1 / (1.015 * 1.015)), -4e2, 0.01);
   EXPECT_TRUE(material_stability(nominal, &biaxial_softening, uniaxial).stable());
   const StabilityReport reach = material_stability(nominal, &biaxial_softening, r);
   EXPECT_FALSE(reach.stable());
