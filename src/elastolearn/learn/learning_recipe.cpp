@@ -187,17 +187,13 @@ VecX flat_positions(const observe::Observation& o) {
   return out;
 }
 
-/// Which of the held-out runs' stretches place the reachable stretches (every frame; a cap
-/// keeps the min, max and largest stress of large meshes' runs representative and cheap).
-constexpr StretchSampleOptions kStretchSamples { 1, 100000 };
-
 /// The candidate's error on the held-out data (completed false if a simulation diverged) and,
 /// for a correction, its run of the larger motion. Returns its predictions of the held-out
 /// observations (at_observed_vertices, the pieces in order; empty if a simulation diverged).
 /// `stretches` (if non-null) receives the principal stretches of its held-out motions' runs
-/// (collect_stretches, stacked; empty if a simulation diverged).
+/// (collect_stretches with `sampling`, stacked; empty if a simulation diverged).
 VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal,
-    MatX* stretches = nullptr) {
+    MatX* stretches = nullptr, const StretchSampleOptions& sampling = {}) {
   std::vector<MatX> run_stretches;
   std::vector<ErrorSummary> errors;
   std::vector<VecX> predictions;
@@ -217,7 +213,7 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
     }
     if (stretches)
       run_stretches.push_back(collect_stretches(
-          ReconstructionMesh(piece.motion.scene.mesh, nominal), run.positions, kStretchSamples));
+          ReconstructionMesh(piece.motion.scene.mesh, nominal), run.positions, sampling));
     const std::vector<VecX> compared(
         run.positions.begin() + piece.first_frame, run.positions.end());
     errors.push_back(observation_error(compared, piece.motion.observed));
@@ -506,11 +502,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     const fem::MaterialModel& material
         = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
     MatX reference_stretches;
-    predictions.push_back(validate_candidate(
-        c, split, material, kind == reference_kind ? &reference_stretches : nullptr));
+    predictions.push_back(validate_candidate(c, split, material,
+        kind == reference_kind ? &reference_stretches : nullptr, options.loop.stretch_samples));
     if (kind == reference_kind)
-      reachable = reachable_stretches(*material.elastic, reference_stretches,
-          kReachableAmplification, kReachableStress, kReachableSpacing);
+      reachable = reachable_stretches(*material.elastic, reference_stretches);
     if (c.correction && c.completed)
       c.stability = material_stability(*material.elastic, c.correction.get(), reachable);
     say(callbacks,

@@ -97,13 +97,12 @@ template <typename T> std::vector<T> without_first(const std::vector<T>& v) {
 constexpr std::array<double, 2> kLoopAmplifications { 1.0, 1.25 };
 
 /// Every stability sample of the loop and the forward fit: the trajectory's stretches amplified
-/// (kLoopAmplifications) and the stretches a motion of another kind may reach (learn::
-/// reachable_stretches, with the same amplification and the recipe's kReachableStress).
+/// (kLoopAmplifications) and the stretches a motion of another kind may reach
+/// (learn::reachable_stretches with the recipe's bounds).
 MatX stability_samples(const material::ElasticModel& nominal, const MatX& stretches) {
   return stacked_rows(
       std::vector<MatX> { amplified_stretches(stretches, kLoopAmplifications, 30000),
-          reachable_stretches(
-              nominal, stretches, kReachableAmplification, kReachableStress, kReachableSpacing) },
+          reachable_stretches(nominal, stretches) },
       3);
 }
 

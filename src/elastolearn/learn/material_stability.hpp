@@ -40,6 +40,16 @@ StabilityReport material_stability(const material::ElasticModel& nominal,
 MatX amplified_stretches(
     ConstRef<MatX> stretches, std::span<const double> amplifications, Eigen::Index max_rows);
 
+/// The recipe's reachable stretches (the loop, the forward fit and the validation choice): the
+/// nominal's stress up to twice the data's largest (a user's next motion of another kind at
+/// twice the load), on a grid a third as fine as the kernel smoothing of the recipe's RBF (0.03:
+/// a kernel correction varies on that scale).
+inline constexpr double kReachableStress = 2;
+inline constexpr double kReachableAmplification = 1.25; ///< as the loop's amplified stretches
+inline constexpr double kReachableSpacing = 0.01;
+inline constexpr int kReachableMinPoints = 9; ///< per axis, however small the data's range
+inline constexpr int kReachableMaxPoints = 25; ///< per axis: 2925 sorted samples at most
+
 /// Where a motion of another kind may go: the data of one motion constrain a correction only
 /// along the stretch combinations that motion visits (a droop's uniaxial states), yet a kernel or
 /// network correction takes values everywhere in between, and a swing or a twist reaches other
@@ -51,18 +61,9 @@ MatX amplified_stretches(
 /// the data's order. (The grid's far corners, large volume changes of a nearly incompressible
 /// material, need stresses many times larger and are left out.) Inverted samples (σ₃ ≤ 0) are
 /// skipped; empty if no sample is left. Needs spacing > 0, amplification ≥ 1 and
-/// stress_factor > 0.
+/// stress_factor > 0. The defaults are the recipe's.
 MatX reachable_stretches(const material::ElasticModel& nominal, ConstRef<MatX> stretches,
-    double amplification, double stress_factor, double spacing);
-
-/// The recipe's reachable stretches (the loop, the forward fit and the validation choice): the
-/// nominal's stress up to twice the data's largest (a user's next motion of another kind at
-/// twice the load), on a grid a third as fine as the kernel smoothing of the recipe's RBF (0.03:
-/// a kernel correction varies on that scale).
-inline constexpr double kReachableStress = 2;
-inline constexpr double kReachableAmplification = 1.25; ///< as the loop's amplified stretches
-inline constexpr double kReachableSpacing = 0.01;
-inline constexpr int kReachableMinPoints = 9; ///< per axis, however small the data's range
-inline constexpr int kReachableMaxPoints = 25; ///< per axis: 2925 sorted samples at most
+    double amplification = kReachableAmplification, double stress_factor = kReachableStress,
+    double spacing = kReachableSpacing);
 
 } // namespace elastolearn::learn
