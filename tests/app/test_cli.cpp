@@ -76,11 +76,13 @@ TEST_F(CliTest, UnknownKeyAndBrokenJsonAreReportedWithTheirPlace) {
 }
 
 TEST_F(CliTest, DivergenceNamesTheFrameAndKeepsEarlierFrames) {
-  // One Newton iteration to 1e-12 cannot converge once the bar moves: the run must stop, say
-  // at which frame, exit non-zero, and keep the frames before it in a readable file.
+  // One Newton iteration per attempt to 1e-12, no substeps, cannot converge once the bar moves:
+  // the run must stop, say at which frame, exit non-zero, and keep the frames before it in a
+  // readable file.
   std::string text = kSmallScene;
   text.replace(text.find("\"time\""), 6,
-      "\"solver\": {\"max_newton_iterations\": 1, \"newton_tolerance\": 1e-12}, \"time\"");
+      "\"solver\": {\"max_newton_iterations\": 1, \"newton_tolerance\": 1e-12, "
+      "\"max_step_halvings\": 0}, \"time\"");
   const auto out = m_dir / "div.h5";
   const auto r
       = run("simulate " + write("div.json", text).string() + " -o " + out.string() + " -q");

@@ -120,10 +120,12 @@ def test_errors_name_the_file_and_field(small_scene, tmp_path):
 
 
 def test_a_diverging_simulation_keeps_its_frames_and_warns(tmp_path):
-    # One Newton iteration to 1e-12 cannot converge once the bar moves (the CLI test's case).
+    # One Newton iteration per attempt to 1e-12, no substeps, cannot converge once the bar moves
+    # (the CLI test's case).
     from conftest import SMALL_SCENE
     scene = el.Scene.from_json(dict(SMALL_SCENE, solver={"max_newton_iterations": 1,
-                                                         "newton_tolerance": 1e-12}))
+                                                         "newton_tolerance": 1e-12,
+                                                         "max_step_halvings": 0}))
     with pytest.warns(RuntimeWarning, match="diverged at frame"):
         sim = el.simulate(scene)
     assert not sim.completed and "diverged at frame" in sim.message

@@ -30,7 +30,8 @@ struct NewtonOptions {
   /// 2^max_step_halvings substeps before the step counts as failed. 0: no retry.
   int max_step_halvings = 3;
   /// Simulator solves (time steps, static load steps): a solve that fails with the PSD-projected
-  /// tangent is retried from the same start with the exact one, before any substep.
+  /// tangent is retried with the exact one, before any substep: from where it stopped if it got
+  /// closer to the solution, then from its start.
   bool retry_exact_tangent = true;
   /// Throws InputError naming the offending option.
   void validate() const;

@@ -2,6 +2,7 @@
 #include <elastolearn/fem/mass.hpp>
 #include <elastolearn/sim/simulator.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace elastolearn::sim {
@@ -210,13 +211,30 @@ NewtonReport Simulator::newton(const NewtonProblem& problem, VecX& u) {
     return projected;
   // Newton's matrix projects every element's tangent to PSD, so it differs from the true
   // Jacobian wherever an element's tangent is indefinite (compression, a learned correction that
-  // softens): Newton then converges only linearly and can stall just above its target. Near a
-  // stable solution the assembled exact Jacobian is positive definite even where element
-  // tangents are not, and Newton with it converges quadratically; where it is not, its
-  // factorisation fails and the solve stops.
-  u = m_u_start;
+  // softens): Newton then converges only linearly and can stall above its target. Near a stable
+  // solution the assembled exact Jacobian is positive definite even where element tangents are
+  // not, and Newton with it converges quadratically. The retry therefore starts where the
+  // projected solve stopped when that is closer to the solution than its start (a stall), and
+  // from the start otherwise or if that fails; both retries keep the projected solve's target.
+  NewtonOptions retry = m_scene.newton;
+  retry.absolute_tolerance
+      = std::max(retry.absolute_tolerance, retry.relative_tolerance * projected.initial_residual);
   m_elastic->set_project_tangent(false);
-  NewtonReport exact = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+  NewtonReport exact;
+  const bool progressed = projected.residual < projected.initial_residual && u.allFinite();
+  if (progressed)
+    exact = newton_solve(problem, u, m_system, *m_solver, retry);
+  if (!exact.converged) {
+    u = m_u_start;
+    NewtonReport from_start = newton_solve(problem, u, m_system, *m_solver, retry);
+    if (progressed) {
+      from_start.add_work(exact);
+      if (!from_start.converged)
+        from_start.message
+            = "from where it stopped: " + exact.message + "; from its start: " + from_start.message;
+    }
+    exact = std::move(from_start);
+  }
   m_elastic->set_project_tangent(true);
   exact.add_work(projected);
   exact.initial_residual = projected.initial_residual;

@@ -69,8 +69,8 @@ class Simulator {
   NewtonReport advance(double t_next, double h);
   /// step()'s retries after `failed`, the report of the whole step.
   NewtonReport advance_in_substeps(double t_next, NewtonReport failed);
-  /// newton_solve on the scene's system, retried from the same start with the exact (unprojected)
-  /// tangent when it fails and NewtonOptions::retry_exact_tangent is set.
+  /// newton_solve on the scene's system, retried with the exact (unprojected) tangent when it
+  /// fails and NewtonOptions::retry_exact_tangent is set (from where it stopped, then its start).
   NewtonReport newton(const NewtonProblem& problem, VecX& u);
   void sum_forces(const VecX& x, const VecX& v, double t, VecX& f);
   void sum_jacobians(const VecX& x, const VecX& v, double t, double c_x, double c_v);
