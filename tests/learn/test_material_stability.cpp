@@ -165,5 +165,39 @@ TEST(MaterialStability, ReachableStretchesSpanOtherMotionsAtTheDatasStress) {
   EXPECT_EQ(reachable_stretches(nominal, inverted, amplification, 2, spacing).rows(), 0);
 }
 
+TEST(MaterialStability, ReachableStretchesChangeTheVolumeNoMoreThanTheData) {
+  // A compressible nominal (ν 0.3) stretched isochorically to s = 1.3 reaches a stress at which
+  // a uniform expansion of 20 % volume or more stays under the stress bound: the volume bound
+  // must still leave it out, while shears of the data's magnitude stay in. Every sample's J is
+  // within the data's J range (here 1) widened by one grid step of the 25-point grid.
+  const material::CorotatedModel nominal(material::Lame::from_young_poisson(1e5, 0.3));
+  MatX isochoric(31, 3);
+  double largest = 0;
+  for (int i = 0; i <= 30; ++i) {
+    const double s = 1 + 0.01 * i;
+    isochoric.row(i) << s, 1 / std::sqrt(s), 1 / std::sqrt(s);
+    largest = std::max(largest, nominal.principal_stress(isochoric.row(i).transpose()).norm());
+  }
+  double expansion = 1; // the largest uniform stretch under the stress bound
+  while (nominal.principal_stress(Vec3::Constant(expansion + 0.001)).norm() <= 2 * largest)
+    expansion += 0.001;
+  ASSERT_GT(std::pow(expansion, 3), 1.2); // the stress bound alone would keep it
+  const MatX r = reachable_stretches(nominal, isochoric);
+  ASSERT_GT(r.rows(), 0);
+  const double low = std::pow(isochoric.minCoeff(), kReachableAmplification);
+  const double high = std::pow(isochoric.maxCoeff(), kReachableAmplification);
+  const double step = (high - low) / (kReachableMaxPoints - 1);
+  double nearest_expansion = std::numeric_limits<double>::infinity();
+  double nearest_shear = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < r.rows(); ++i) {
+    const Vec3 s = r.row(i).transpose();
+    EXPECT_NEAR(s.prod(), 1.0, step + 1e-12);
+    nearest_expansion = std::min(nearest_expansion, (s - Vec3::Constant(expansion)).norm());
+    nearest_shear = std::min(nearest_shear, (s - Vec3(1.2, 1.0, 1 / 1.2)).norm());
+  }
+  EXPECT_GT(nearest_expansion, 0.05);
+  EXPECT_LT(nearest_shear, step);
+}
+
 } // namespace
 } // namespace elastolearn::learn

@@ -98,12 +98,15 @@ MatX reachable_stretches(const material::ElasticModel& nominal, ConstRef<MatX> s
   // Over the uninverted samples (σ₃ > 0): an inverted element says nothing about the stresses
   // of the motion, and log-amplifying it is undefined.
   double low = std::numeric_limits<double>::infinity(), high = 0, largest_stress = 0;
+  double j_low = std::numeric_limits<double>::infinity(), j_high = 0;
   for (Eigen::Index i = 0; i < stretches.rows(); ++i) {
     const Vec3 s = stretches.row(i).transpose();
     if (!(s.minCoeff() > 0))
       continue;
     low = std::min(low, s.minCoeff());
     high = std::max(high, s.maxCoeff());
+    j_low = std::min(j_low, s.prod());
+    j_high = std::max(j_high, s.prod());
     largest_stress = std::max(largest_stress, nominal.principal_stress(s).norm());
   }
   if (!(high > 0))
@@ -113,13 +116,19 @@ MatX reachable_stretches(const material::ElasticModel& nominal, ConstRef<MatX> s
   const double bound = stress_factor * largest_stress;
   const int n = std::clamp(static_cast<int>(std::ceil((high - low) / spacing)) + 1,
       kReachableMinPoints, kReachableMaxPoints);
-  const auto at = [&](int k) { return low + (high - low) * k / (n - 1); };
+  const double step = (high - low) / (n - 1);
+  const auto at = [&](int k) { return low + step * k; };
+  // Volume changes as far as the data's, amplified alike, and one grid step wider (a grid point
+  // changes J by about a step: an isochoric data set keeps a shell of samples around J = 1).
+  j_low = std::min(std::pow(j_low, amplification), j_low) - step;
+  j_high = std::max(std::pow(j_high, amplification), j_high) + step;
   std::vector<Vec3> kept;
   for (int i = 0; i < n; ++i) // σ₁ ≥ σ₂ ≥ σ₃: i ≥ j ≥ k
     for (int j = 0; j <= i; ++j)
       for (int k = 0; k <= j; ++k) {
         const Vec3 s(at(i), at(j), at(k));
-        if (nominal.principal_stress(s).norm() <= bound)
+        const double volume = s.prod();
+        if (volume >= j_low && volume <= j_high && nominal.principal_stress(s).norm() <= bound)
           kept.push_back(s);
       }
   MatX out(static_cast<Eigen::Index>(kept.size()), 3);

@@ -57,11 +57,15 @@ inline constexpr int kReachableMaxPoints = 25; ///< per axis: 2925 sorted sample
 /// (σ₁ ≥ σ₂ ≥ σ₃) with spacing at most `spacing` (kReachableMinPoints to kReachableMaxPoints per
 /// axis) over [a, b] = [min, max] of `stretches` raised to `amplification` (beyond the data, as
 /// amplified_stretches), kept where the nominal's principal stress ‖P̂(σ)‖ is at most
-/// `stress_factor` times its largest over `stretches`: states the nominal reaches under loads of
-/// the data's order. (The grid's far corners, large volume changes of a nearly incompressible
-/// material, need stresses many times larger and are left out.) Inverted samples (σ₃ ≤ 0) are
-/// skipped; empty if no sample is left. Needs spacing > 0, amplification ≥ 1 and
-/// stress_factor > 0. The defaults are the recipe's.
+/// `stress_factor` times its largest over `stretches` (states the nominal reaches under loads of
+/// the data's order) and the volume ratio J = σ₁σ₂σ₃ is within the data's range of J raised to
+/// `amplification`, widened by one grid step. Motions of other kinds change an element's shape
+/// differently, its volume no more than loads of the same order do: without the J bound, data
+/// that reach a large stress in shear (the turtle's droop, s₁ 1.32) admit equibiaxial states
+/// of 59 % more volume, far from any motion of a nearly incompressible solid, where a correction
+/// is then required to be stable. Inverted samples (σ₃ ≤ 0) are skipped; empty if no sample is
+/// left. Needs spacing > 0, amplification ≥ 1 and stress_factor > 0. The defaults are the
+/// recipe's.
 MatX reachable_stretches(const material::ElasticModel& nominal, ConstRef<MatX> stretches,
     double amplification = kReachableAmplification, double stress_factor = kReachableStress,
     double spacing = kReachableSpacing);
