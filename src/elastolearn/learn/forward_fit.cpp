@@ -271,12 +271,22 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
     equations.hessian.diagonal() += prior_weights;
     return equations;
   };
+  const auto stability_of = [&](const VecX& unknowns) {
+    const material::RbfCorrection c = design.correction(unknowns);
+    return material_stability(
+        *motions.front().scene.material.elastic, &c, options.stability_stretches);
+  };
   problem.evaluate = [&](const VecX& step) {
     trial_unknowns = result.unknowns + step;
     if (options.stability_stretches.rows() > 0) {
-      const material::RbfCorrection c = design.correction(trial_unknowns);
-      const StabilityReport stability = material_stability(
-          *motions.front().scene.material.elastic, &c, options.stability_stretches);
+      // A step to an unstable material is shortened along its direction first: the check costs
+      // no simulation, so a trial is spent on a simulated step whenever a shorter one is stable
+      // (rejecting it instead would cost a whole trial and only grow μ).
+      StabilityReport stability = stability_of(trial_unknowns);
+      for (int halving = 1; !stability.stable() && halving <= kStabilityStepHalvings; ++halving) {
+        trial_unknowns = result.unknowns + std::ldexp(1.0, -halving) * step;
+        stability = stability_of(trial_unknowns);
+      }
       if (!stability.stable()) {
         trial = {};
         trial.unstable = true;

@@ -63,6 +63,10 @@ ForwardSensitivityPass simulate_with_sensitivities(std::span<const Motion> motio
     std::span<const ReconstructionMesh> meshes, const RbfDesign& design, const VecX& unknowns,
     Sensitivities sensitivities, const ProgressCallback& progress = {});
 
+/// A trial step whose material is unstable at ForwardFitOptions::stability_stretches is halved up
+/// to this many times (to 1/16 of its length) before it is rejected unsimulated.
+inline constexpr int kStabilityStepHalvings = 4;
+
 struct ForwardFitOptions {
   int max_iterations = 0; ///< trial steps (one forward simulation each) after the start
   /// Initial Levenberg–Marquardt damping μ on the Jacobi-scaled normal equations; ÷3 after an
@@ -87,8 +91,9 @@ struct ForwardFitOptions {
   /// (docs/learning.md, "Forward fit"). 0 turns the prior off.
   double elastic_prior = 0;
   /// Principal stretches (N × 3) where every trial's material must be stable
-  /// (material_stability.hpp); a trial that is not is rejected without being simulated (its
-  /// simulation would diverge or stall). Empty: no check.
+  /// (material_stability.hpp); a trial that is not is shortened (kStabilityStepHalvings), and
+  /// rejected without being simulated if no shorter step is stable (its simulation would diverge
+  /// or stall). Empty: no check.
   MatX stability_stretches;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;
