@@ -49,6 +49,14 @@ MatX centres() {
   return c;
 }
 
+/// The stress-kernel design on centres() with elastic unknowns only (no Δα₁): kernel weights
+/// first, then the linear tail's own and other slopes.
+RbfDesign elastic_design() {
+  RbfFitOptions rbf;
+  rbf.fit_damping = false;
+  return RbfDesign(centres(), rbf);
+}
+
 } // namespace
 
 TEST(ForwardFit, SensitivityGradientMatchesFiniteDifferencesOfTheError) {
@@ -64,9 +72,7 @@ TEST(ForwardFit, SensitivityGradientMatchesFiniteDifferencesOfTheError) {
   const observe::Observation observed = observe_run(truth);
   const ReconstructionMesh mesh(nominal.mesh, nominal.material);
   // Elastic unknowns only: with α₁ = 0 the clamp α₁ + Δα₁ ≥ 0 makes the force kink at Δα₁ = 0.
-  RbfFitOptions rbf;
-  rbf.fit_damping = false;
-  const RbfDesign design(centres(), rbf);
+  const RbfDesign design = elastic_design();
   const VecX start = VecX::Zero(design.num_unknowns());
   const ForwardSensitivityPass pass
       = simulate_with_sensitivities(nominal, observed, mesh, design, start, Sensitivities::exact);
@@ -102,9 +108,7 @@ TEST(ForwardFit, RecoversACorrectionTheDesignCanExpressFromHalfTheVertices) {
   // broken step or sensitivity leaves it within an order of magnitude of the start.
   const sim::Scene nominal = small_bar();
   const ReconstructionMesh mesh(nominal.mesh, nominal.material);
-  RbfFitOptions rbf;
-  rbf.fit_damping = false;
-  const RbfDesign design(centres(), rbf);
+  const RbfDesign design = elastic_design();
   VecX truth_unknowns = VecX::Zero(design.num_unknowns());
   truth_unknowns[0] = -2e3; // a kernel weight [Pa]
   truth_unknowns[4] = 8e3; // own slope a = 2Δμ + Δλ [Pa]
@@ -131,7 +135,7 @@ TEST(ForwardFit, RecoversACorrectionTheDesignCanExpressFromHalfTheVertices) {
 }
 
 TEST(ForwardFit, ShortensAStepToAnUnstableMaterialInsteadOfRejectingIt) {
-  // The truth softens near kernel 0 (ΔΨ weight 16e3 Pa at (1.05, 1, 0.98)) past stability there
+  // The truth softens near kernel 0 (weight 16e3 Pa at (1.05, 1, 0.98)) past stability there
   // (relative eigenvalue −0.56), yet its sag stays clear of that state and simulates. Required
   // to be stable at that state, the fit cannot reach it: the Gauss–Newton step towards it is
   // unstable, half of it is not. Each trial must then be the longest stable fraction of the step
@@ -139,9 +143,7 @@ TEST(ForwardFit, ShortensAStepToAnUnstableMaterialInsteadOfRejectingIt) {
   // the four trials is lost and the error ends 1.5× higher (measured: 2.1e-3 against 1.4e-3 m).
   const sim::Scene nominal = small_bar();
   const ReconstructionMesh mesh(nominal.mesh, nominal.material);
-  RbfFitOptions rbf;
-  rbf.fit_damping = false;
-  const RbfDesign design(centres(), rbf);
+  const RbfDesign design = elastic_design();
   VecX truth_unknowns = VecX::Zero(design.num_unknowns());
   truth_unknowns[0] = 16e3;
   const MatX samples = centres().topRows(1);
@@ -242,9 +244,7 @@ TEST(ForwardFit, SeveralMotionsSumTheirNormalEquationsAndFitTogether) {
   // design expresses. The pass over both is the sum of their passes (exactly: the sums are formed
   // in motion order), one motion through the span is that motion's pass, and the fit over both
   // recovers the correction as the single-motion fit does.
-  RbfFitOptions rbf;
-  rbf.fit_damping = false;
-  const RbfDesign design(centres(), rbf);
+  const RbfDesign design = elastic_design();
   VecX truth_unknowns = VecX::Zero(design.num_unknowns());
   truth_unknowns[0] = -2e3;
   truth_unknowns[4] = 8e3;

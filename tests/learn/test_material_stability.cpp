@@ -47,6 +47,32 @@ material::RbfCorrection one_kernel(const Vec3& centre, double weight, double eps
   return material::RbfCorrection(std::move(p));
 }
 
+/// Isochoric uniaxial stretches σ = (s, s^-1/2, s^-1/2) for s = 1, 1 + ds, …, 1 + n·ds.
+MatX isochoric_uniaxial(int n, double ds) {
+  MatX out(n + 1, 3);
+  for (int i = 0; i <= n; ++i) {
+    const double s = 1 + ds * i;
+    out.row(i) << s, 1 / std::sqrt(s), 1 / std::sqrt(s);
+  }
+  return out;
+}
+
+/// The largest ‖P̂(σ)‖ of `nominal` over the rows of `stretches`.
+double largest_stress(const material::ElasticModel& nominal, const MatX& stretches) {
+  double largest = 0;
+  for (Eigen::Index i = 0; i < stretches.rows(); ++i)
+    largest = std::max(largest, nominal.principal_stress(stretches.row(i).transpose()).norm());
+  return largest;
+}
+
+/// The distance from `target` to the nearest row of `samples` (∞ if there is none).
+double nearest_distance(const MatX& samples, const Vec3& target) {
+  double best = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < samples.rows(); ++i)
+    best = std::min(best, (samples.row(i).transpose() - target).norm());
+  return best;
+}
+
 TEST(MaterialStability, NominalAndMildCorrectionsAreStable) {
   const MatX grid = stretch_grid();
   const StabilityReport nominal = material_stability(k_nominal, nullptr, grid);
@@ -120,13 +146,8 @@ TEST(MaterialStability, ReachableStretchesSpanOtherMotionsAtTheDatasStress) {
   // motion at the same stress) but not a uniform expansion to the data's largest stretch, whose
   // corotated stress λ(J − 1) ≈ 9μ · 0.125 is about 18 times the data's largest (≈ 2μ · 0.05).
   const material::CorotatedModel nominal(material::Lame::from_young_poisson(1e5, 0.45));
-  MatX uniaxial(11, 3);
-  double largest = 0;
-  for (int i = 0; i <= 10; ++i) {
-    const double s = 1 + 0.005 * i;
-    uniaxial.row(i) << s, 1 / std::sqrt(s), 1 / std::sqrt(s);
-    largest = std::max(largest, nominal.principal_stress(uniaxial.row(i).transpose()).norm());
-  }
+  const MatX uniaxial = isochoric_uniaxial(10, 0.005);
+  const double largest = largest_stress(nominal, uniaxial);
   const double amplification = 1.25, spacing = 0.01;
   const MatX r = reachable_stretches(nominal, uniaxial, amplification, 2, spacing);
   ASSERT_GT(r.rows(), 0);
@@ -141,14 +162,8 @@ TEST(MaterialStability, ReachableStretchesSpanOtherMotionsAtTheDatasStress) {
     EXPECT_LE(nominal.principal_stress(s).norm(), 2 * largest);
   }
   // The nearest sample to a pure shear (1.03, 1, 1/1.03) and to a uniform expansion 1.04³.
-  const auto nearest = [&](const Vec3& target) {
-    double best = std::numeric_limits<double>::infinity();
-    for (Eigen::Index i = 0; i < r.rows(); ++i)
-      best = std::min(best, (r.row(i).transpose() - target).norm());
-    return best;
-  };
-  EXPECT_LT(nearest(Vec3(1.03, 1.0, 1 / 1.03)), spacing);
-  EXPECT_GT(nearest(Vec3(1.04, 1.04, 1.04)), 3 * spacing);
+  EXPECT_LT(nearest_distance(r, Vec3(1.03, 1.0, 1 / 1.03)), spacing);
+  EXPECT_GT(nearest_distance(r, Vec3(1.04, 1.04, 1.04)), 3 * spacing);
   // A kernel softening at the isochoric biaxial state (1.015, 1.015, 1/1.015²), ≥ 0.05 = 5ε from
   // every data sample: it removes about 0.7 of the nominal's stiffness there, 0.35 along the data.
   // Stable where the data went, it is found unstable where another motion may go.
@@ -171,13 +186,8 @@ TEST(MaterialStability, ReachableStretchesChangeTheVolumeNoMoreThanTheData) {
   // must still leave it out, while shears of the data's magnitude stay in. Every sample's J is
   // within the data's J range (here 1) widened by one grid step of the 25-point grid.
   const material::CorotatedModel nominal(material::Lame::from_young_poisson(1e5, 0.3));
-  MatX isochoric(31, 3);
-  double largest = 0;
-  for (int i = 0; i <= 30; ++i) {
-    const double s = 1 + 0.01 * i;
-    isochoric.row(i) << s, 1 / std::sqrt(s), 1 / std::sqrt(s);
-    largest = std::max(largest, nominal.principal_stress(isochoric.row(i).transpose()).norm());
-  }
+  const MatX isochoric = isochoric_uniaxial(30, 0.01);
+  const double largest = largest_stress(nominal, isochoric);
   double expansion = 1; // the largest uniform stretch under the stress bound
   while (nominal.principal_stress(Vec3::Constant(expansion + 0.001)).norm() <= 2 * largest)
     expansion += 0.001;
@@ -187,16 +197,10 @@ TEST(MaterialStability, ReachableStretchesChangeTheVolumeNoMoreThanTheData) {
   const double low = std::pow(isochoric.minCoeff(), kReachableAmplification);
   const double high = std::pow(isochoric.maxCoeff(), kReachableAmplification);
   const double step = (high - low) / (kReachableMaxPoints - 1);
-  double nearest_expansion = std::numeric_limits<double>::infinity();
-  double nearest_shear = std::numeric_limits<double>::infinity();
-  for (Eigen::Index i = 0; i < r.rows(); ++i) {
-    const Vec3 s = r.row(i).transpose();
-    EXPECT_NEAR(s.prod(), 1.0, step + 1e-12);
-    nearest_expansion = std::min(nearest_expansion, (s - Vec3::Constant(expansion)).norm());
-    nearest_shear = std::min(nearest_shear, (s - Vec3(1.2, 1.0, 1 / 1.2)).norm());
-  }
-  EXPECT_GT(nearest_expansion, 0.05);
-  EXPECT_LT(nearest_shear, step);
+  for (Eigen::Index i = 0; i < r.rows(); ++i)
+    EXPECT_NEAR(r.row(i).prod(), 1.0, step + 1e-12);
+  EXPECT_GT(nearest_distance(r, Vec3::Constant(expansion)), 0.05);
+  EXPECT_LT(nearest_distance(r, Vec3(1.2, 1.0, 1 / 1.2)), step);
 }
 
 } // namespace
