@@ -87,7 +87,7 @@ void print_candidate_tests(const learn::RecipeResult& result, const sim::Scene& 
                 "err_L %.3f %%%s\n",
         name.c_str(), 100 * c.validation.rms / size, c.significance,
         c.eligible() ? "eligible" : "not eligible", learn::kLargerMotion,
-        !x.checked ? "not checked" : (x.completed ? "completed" : "diverged"), test_error,
+        !x.checked ? "not checked" : (x.completed ? "passed" : x.message.c_str()), test_error,
         int(i) == result.chosen ? "  <- chosen" : "");
   }
   std::fflush(stdout);

@@ -33,7 +33,7 @@ nlohmann::json larger_motion_to_json(const learn::LargerMotionCheck& l) {
   if (!l.checked)
     return nullptr;
   return { { "factor", learn::kLargerMotion }, { "completed", l.completed },
-    { "message", l.message } };
+    { "message", l.message }, { "first_substepped_frame", l.first_substepped_frame } };
 }
 
 /// null for a candidate not checked (the nominals, and a correction whose validation diverged).

@@ -11,7 +11,6 @@
 #include <elastolearn/material/spline_edited.hpp>
 #include <elastolearn/material/stvk.hpp>
 #include <elastolearn/observe/observation_noise.hpp>
-#include <elastolearn/sim/amplified_scene.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
 #include <algorithm>
@@ -197,15 +196,15 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
   std::vector<MatX> run_stretches;
   std::vector<ErrorSummary> errors;
   std::vector<VecX> predictions;
-  // The held-out motion's scene (driven `factor` times as hard) with the candidate's material.
-  const auto with_candidate = [&](const HeldOut& piece, double factor) {
-    sim::Scene scene = sim::amplified_scene(piece.motion.scene, factor);
+  // The held-out motion's scene with the candidate's material.
+  const auto with_candidate = [&](const HeldOut& piece) {
+    sim::Scene scene = piece.motion.scene;
     scene.material = nominal;
     scene.material.correction = c.correction;
     return scene;
   };
   for (const HeldOut& piece : split.validation) {
-    const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece, 1));
+    const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece));
     c.completed = run.completed;
     if (!run.completed) {
       c.failure = piece.motion.name + ": " + run.message;
@@ -223,21 +222,13 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
   if (stretches)
     *stretches = stacked_rows(run_stretches, 3);
   if (c.correction) {
-    LargerMotionCheck& larger = c.larger_motion;
-    larger.checked = true;
     for (const HeldOut& piece : split.validation) {
-      const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece, kLargerMotion));
-      // A step that converges only in substeps is one whose incremental problem at the scene's
-      // time step Newton could not solve: the material is at the edge of stability there, and
-      // the next motion, a little larger, diverges (the check's purpose).
-      if (!run.completed || run.first_substepped_frame > 0) {
-        larger.completed = false;
-        larger.message = piece.motion.name + ": "
-            + (run.completed ? "frame " + std::to_string(run.first_substepped_frame)
-                        + " converged only in substeps"
-                             : run.message);
+      const int substepped = c.larger_motion.first_substepped_frame; // of an earlier motion
+      c.larger_motion = check_larger_motion(with_candidate(piece), piece.motion.name);
+      if (substepped > 0)
+        c.larger_motion.first_substepped_frame = substepped;
+      if (!c.larger_motion.completed)
         break;
-      }
     }
   }
   return stacked_rows(predictions);
@@ -482,34 +473,48 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     if (callbacks.loop.checkpoint)
       callbacks.loop.checkpoint(s);
   };
-  if (!run_learning(split.training, options.loop, result.loop, loop_callbacks)) {
+  // The validation's reference on the held-out data, simulated before the loop: the stretches a
+  // motion of another kind may reach from its runs are where the validation requires a
+  // correction to be stable, so the loop and the forward fit require it too (a step they take
+  // must be one the validation can choose).
+  const CandidateKind reference_kind
+      = options.fit_parameters ? CandidateKind::FittedNominal : CandidateKind::Nominal;
+  const fem::MaterialModel& reference_material
+      = options.fit_parameters ? result.fitted_nominal : given;
+  Candidate reference_candidate;
+  reference_candidate.kind = reference_kind;
+  MatX reference_stretches;
+  VecX reference_prediction = validate_candidate(reference_candidate, split, reference_material,
+      &reference_stretches, options.loop.stretch_samples);
+  const MatX reachable = reachable_stretches(*reference_material.elastic, reference_stretches);
+  LearningOptions loop_options = options.loop;
+  loop_options.stability_stretches = reachable;
+  if (!run_learning(split.training, loop_options, result.loop, loop_callbacks)) {
     result.interrupted = true;
     return result;
   }
 
   // Stage 4: every candidate on the held-out data.
   std::vector<VecX> predictions; // per candidate, at_observed_vertices
-  const CandidateKind reference_kind
-      = options.fit_parameters ? CandidateKind::FittedNominal : CandidateKind::Nominal;
-  MatX reachable; // where a correction must be stable: around the reference's held-out runs
   auto add = [&](CandidateKind kind, int iteration,
                  std::shared_ptr<const material::Correction> correction, double training) {
-    Candidate c;
+    const bool is_reference = kind == reference_kind && !correction;
+    Candidate c = is_reference ? std::move(reference_candidate) : Candidate {};
     c.kind = kind;
     c.iteration = iteration;
     c.correction = std::move(correction);
     c.training.rms = training;
     const fem::MaterialModel& material
         = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
-    MatX reference_stretches;
-    predictions.push_back(validate_candidate(c, split, material,
-        kind == reference_kind ? &reference_stretches : nullptr, options.loop.stretch_samples));
-    if (kind == reference_kind)
-      reachable = reachable_stretches(*material.elastic, reference_stretches);
+    predictions.push_back(
+        is_reference ? std::move(reference_prediction) : validate_candidate(c, split, material));
     if (c.correction && c.completed)
       c.stability = material_stability(*material.elastic, c.correction.get(), reachable);
+    std::string label = "candidate " + to_string(kind);
+    if (iteration >= 0) // append, not " " + to_string(): GCC 12 warns -Wrestrict on that wrongly
+      label.append(" ").append(std::to_string(iteration));
     say(callbacks,
-        "candidate " + to_string(kind) + (iteration >= 0 ? " " + std::to_string(iteration) : "")
+        label
             + (c.completed ? format(": validation error rms %.4f %%, max %.4f %%",
                    100 * c.validation.rms / size, 100 * c.validation.max / size)
                            : ": its simulation of the held-out data diverged (" + c.failure + ")")

@@ -19,6 +19,7 @@
 ///      (network_replaces_teacher); it is several times cheaper to evaluate.
 /// The validation choice is what makes the result never worse than fitting parameters on data
 /// nobody tuned the recipe for: the fitted nominal is always a candidate.
+#include <elastolearn/learn/larger_motion_check.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
 #include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/motion.hpp>
@@ -62,19 +63,6 @@ struct NoiseLevel {
   double smoothing_residual = 0; ///< RMS change of the positions by the temporal smoothing [m]
 };
 
-/// How much harder than the recorded motions the larger motion of Candidate::larger_motion is
-/// driven: "half as large again".
-inline constexpr double kLargerMotion = 1.5;
-
-/// A candidate's run of the larger motion (Candidate::larger_motion).
-struct LargerMotionCheck {
-  bool checked = false; ///< false for the nominals (no correction: nothing to check)
-  /// Every amplified held-out motion simulated to its end at the scene's time step (no step
-  /// needed substeps: Simulator::step).
-  bool completed = true;
-  std::string message; ///< why one failed (names the motion and frame); empty if none did
-};
-
 /// What the validation compares.
 enum class CandidateKind { Nominal, FittedNominal, Loop, ForwardFit, Network };
 std::string to_string(CandidateKind kind);
@@ -96,8 +84,8 @@ struct Candidate {
   ErrorSummary validation; ///< at the held-out observations [m]
   /// Whether its material survives a larger motion of the same kind: every held-out motion's
   /// scene driven kLargerMotion times as hard (sim::amplified_scene) must simulate to its end
-  /// without substeps, as the fitted nominal's does. A user's next motion is rarely the one
-  /// recorded. Not checked (passed) for the nominals.
+  /// and stay where the material is stable. A user's next motion is rarely the one recorded.
+  /// Not checked (passed) for the nominals.
   LargerMotionCheck larger_motion;
   /// Its material at the stretches a motion of another kind may reach (reachable_stretches of
   /// the fitted nominal's runs of the held-out motions): a correction must be stable there. Not
