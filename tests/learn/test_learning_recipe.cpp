@@ -212,11 +212,6 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
       EXPECT_TRUE(k.larger_motion.checked);
       // Checked where a motion of another kind may go (the fitted nominal's reachable grid).
       EXPECT_GT(k.stability.samples, 0);
-      // The loop and the forward fit keep their corrections stable at those same samples, so
-      // the validation never has to exclude one of theirs for it.
-      if (k.kind == CandidateKind::Loop || k.kind == CandidateKind::ForwardFit) {
-        EXPECT_TRUE(k.stability.stable()) << to_string(k.kind) << " " << k.iteration;
-      }
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);

@@ -31,8 +31,6 @@ void LearningOptions::validate() const {
     throw InputError("learn.max_reconstruction_frames", "must be ≥ 0");
   if (full_space && max_full_space_dofs < 1)
     throw InputError("learn.max_full_space_dofs", "must be ≥ 1");
-  if (stability_stretches.rows() > 0 && stability_stretches.cols() != 3)
-    throw InputError("learn.stability_stretches", "needs 3 columns (σ₁ σ₂ σ₃ per row)");
 }
 
 namespace {

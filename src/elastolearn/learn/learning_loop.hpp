@@ -87,10 +87,6 @@ struct LearningOptions {
   /// fit far better than the loop's iterations (docs/learning_loop.md; docs/learning.md,
   /// "Forward fit").
   ForwardFitOptions forward_fit;
-  /// Principal stretches (rows σ₁ σ₂ σ₃) where every correction must be stable besides those of
-  /// its own trajectories: the recipe passes the ones its validation checks a candidate at, so
-  /// that a correction the loop or the forward fit takes is one the validation can choose.
-  MatX stability_stretches = MatX(0, 3);
   /// Throws InputError("learn.<field>", ...) for an out-of-range field.
   void validate() const;
 };

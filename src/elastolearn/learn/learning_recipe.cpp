@@ -473,41 +473,30 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     if (callbacks.loop.checkpoint)
       callbacks.loop.checkpoint(s);
   };
-  // The validation's reference on the held-out data, simulated before the loop: the stretches a
-  // motion of another kind may reach from its runs are where the validation requires a
-  // correction to be stable, so the loop and the forward fit require it too (a step they take
-  // must be one the validation can choose).
-  const CandidateKind reference_kind
-      = options.fit_parameters ? CandidateKind::FittedNominal : CandidateKind::Nominal;
-  const fem::MaterialModel& reference_material
-      = options.fit_parameters ? result.fitted_nominal : given;
-  Candidate reference_candidate;
-  reference_candidate.kind = reference_kind;
-  MatX reference_stretches;
-  VecX reference_prediction = validate_candidate(reference_candidate, split, reference_material,
-      &reference_stretches, options.loop.stretch_samples);
-  const MatX reachable = reachable_stretches(*reference_material.elastic, reference_stretches);
-  LearningOptions loop_options = options.loop;
-  loop_options.stability_stretches = reachable;
-  if (!run_learning(split.training, loop_options, result.loop, loop_callbacks)) {
+  if (!run_learning(split.training, options.loop, result.loop, loop_callbacks)) {
     result.interrupted = true;
     return result;
   }
 
   // Stage 4: every candidate on the held-out data.
   std::vector<VecX> predictions; // per candidate, at_observed_vertices
+  const CandidateKind reference_kind
+      = options.fit_parameters ? CandidateKind::FittedNominal : CandidateKind::Nominal;
+  MatX reachable; // where a correction must be stable: around the reference's held-out runs
   auto add = [&](CandidateKind kind, int iteration,
                  std::shared_ptr<const material::Correction> correction, double training) {
-    const bool is_reference = kind == reference_kind && !correction;
-    Candidate c = is_reference ? std::move(reference_candidate) : Candidate {};
+    Candidate c;
     c.kind = kind;
     c.iteration = iteration;
     c.correction = std::move(correction);
     c.training.rms = training;
     const fem::MaterialModel& material
         = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
-    predictions.push_back(
-        is_reference ? std::move(reference_prediction) : validate_candidate(c, split, material));
+    MatX reference_stretches;
+    predictions.push_back(validate_candidate(c, split, material,
+        kind == reference_kind ? &reference_stretches : nullptr, options.loop.stretch_samples));
+    if (kind == reference_kind)
+      reachable = reachable_stretches(*material.elastic, reference_stretches);
     if (c.correction && c.completed)
       c.stability = material_stability(*material.elastic, c.correction.get(), reachable);
     std::string label = "candidate " + to_string(kind);

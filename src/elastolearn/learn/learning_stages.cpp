@@ -97,14 +97,12 @@ template <typename T> std::vector<T> without_first(const std::vector<T>& v) {
 constexpr std::array<double, 2> kLoopAmplifications { 1.0, 1.25 };
 
 /// Every stability sample of the loop and the forward fit: the trajectory's stretches amplified
-/// (kLoopAmplifications), the stretches a motion of another kind may reach from them
-/// (learn::reachable_stretches with the recipe's bounds) and the caller's
-/// (LearningOptions::stability_stretches).
-MatX stability_samples(
-    const material::ElasticModel& nominal, const MatX& stretches, const LearningOptions& options) {
+/// (kLoopAmplifications) and the stretches a motion of another kind may reach
+/// (learn::reachable_stretches with the recipe's bounds).
+MatX stability_samples(const material::ElasticModel& nominal, const MatX& stretches) {
   return stacked_rows(
       std::vector<MatX> { amplified_stretches(stretches, kLoopAmplifications, 30000),
-          reachable_stretches(nominal, stretches), options.stability_stretches },
+          reachable_stretches(nominal, stretches) },
       3);
 }
 
@@ -264,8 +262,8 @@ Reconstruction reconstruct_correction(std::span<const ReconstructionMesh> meshes
   out.centres = design.num_centres();
   out.misfit = reconstructed.misfit.rms_residual;
   out.target = reconstructed.misfit.rms_target;
-  stable_fraction(reconstructed.correction, nominal,
-      stability_samples(*nominal.elastic, stretches, options), out);
+  stable_fraction(
+      reconstructed.correction, nominal, stability_samples(*nominal.elastic, stretches), out);
   return out;
 }
 
@@ -304,7 +302,7 @@ ForwardFitStart forward_fit_start(std::span<const Motion> motions,
     fit_options.damping = damping;
   if (stretches.rows() > 0)
     fit_options.stability_stretches
-        = stability_samples(*motions.front().scene.material.elastic, stretches, options);
+        = stability_samples(*motions.front().scene.material.elastic, stretches);
   return { std::move(design), std::move(start), std::move(fit_options) };
 }
 
