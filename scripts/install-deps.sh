@@ -21,6 +21,7 @@ packages=(
   chromium                 # the report test opens report.html headless (WebGL); large, but CI needs it
   pybind11-dev python3-dev # the Python module (python/, docs/python.md)
   python3-numpy python3-pytest # its arrays and its tests (tests/python)
+  python3-h5py             # the HDF5 interop test: h5py reads our files and we read its
 )
 # Real surface meshes for examples and benchmarks (optional; tests never need them).
 if [[ "${ELASTOLEARN_WITH_CGAL_DATA:-1}" == 1 ]]; then packages+=(libcgal-demo); fi

@@ -39,7 +39,9 @@ std::string to_string(CandidateKind kind) {
 }
 
 RecipeOptions::RecipeOptions() {
-  parameter_fit.max_iterations = 10;
+  // As fit-parameters: with 10, 12 of random seed 9's 30 fits stopped at the cap, one of them
+  // (a truth in the nominal's family, exact data) at 0.28 % where 20 reach the truth exactly.
+  parameter_fit.max_iterations = 20;
   loop.forward_fit.max_iterations = 3;
   loop.rbf.energy_kernels = true;
   loop.rbf.epsilon = 0.03;

@@ -49,7 +49,7 @@ struct RecipeOptions {
   LearningOptions loop;
   /// Stage 5.
   NetworkOptions network;
-  /// The recipe's defaults: a parameter fit of ≤ 10 Levenberg–Marquardt iterations and 3
+  /// The recipe's defaults: a parameter fit of ≤ 20 Levenberg–Marquardt iterations and 3
   /// forward-fit steps after the loop.
   RecipeOptions();
   /// Throws InputError("learn.<field>", ...) for an out-of-range field.
