@@ -225,7 +225,8 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
     *stretches = stacked_rows(run_stretches, 3);
   if (c.correction) {
     for (const HeldOut& piece : split.validation) {
-      const int substepped = c.larger_motion.first_substepped_frame; // of an earlier motion
+      // The first substepped frame of the first motion that needed substeps is kept.
+      const int substepped = c.larger_motion.first_substepped_frame;
       c.larger_motion = check_larger_motion(with_candidate(piece), piece.motion.name);
       if (substepped > 0)
         c.larger_motion.first_substepped_frame = substepped;

@@ -84,7 +84,7 @@ struct Candidate {
   ErrorSummary validation; ///< at the held-out observations [m]
   /// Whether its material survives a larger motion of the same kind: every held-out motion's
   /// scene driven kLargerMotion times as hard (sim::amplified_scene) must simulate to its end
-  /// and stay where the material is stable. A user's next motion is rarely the one recorded.
+  /// (check_larger_motion; substeps allowed). A user's next motion is rarely the one recorded.
   /// Not checked (passed) for the nominals.
   LargerMotionCheck larger_motion;
   /// Its material at the stretches a motion of another kind may reach (reachable_stretches of
