@@ -60,11 +60,11 @@ struct Undrawable : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Print case `index` of `seed`; with `run`, simulate its truth, learn with the recipe (default
-/// options), and measure nominal / fitted / learned on the test motion (with `test_candidates`,
-/// every validated candidate too).
-RandomRow run_random_case(
-    std::uint64_t seed, int index, const fs::path& data, bool run, bool test_candidates) {
+/// Print case `index` of `seed`; unless options.draw_only, simulate its truth, learn with the
+/// recipe (default options), and measure nominal / fitted / learned on the test motion (with
+/// options.test_candidates, every validated candidate too).
+RandomRow run_random_case(std::uint64_t seed, int index, const RandomRunOptions& options) {
+  const bool run = !options.draw_only;
   RandomRow row;
   row.index = index;
   std::printf("\n== random case %d of seed %llu (alone: bench_learning --seed %llu --random-case "
@@ -72,7 +72,10 @@ RandomRow run_random_case(
       index, static_cast<unsigned long long>(seed), static_cast<unsigned long long>(seed), index);
   std::fflush(stdout);
   auto t0 = Clock::now();
-  const RandomObject o = draw_random_object(seed, index, data);
+  RandomObject o = draw_random_object(seed, index, options.data);
+  const double drawn_noise = o.noise_percent;
+  if (options.noise_percent >= 0)
+    o.noise_percent = options.noise_percent; // after the draw: every other choice is unchanged
   row.shape = o.shape_label;
   row.truth = o.truth_label;
   row.tets = o.mesh.num_tets();
@@ -83,6 +86,10 @@ RandomRow run_random_case(
       o.shape_label.c_str(), o.truth_label.c_str(),
       o.truth_in_family ? "" : " (not in the nominal's family)", o.nominal_label.c_str(),
       o.setup_label.c_str(), seconds_since(t0));
+  if (options.noise_percent >= 0)
+    std::printf(
+        "   --noise: observation noise σ %.2f %% of the diagonal instead of the drawn %.1f %%\n",
+        o.noise_percent, drawn_noise);
   std::fflush(stdout);
 
   RandomMotions motions;
@@ -195,7 +202,7 @@ RandomRow run_random_case(
       percent(row.err_nominal).c_str(), percent(row.err_fit).c_str(),
       percent(row.err_learned).c_str(), seconds_since(t0));
   std::fflush(stdout);
-  if (test_candidates)
+  if (options.test_candidates)
     print_candidate_tests(result, motions.train, motions.test, o.nominal, truth_test,
         motions.test.mesh.bounding_box_diagonal());
   return row;
@@ -277,13 +284,15 @@ void print_random_summary(const std::vector<RandomRow>& rows, int failed) {
 
 } // namespace
 
-int run_random(int count, int only, const fs::path& data, bool draw_only, long seed_option,
-    bool test_candidates) {
-  const std::uint64_t seed = seed_option >= 0 ? static_cast<std::uint64_t>(seed_option)
-                                              : std::random_device {}() & 0x7fffffffu;
-  std::printf("bench_learning --random %d --seed %llu%s: %u hardware threads\n", count,
+int run_random(const RandomRunOptions& options) {
+  const int count = options.count, only = options.only;
+  const bool draw_only = options.draw_only;
+  const std::uint64_t seed = options.seed >= 0 ? static_cast<std::uint64_t>(options.seed)
+                                               : std::random_device {}() & 0x7fffffffu;
+  std::printf("bench_learning --random %d --seed %llu%s%s: %u hardware threads\n", count,
       static_cast<unsigned long long>(seed),
       only >= 0 ? (" --random-case " + std::to_string(only)).c_str() : "",
+      options.noise_percent >= 0 ? (" --noise " + err(options.noise_percent)).c_str() : "",
       std::thread::hardware_concurrency());
   std::vector<RandomRow> rows;
   std::string skipped;
@@ -292,7 +301,7 @@ int run_random(int count, int only, const fs::path& data, bool draw_only, long s
   const auto more = [&] { return only >= 0 || static_cast<int>(rows.size()) + failed < count; };
   for (; index < last_index && more(); ++index) {
     try {
-      rows.push_back(run_random_case(seed, index, data, !draw_only, test_candidates));
+      rows.push_back(run_random_case(seed, index, options));
       if (!draw_only && only < 0 && more())
         print_random_summary(rows, failed);
     } catch (const Undrawable& e) {

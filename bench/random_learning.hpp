@@ -5,14 +5,22 @@
 
 namespace bench_learning {
 
-/// --random N / --random-case I: runs `count` random cases of the seed `seed_option` (−1: a fresh
-/// seed, printed), or with `only` ≥ 0 only case `only`, then prints the table and issue 19's
-/// targets; `draw_only` prints the draws without simulating. A case whose motions cannot be
+struct RandomRunOptions {
+  int count = 0; ///< --random N: how many cases run
+  int only = -1; ///< --random-case I: only case I (≥ 0)
+  long seed = -1; ///< --seed S (−1: a fresh seed, printed)
+  std::filesystem::path data; ///< where libcgal-demo's meshes are (random_cases.hpp)
+  bool draw_only = false; ///< --draw-only: print the draws without simulating
+  bool test_candidates = false; ///< --test-candidates: every validated candidate's test err_L
+  /// --noise PCT: observation noise σ in % of the diagonal instead of the drawn level (every other
+  /// draw unchanged), so that runs at two levels compare the same cases; −1: the drawn level.
+  double noise_percent = -1;
+};
+
+/// --random N / --random-case I: runs `count` random cases of the seed, or with `only` ≥ 0 only
+/// case `only`, then prints the table and issue 19's targets. A case whose motions cannot be
 /// drawn is skipped and, without `only`, replaced by the next index, so that `count` cases run.
-/// `data`: where libcgal-demo's meshes are (random_cases.hpp); `test_candidates`: also print every
-/// validated candidate's test err_L. Returns the exit status: non-zero only if a case failed to
-/// run.
-int run_random(int count, int only, const std::filesystem::path& data, bool draw_only,
-    long seed_option, bool test_candidates);
+/// Returns the exit status: non-zero only if a case failed to run.
+int run_random(const RandomRunOptions& options);
 
 } // namespace bench_learning

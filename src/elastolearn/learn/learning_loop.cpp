@@ -82,6 +82,9 @@ void set_up(std::span<const Motion> motions, const LearningOptions& options, Loo
           "the nominal scene must not carry a correction already");
     motions[i].observed.validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt,
         motion_field(motions, i, "observations"));
+    if (motions[i].smoothed)
+      motions[i].smoothed->validate(scene.mesh.num_vertices(), scene.frames + 1, scene.dt,
+          motion_field(motions, i, "smoothed observations"));
   }
   // The learned Δα₁ may lower the nominal damping; fem::ElasticForce keeps α₁ + Δα₁ ≥ 0.
   setup.meshes.reserve(motions.size());
@@ -174,7 +177,7 @@ std::optional<TrajectoryStagesResult> trajectory_stages(std::span<const Motion> 
     OptimizedMotion& optimized_motion
         = optimized_motions.emplace_back(sim::with_correction(scene, correction));
     SpaceTimeResult optimized = optimize_space_time(optimized_motion.physics, basis.modes, origin,
-        run.initial_velocity, motions[i].observed, options.space_time, callbacks.progress);
+        run.initial_velocity, motions[i].followed(), options.space_time, callbacks.progress);
     record.space_time_initial += optimized.initial_objective;
     record.space_time_objective += optimized.objective;
     record.space_time_iterations += optimized.iterations;

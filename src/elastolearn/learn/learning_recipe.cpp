@@ -121,10 +121,9 @@ struct HeldOut {
 
 /// The training and validation data of stage 1.
 struct Split {
-  std::vector<Motion> training; ///< observations smoothed to the noise level
-  /// The training motions' observations as recorded, in order (the parameter fit's data: it
-  /// does not differentiate positions).
-  std::vector<observe::Observation> fit_observed;
+  /// Observations as recorded (what the parameter fit, the forward error and the forward fit
+  /// compare with), and smoothed to the noise level (what the space-time stages follow).
+  std::vector<Motion> training;
   std::vector<HeldOut> validation; ///< one per motion
   std::string description;
 };
@@ -149,9 +148,10 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
               + std::to_string(held_out) + " for validation");
     Motion train = m;
     train.scene.frames = train_frames;
-    train.observed = frame_range(smoothed[i], 0, train_frames);
+    train.observed = frame_range(m.observed, 0, train_frames);
+    train.smoothed
+        = std::make_shared<const observe::Observation>(frame_range(smoothed[i], 0, train_frames));
     split.training.push_back(std::move(train));
-    split.fit_observed.push_back(frame_range(m.observed, 0, train_frames));
     HeldOut piece { m, train_frames + 1 };
     piece.motion.observed = frame_range(m.observed, train_frames + 1, frames);
     split.validation.push_back(std::move(piece));
@@ -409,17 +409,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // Stages 0 and 1.
   Split split = prepare_data(learned_from, options, result, callbacks, size);
 
-  // Stage 2: the nominal model's parameters, fitted to every training motion as recorded (the
-  // training motions lend their scenes, their observations swapped for the raw ones meanwhile).
+  // Stage 2: the nominal model's parameters, fitted to every training motion as recorded.
   const auto fit_from = [&](const NominalParameters& start) {
-    const auto swap_observations = [&] {
-      for (size_t i = 0; i < split.training.size(); ++i)
-        std::swap(split.training[i].observed, split.fit_observed[i]);
-    };
-    swap_observations();
     ParameterFitReport f
         = fit_parameters(split.training, result.nominal_type, start, options.parameter_fit, {});
-    swap_observations();
     say(callbacks,
         format("parameter fit: E %.4g Pa, ν %.3f, α₀ %.3g 1/s, ", f.fitted.young, f.fitted.poisson,
             f.fitted.alpha0)
@@ -456,8 +449,9 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   for (const Motion& m : learned_from)
     result.observed.push_back(m.observed);
 
-  // Stage 3: the loop (and its forward fit) on the fitted nominal, following smoothed positions,
-  // over every training motion.
+  // Stage 3: the loop (and its forward fit) on the fitted nominal over every training motion:
+  // its space-time stages follow the smoothed positions, its forward errors and forward fit
+  // compare with the recorded ones.
   for (Motion& m : split.training)
     m.scene.material = result.fitted_nominal;
   std::map<int, std::shared_ptr<const material::RbfCorrection>> tried; // C_k per iteration

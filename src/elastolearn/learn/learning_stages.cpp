@@ -166,7 +166,7 @@ void stable_fraction(const material::RbfCorrection& fitted, const fem::MaterialM
 
 MotionSetup::MotionSetup(const Motion& motion)
     : basis_vertices(free_vertices(motion.scene))
-    , tracked_scene(constrained_scene(motion.scene, motion.observed))
+    , tracked_scene(constrained_scene(motion.scene, motion.followed()))
     , nominal_physics(motion.scene) {
   all_free_tracked
       = tracked_scene.tracked && tracked_scene.tracked->vertices.size() == basis_vertices.size();

@@ -29,6 +29,15 @@ struct Motion {
   observe::Observation observed;
   /// Set when the motion was captured as point clouds (shared: a motion is copied per stage).
   std::shared_ptr<const CloudCapture> captured = nullptr;
+  /// `observed` smoothed in time to the noise level (observe::smooth_to_noise), or null. The
+  /// stages that differentiate positions twice (the space-time solve, the constrained forward
+  /// simulation) follow these; every comparison of a simulation with the data (the forward error,
+  /// the forward fit) uses `observed` itself, whose noise has zero mean, where the smoothing's
+  /// bias would be taken for signal. Shared: a motion is copied per stage.
+  std::shared_ptr<const observe::Observation> smoothed = nullptr;
+
+  /// The positions the differentiating stages follow: `smoothed` if set, else `observed`.
+  const observe::Observation& followed() const { return smoothed ? *smoothed : observed; }
 };
 
 } // namespace elastolearn::learn
