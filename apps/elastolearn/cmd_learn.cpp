@@ -215,6 +215,14 @@ void run_learn(const LearnOptions& o) {
           + elastolearn::to_text(
               100 * (c.validation.rms / result.candidates[c.teacher].validation.rms - 1))
           + " % worse than its teacher: the RBF is kept)";
+    else if (c.completed && !reference && c.resolution < learn::kSignificance)
+      note = "   (the held-out data cannot tell it from the fitted nominal; on the training data "
+          + (std::isnan(c.training_significance)
+                  ? std::string("not compared")
+                  : "better by " + elastolearn::to_text(c.training_significance)
+                      + " noise deviations after its unknowns' share"
+                      + (c.beats_reference ? "" : ": not significant"))
+          + ")";
     else if (c.completed && !reference && c.significance <= 0)
       note = "   (no better than the fitted nominal)";
     else if (c.completed && !reference && c.significance < learn::kSignificance)

@@ -57,7 +57,12 @@ nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
         { "larger_motion", larger_motion_to_json(c.larger_motion) },
         { "reachable_stretches", stability_to_json(c.stability) }, { "eligible", c.eligible() },
         // null: infinite (noise σ = 0), its sign that of the validation errors' difference
-        { "significance", finite_or_null(c.significance) } });
+        { "significance", finite_or_null(c.significance) },
+        // the z an exactly right candidate would reach on the held-out data; null: infinite
+        { "resolution", finite_or_null(c.resolution) }, { "unknowns", c.unknowns },
+        // null: not measured, or infinite (noise σ = 0)
+        { "training_significance", finite_or_null(c.training_significance) },
+        { "beats_reference", c.beats_reference } });
     if (!c.completed)
       candidates.back()["failure"] = c.failure;
     if (c.kind == learn::CandidateKind::Network) {

@@ -188,16 +188,24 @@ VecX flat_positions(const observe::Observation& o) {
   return out;
 }
 
+/// A candidate's predictions (at_observed_vertices, the motions in order; empty if a simulation
+/// diverged).
+struct CandidatePredictions {
+  VecX held_out; ///< of the held-out observations
+  VecX training; ///< of the training observations (as recorded)
+};
+
 /// The candidate's error on the held-out data (completed false if a simulation diverged) and,
-/// for a correction, its run of the larger motion. Returns its predictions of the held-out
-/// observations (at_observed_vertices, the pieces in order; empty if a simulation diverged).
-/// `stretches` (if non-null) receives the principal stretches of its held-out motions' runs
-/// (collect_stretches with `sampling`, stacked; empty if a simulation diverged).
-VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialModel& nominal,
-    MatX* stretches = nullptr, const StretchSampleOptions& sampling = {}) {
+/// for a correction, its run of the larger motion. Each motion is simulated once, whole: the
+/// run predicts its training frames too. `stretches` (if non-null) receives the principal
+/// stretches of its held-out motions' runs (collect_stretches with `sampling`, stacked; empty if
+/// a simulation diverged).
+CandidatePredictions validate_candidate(Candidate& c, const Split& split,
+    const fem::MaterialModel& nominal, MatX* stretches = nullptr,
+    const StretchSampleOptions& sampling = {}) {
   std::vector<MatX> run_stretches;
   std::vector<ErrorSummary> errors;
-  std::vector<VecX> predictions;
+  std::vector<VecX> predictions, training_predictions;
   // The held-out motion's scene with the candidate's material.
   const auto with_candidate = [&](const HeldOut& piece) {
     sim::Scene scene = piece.motion.scene;
@@ -205,7 +213,8 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
     scene.material.correction = c.correction;
     return scene;
   };
-  for (const HeldOut& piece : split.validation) {
+  for (size_t i = 0; i < split.validation.size(); ++i) {
+    const HeldOut& piece = split.validation[i];
     const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece));
     c.completed = run.completed;
     if (!run.completed) {
@@ -219,6 +228,9 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
         run.positions.begin() + piece.first_frame, run.positions.end());
     errors.push_back(observation_error(compared, piece.motion.observed));
     predictions.push_back(at_observed_vertices(compared, piece.motion.observed));
+    const observe::Observation& trained_on = split.training[i].observed;
+    training_predictions.push_back(at_observed_vertices(
+        std::span(run.positions).first(static_cast<size_t>(trained_on.num_frames())), trained_on));
   }
   c.validation = combined_error(errors);
   if (stretches)
@@ -234,7 +246,7 @@ VecX validate_candidate(Candidate& c, const Split& split, const fem::MaterialMod
         break;
     }
   }
-  return stacked_rows(predictions);
+  return { stacked_rows(predictions), stacked_rows(training_predictions) };
 }
 
 /// "; failed in the motion driven 1.5× as hard (...)" when the larger motion failed, else "".
@@ -272,8 +284,10 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0, do
 
 } // namespace
 
-double paired_significance(const VecX& r, const VecX& c, const VecX& o, double sigma) {
-  const double gain = (r - o).squaredNorm() - (c - o).squaredNorm();
+namespace {
+
+/// gain / (2σ‖c − r‖), ±∞ (0 for no gain) where the spread vanishes.
+double in_noise_deviations(double gain, const VecX& r, const VecX& c, double sigma) {
   const double spread = 2 * sigma * (c - r).norm();
   if (spread > 0)
     return gain / spread;
@@ -283,17 +297,45 @@ double paired_significance(const VecX& r, const VecX& c, const VecX& o, double s
                   : -std::numeric_limits<double>::infinity();
 }
 
+} // namespace
+
+double paired_significance(const VecX& r, const VecX& c, const VecX& o, double sigma) {
+  return in_noise_deviations((r - o).squaredNorm() - (c - o).squaredNorm(), r, c, sigma);
+}
+
+void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int reference,
+    const ComparedData& validation, const ComparedData& training, double sigma) {
+  Candidate& c = candidates[i];
+  const auto r = static_cast<size_t>(reference);
+  const VecX &rv = validation.predictions[r], &cv = validation.predictions[i];
+  c.significance = paired_significance(rv, cv, validation.observed, sigma);
+  c.resolution = in_noise_deviations((cv - rv).squaredNorm(), rv, cv, sigma);
+  c.training_significance = std::numeric_limits<double>::quiet_NaN();
+  if (std::max(i, r) < training.predictions.size() && training.predictions[i].size() > 0
+      && training.predictions[r].size() > 0) {
+    const VecX &rt = training.predictions[r], &ct = training.predictions[i];
+    const VecX& o = training.observed;
+    const double charge = c.unknowns * sigma * sigma;
+    c.training_significance = in_noise_deviations(
+        (rt - o).squaredNorm() - (ct - o).squaredNorm() - charge, rt, ct, sigma);
+  }
+  // NaN (not measured) compares false: such a candidate passes on the held-out data or not at all.
+  c.beats_reference = c.resolution >= kSignificance ? c.significance >= kSignificance
+                                                    : c.training_significance >= kSignificance;
+}
+
 bool network_replaces_teacher(
     const Candidate& network, const Candidate& teacher, bool has_reference) {
   const bool as_good = network.gain_over_teacher > -kSignificance
       || network.validation.rms <= (1 + kNetworkTolerance) * teacher.validation.rms;
   return network.kind == CandidateKind::Network && network.eligible() && teacher.completed
-      && (!has_reference || network.significance >= kSignificance) && as_good;
+      && (!has_reference || network.beats_reference) && as_good;
 }
 
-int choose_candidate(std::vector<Candidate>& candidates, std::span<const VecX> predictions,
-    const VecX& observed, int reference, double sigma) {
-  int chosen = -1;
+int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
+    const ComparedData& training, int reference, double sigma) {
+  int chosen = -1, by_training = -1;
+  double lowest_training = std::numeric_limits<double>::infinity();
   const Candidate* ref = reference >= 0 ? &candidates[static_cast<size_t>(reference)] : nullptr;
   if (ref && !ref->completed)
     ref = nullptr;
@@ -301,15 +343,28 @@ int choose_candidate(std::vector<Candidate>& candidates, std::span<const VecX> p
     Candidate& c = candidates[i];
     if (!c.completed)
       continue;
-    if (ref && static_cast<int>(i) != reference)
-      c.significance = paired_significance(
-          predictions[static_cast<size_t>(reference)], predictions[i], observed, sigma);
-    const bool passes = !ref || static_cast<int>(i) == reference || c.significance >= kSignificance;
-    if (c.eligible() && passes
+    const bool is_reference = !ref || static_cast<int>(i) == reference;
+    if (!is_reference)
+      compare_with_reference(candidates, i, reference, validation, training, sigma);
+    if (!c.eligible())
+      continue;
+    const bool on_held_out = is_reference || (c.beats_reference && c.resolution >= kSignificance);
+    if (on_held_out
         && (chosen < 0
             || c.validation.rms < candidates[static_cast<size_t>(chosen)].validation.rms))
       chosen = static_cast<int>(i);
+    if (!is_reference && c.beats_reference && c.resolution < kSignificance) {
+      const double error = (training.predictions[i] - training.observed).squaredNorm();
+      if (error < lowest_training) {
+        lowest_training = error;
+        by_training = static_cast<int>(i);
+      }
+    }
   }
+  // The training data decide only where the held-out data could not: no candidate beat the
+  // reference there.
+  if (by_training >= 0 && (chosen < 0 || chosen == reference))
+    return by_training;
   return chosen;
 }
 
@@ -476,7 +531,14 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   }
 
   // Stage 4: every candidate on the held-out data.
-  std::vector<VecX> predictions; // per candidate, at_observed_vertices
+  ComparedData held_out, trained; // per candidate, at_observed_vertices
+  // The unknowns the loop's design fitted for an RBF correction (a network takes its teacher's).
+  const auto fitted_unknowns = [&](const material::Correction* correction) {
+    const auto* rbf = dynamic_cast<const material::RbfCorrection*>(correction);
+    return rbf ? RbfDesign(rbf->parameters().centres, options.loop.rbf, rbf->parameters().trusted)
+                     .num_unknowns()
+               : 0;
+  };
   const CandidateKind reference_kind
       = options.fit_parameters ? CandidateKind::FittedNominal : CandidateKind::Nominal;
   MatX reachable; // where a correction must be stable: around the reference's held-out runs
@@ -489,9 +551,12 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     c.training.rms = training;
     const fem::MaterialModel& material
         = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
+    c.unknowns = fitted_unknowns(c.correction.get());
     MatX reference_stretches;
-    predictions.push_back(validate_candidate(c, split, material,
-        kind == reference_kind ? &reference_stretches : nullptr, options.loop.stretch_samples));
+    CandidatePredictions p = validate_candidate(c, split, material,
+        kind == reference_kind ? &reference_stretches : nullptr, options.loop.stretch_samples);
+    held_out.predictions.push_back(std::move(p.held_out));
+    trained.predictions.push_back(std::move(p.training));
     if (kind == reference_kind)
       reachable = reachable_stretches(*material.elastic, reference_stretches);
     if (c.correction && c.completed)
@@ -538,12 +603,15 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   if (result.loop.best && tried.find(result.loop.best_iteration) == tried.end())
     add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best, result.loop.best_error);
   const int reference = options.fit_parameters ? 1 : 0;
-  std::vector<VecX> held_out;
+  std::vector<VecX> held_out_observed, trained_observed;
   for (const HeldOut& piece : split.validation)
-    held_out.push_back(flat_positions(piece.motion.observed));
-  const VecX observed = stacked_rows(held_out);
+    held_out_observed.push_back(flat_positions(piece.motion.observed));
+  for (const Motion& m : split.training)
+    trained_observed.push_back(flat_positions(m.observed));
+  held_out.observed = stacked_rows(held_out_observed);
+  trained.observed = stacked_rows(trained_observed);
   result.chosen
-      = choose_candidate(result.candidates, predictions, observed, reference, result.noise.sigma);
+      = choose_candidate(result.candidates, held_out, trained, reference, result.noise.sigma);
   if (result.chosen < 0)
     throw InputError(split.validation.front().motion.name,
         "no candidate, not even the nominal material, simulates the held-out data");
@@ -560,13 +628,14 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
         result.network->correction, std::numeric_limits<double>::quiet_NaN());
     Candidate& network = result.candidates.back();
     network.teacher = t;
+    network.unknowns = result.candidates[static_cast<size_t>(t)].unknowns;
     if (network.completed) {
       const bool has_reference = result.candidates[static_cast<size_t>(reference)].completed;
       if (has_reference)
-        network.significance = paired_significance(predictions[static_cast<size_t>(reference)],
-            predictions.back(), observed, result.noise.sigma);
-      network.gain_over_teacher = paired_significance(
-          predictions[static_cast<size_t>(t)], predictions.back(), observed, result.noise.sigma);
+        compare_with_reference(result.candidates, result.candidates.size() - 1, reference, held_out,
+            trained, result.noise.sigma);
+      network.gain_over_teacher = paired_significance(held_out.predictions[static_cast<size_t>(t)],
+          held_out.predictions.back(), held_out.observed, result.noise.sigma);
       if (network_replaces_teacher(
               network, result.candidates[static_cast<size_t>(t)], has_reference))
         result.chosen = static_cast<int>(result.candidates.size()) - 1;

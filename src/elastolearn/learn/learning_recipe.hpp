@@ -12,7 +12,9 @@
 ///      correction of the loop and of the forward fit) simulates the held-out data; among those
 ///      whose material survives a larger motion (kLargerMotion) and that beat the fitted nominal
 ///      by more than noise could (z ≥ kSignificance), the one with the smallest RMS error there
-///      is the result; the fitted nominal if none;
+///      is the result; the fitted nominal if none. Where the held-out data cannot resolve a
+///      candidate from the fitted nominal (a motion that has died out under noise), the training
+///      data decide, charged for the unknowns fitted to them (choose_candidate);
 ///   5. network: a chosen correction is distilled into the network correction
 ///      (network_distillation.hpp), validated the same way, and replaces its teacher when it is
 ///      eligible, beats the fitted nominal by kSignificance, and is as good as its teacher
@@ -30,6 +32,7 @@
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>
 
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -100,6 +103,22 @@ struct Candidate {
   /// (the noise term of the difference, −2 nᵀ(c − r), has standard deviation 2σ‖c − r‖). 0 for
   /// the reference itself.
   double significance = 0;
+  /// How far the held-out data can tell it from the reference: the z it would reach there if it
+  /// were exactly right, ‖c − r‖ / (2σ) (+∞ without noise, 0 for the reference). Below
+  /// kSignificance no candidate, however good, could pass the held-out test: the held-out frames
+  /// barely move (a damped motion's tail) or the candidate barely differs there.
+  double resolution = 0;
+  /// The unknowns fitted to the training data (a correction's weights and tails; a network's
+  /// teacher's): the degrees of freedom training_significance charges. 0 for the nominals.
+  int unknowns = 0;
+  /// Its improvement on the reference over the training observations, charged for what fitting
+  /// its unknowns to their noise gains by itself (k σ² in expectation, k = unknowns):
+  /// z = (‖r − o‖² − ‖c − o‖² − k σ²) / (2σ‖c − r‖). NaN where not measured.
+  double training_significance = std::numeric_limits<double>::quiet_NaN();
+  /// It beats the reference beyond noise: on the held-out data where they resolve it
+  /// (resolution ≥ kSignificance: significance ≥ kSignificance), else on the training data
+  /// (training_significance ≥ kSignificance). False for the reference itself.
+  bool beats_reference = false;
   /// Eligible for the choice: its validation completed, it survives a larger motion and it is
   /// stable where a motion of another kind may go.
   bool eligible() const { return completed && larger_motion.completed && stability.stable(); }
@@ -166,21 +185,34 @@ double paired_significance(const VecX& r, const VecX& c, const VecX& o, double s
 /// distillation error) predicts the held-out data within rounding of the teacher's prediction.
 inline constexpr double kNetworkTolerance = 0.01;
 
-/// Stage 5's decision: a network candidate replaces its teacher when it is eligible, passes the
-/// reference test (significance ≥ kSignificance, unless `has_reference` is false) and is as good
-/// as its teacher: not worse by kSignificance noise deviations, or its validation RMS within
+/// Stage 5's decision: a network candidate replaces its teacher when it is eligible, beats the
+/// reference (beats_reference, unless `has_reference` is false) and is as good as its teacher:
+/// not worse by kSignificance noise deviations, or its validation RMS within
 /// (1 + kNetworkTolerance) of the teacher's.
 bool network_replaces_teacher(
     const Candidate& network, const Candidate& teacher, bool has_reference);
 
-/// Stage 4's choice. `predictions[i]` is candidate i's prediction of the held-out observations
-/// `observed` (both flat: frame, observed vertex, xyz; empty if it did not complete), `reference`
-/// the index of the fitted nominal (or −1: no reference), σ the noise per coordinate. Sets every
-/// other completed candidate's `significance` against the reference and returns the index of the
-/// eligible candidate with the lowest validation RMS among the reference and the candidates with
-/// significance ≥ kSignificance (−1 if none is eligible).
-int choose_candidate(std::vector<Candidate>& candidates, std::span<const VecX> predictions,
-    const VecX& observed, int reference, double sigma);
+/// Observations and every candidate's prediction of them, flat (frame, observed vertex, xyz; 0
+/// at lost entries; a prediction is empty where the candidate's simulation did not complete).
+struct ComparedData {
+  std::vector<VecX> predictions;
+  VecX observed;
+};
+
+/// Sets candidate i's significance, resolution, training_significance and beats_reference
+/// against the reference candidate (index `reference`), on the held-out data `validation` and,
+/// if it holds predictions of both, the training data `training`; σ the noise per coordinate.
+void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int reference,
+    const ComparedData& validation, const ComparedData& training, double sigma);
+
+/// Stage 4's choice, `reference` the index of the fitted nominal (or −1: no reference), σ the
+/// noise per coordinate. Compares every other completed candidate with the reference
+/// (compare_with_reference) and returns the index of the eligible candidate with the lowest
+/// validation RMS among the reference and the candidates that beat it on the held-out data. If
+/// none does, but some that the held-out data cannot resolve beat it on the training data, the
+/// one of those with the lowest training error. −1 if no candidate is eligible.
+int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
+    const ComparedData& training, int reference, double sigma);
 
 /// Run all stages (from `resume` on, if given: stage 2 is then not repeated). Returns with
 /// `interrupted` set if callbacks.loop.interrupted asked to stop (the last checkpoint holds the
