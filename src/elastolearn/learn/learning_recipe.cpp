@@ -282,10 +282,6 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0, do
   return text;
 }
 
-} // namespace
-
-namespace {
-
 /// gain / (2σ‖c − r‖), ±∞ (0 for no gain) where the spread vanishes.
 double in_noise_deviations(double gain, const VecX& r, const VecX& c, double sigma) {
   const double spread = 2 * sigma * (c - r).norm();
