@@ -197,14 +197,14 @@ struct CandidatePredictions {
 
 /// The candidate's error on the held-out data (completed false if a simulation diverged) and,
 /// for a correction, its run of the larger motion. Each motion is simulated once, whole: the
-/// run predicts its training frames too. `stretches` (if non-null) receives the principal
-/// stretches of its held-out motions' runs (collect_stretches with `sampling`, stacked; empty if
-/// a simulation diverged).
+/// run predicts its training frames too (c.training). `stretches` (if non-null) receives the
+/// principal stretches of its held-out motions' runs (collect_stretches with `sampling`, stacked;
+/// empty if a simulation diverged).
 CandidatePredictions validate_candidate(Candidate& c, const Split& split,
     const fem::MaterialModel& nominal, MatX* stretches = nullptr,
     const StretchSampleOptions& sampling = {}) {
   std::vector<MatX> run_stretches;
-  std::vector<ErrorSummary> errors;
+  std::vector<ErrorSummary> errors, training_errors;
   std::vector<VecX> predictions, training_predictions;
   // The held-out motion's scene with the candidate's material.
   const auto with_candidate = [&](const HeldOut& piece) {
@@ -229,10 +229,13 @@ CandidatePredictions validate_candidate(Candidate& c, const Split& split,
     errors.push_back(observation_error(compared, piece.motion.observed));
     predictions.push_back(at_observed_vertices(compared, piece.motion.observed));
     const observe::Observation& trained_on = split.training[i].observed;
-    training_predictions.push_back(at_observed_vertices(
-        std::span(run.positions).first(static_cast<size_t>(trained_on.num_frames())), trained_on));
+    const std::vector<VecX> trained_frames(
+        run.positions.begin(), run.positions.begin() + trained_on.num_frames());
+    training_errors.push_back(observation_error(trained_frames, trained_on));
+    training_predictions.push_back(at_observed_vertices(trained_frames, trained_on));
   }
   c.validation = combined_error(errors);
+  c.training = combined_error(training_errors);
   if (stretches)
     *stretches = stacked_rows(run_stretches, 3);
   if (c.correction) {
@@ -539,12 +542,11 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
       = options.fit_parameters ? CandidateKind::FittedNominal : CandidateKind::Nominal;
   MatX reachable; // where a correction must be stable: around the reference's held-out runs
   auto add = [&](CandidateKind kind, int iteration,
-                 std::shared_ptr<const material::Correction> correction, double training) {
+                 std::shared_ptr<const material::Correction> correction) {
     Candidate c;
     c.kind = kind;
     c.iteration = iteration;
     c.correction = std::move(correction);
-    c.training.rms = training;
     const fem::MaterialModel& material
         = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
     c.unknowns = fitted_unknowns(c.correction.get());
@@ -569,9 +571,9 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
             + describe_instability(c.stability));
     result.candidates.push_back(std::move(c));
   };
-  add(CandidateKind::Nominal, -1, nullptr, result.parameter_fit.initial_rms);
+  add(CandidateKind::Nominal, -1, nullptr);
   if (options.fit_parameters)
-    add(CandidateKind::FittedNominal, -1, nullptr, result.parameter_fit.final_rms);
+    add(CandidateKind::FittedNominal, -1, nullptr);
   // The loop's corrections with the lowest training errors, and the forward fit's last
   // accepted step: each validation costs a simulation of the held-out data.
   std::vector<const IterationRecord*> loop_records;
@@ -594,10 +596,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     loop_records.push_back(forward_fit);
   for (const IterationRecord* r : loop_records)
     add(forward_fit_of(*r) ? CandidateKind::ForwardFit : CandidateKind::Loop, iteration_of(*r),
-        tried.at(iteration_of(*r)), forward_of(*r).error().rms);
+        tried.at(iteration_of(*r)));
   // A resumed run knows the earlier iterations only through the best one.
   if (result.loop.best && tried.find(result.loop.best_iteration) == tried.end())
-    add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best, result.loop.best_error);
+    add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best);
   const int reference = options.fit_parameters ? 1 : 0;
   std::vector<VecX> held_out_observed, trained_observed;
   for (const HeldOut& piece : split.validation)
@@ -621,7 +623,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     result.network = distil_network(split.training.front().scene, *teacher, options.network);
     say(callbacks, result.network->describe());
     add(CandidateKind::Network, result.candidates[static_cast<size_t>(t)].iteration,
-        result.network->correction, std::numeric_limits<double>::quiet_NaN());
+        result.network->correction);
     Candidate& network = result.candidates.back();
     network.teacher = t;
     network.unknowns = result.candidates[static_cast<size_t>(t)].unknowns;

@@ -96,8 +96,8 @@ struct Candidate {
   /// the fitted nominal's runs of the held-out motions): a correction must be stable there. Not
   /// checked (stable) for the nominals.
   StabilityReport stability;
-  /// At the training observations [m] (the loop's own signal); NaN for a network (not simulated
-  /// on the training data).
+  /// At the training observations as recorded [m], from the run of its validation (each motion
+  /// is simulated whole).
   ErrorSummary training;
   /// Its improvement on the reference (the fitted nominal, or the given one without a fit) in
   /// standard deviations of what noise alone would give: z = (‖r − o‖² − ‖c − o‖²) / (2σ‖c − r‖)
