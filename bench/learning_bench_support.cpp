@@ -4,6 +4,7 @@
 
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/element_state.hpp>
+#include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
 #include <elastolearn/learn/trajectory_error.hpp>
 #include <elastolearn/sim/amplified_scene.hpp>
@@ -76,6 +77,8 @@ void print_candidate_tests(const learn::RecipeResult& result, const sim::Scene& 
     std::printf("   fitted nominal in the training motion ×%.1f: s₁ up to %.3f, s₃ down to %.3f\n",
         learn::kLargerMotion, s.col(0).maxCoeff(), s.col(2).minCoeff());
   }
+  // Where the test goes: a learned candidate unstable there can diverge in it.
+  const MatX test_stretches = learn::collect_stretches(learn::ReconstructionMesh(test.mesh), truth);
   for (size_t i = 0; i < result.candidates.size(); ++i) {
     const learn::Candidate& c = result.candidates[i];
     const std::string name = candidate_label(c);
@@ -89,6 +92,16 @@ void print_candidate_tests(const learn::RecipeResult& result, const sim::Scene& 
         c.training_significance, c.eligible() ? "eligible" : "not eligible", learn::kLargerMotion,
         !x.checked ? "not checked" : (x.completed ? "passed" : x.message.c_str()), test_error,
         int(i) == result.chosen ? "  <- chosen" : "");
+    if (c.completed && c.kind != learn::CandidateKind::Nominal
+        && c.kind != learn::CandidateKind::FittedNominal) {
+      const fem::MaterialModel m = result.material(given_nominal, int(i));
+      const learn::StabilityReport s
+          = learn::material_stability(*m.elastic, m.correction.get(), test_stretches);
+      const Vec3& w = s.worst_stretches;
+      std::printf("      at the truth's test stretches: unstable at %ld of %ld, smallest stiffness "
+                  "%.3f × the nominal's at σ = (%.3f, %.3f, %.3f)\n",
+          s.unstable_samples, s.samples, s.min_relative_eigenvalue, w(0), w(1), w(2));
+    }
   }
   std::fflush(stdout);
 }

@@ -529,3 +529,56 @@ TEST(MaterialFile, RbfTrustedStretchesRoundTrip) {
   bad["correction"]["trusted_stretches"] = Json::array({ 1.2, 0.9 });
   expect_bad(bad, { "bad.json: correction.trusted_stretches", "min ≤ max" });
 }
+
+TEST(MaterialFile, RbfContinuationRoundTripsAndOlderFilesKeepTheEdgeHessian) {
+  // "continuation" (with the bound's "nominal_stiffness" and "kept_stiffness") travels with the
+  // trusted interval; a file without it (written before it existed) is continued with the edge's
+  // whole Hessian, as it was when written. Beyond the lower edge (0.85) the test correction's
+  // edge Hessian removes more than the bound allows, so the two continuations differ.
+  auto p = rbf_parameters(3, 9);
+  p.energy_kernels = true;
+  p.quadratic[1] = 2 * p.quadratic[2];
+  p.weights *= 50;
+  p.trusted = { 0.85, 1.3, material::Continuation::bounded_softening };
+  p.trusted.nominal_stiffness = 1e4 * (Mat3::Identity() + Mat3::Ones());
+  p.trusted.kept_stiffness = 0.25;
+  MaterialFile f;
+  f.material = k_nominal;
+  f.correction = std::make_shared<material::RbfCorrection>(p);
+  const Json j = material_file_to_json(f);
+  EXPECT_EQ(j["correction"]["continuation"], "bounded_softening");
+  EXPECT_EQ(j["correction"]["kept_stiffness"], 0.25);
+  const auto read = [](const Json& json) {
+    return parse_material_file(Json::parse(json.dump()), "f.json").correction;
+  };
+  const auto bounded = read(j);
+  const auto& q = dynamic_cast<const material::RbfCorrection&>(*bounded).parameters().trusted;
+  EXPECT_EQ(q.nominal_stiffness, p.trusted.nominal_stiffness);
+  EXPECT_EQ(q.kept_stiffness, 0.25);
+  Json older = j;
+  for (const char* key : { "continuation", "nominal_stiffness", "kept_stiffness" })
+    older["correction"].erase(key);
+  const auto hessian = read(older);
+  EXPECT_EQ(
+      dynamic_cast<const material::RbfCorrection&>(*hessian).parameters().trusted.continuation,
+      material::Continuation::edge_hessian);
+  const Vec3 beyond(1.0, 0.9, 0.5);
+  EXPECT_EQ(
+      f.correction->correction(beyond, Vec3::Zero()), bounded->correction(beyond, Vec3::Zero()));
+  p.trusted.continuation = material::Continuation::edge_hessian;
+  EXPECT_EQ(material::RbfCorrection(p).correction(beyond, Vec3::Zero()),
+      hessian->correction(beyond, Vec3::Zero()));
+  EXPECT_GT((bounded->correction(beyond, Vec3::Zero()) - hessian->correction(beyond, Vec3::Zero()))
+                .norm(),
+      1e-6 * hessian->correction(beyond, Vec3::Zero()).norm())
+      << "the test needs an edge beyond the bound";
+  Json bad = j;
+  bad["correction"]["continuation"] = "linear";
+  expect_bad(bad, { "bad.json: correction.continuation", "bounded_softening" });
+  bad = j;
+  bad["correction"].erase("nominal_stiffness");
+  expect_bad(bad, { "bad.json: correction.nominal_stiffness" });
+  bad = j;
+  bad["correction"]["kept_stiffness"] = 2;
+  expect_bad(bad, { "bad.json: correction", "kept_stiffness" });
+}

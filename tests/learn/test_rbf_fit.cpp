@@ -396,10 +396,12 @@ TEST(RbfFit, NeoHookeanTailExtrapolatesNeoHookeanMinusCorotatedIntoStrongCompres
 
 TEST(RbfDesign, BeyondTheTrustedStretchesTheDesignContinuesAsTheCorrection) {
   // A x = N everywhere, also where the correction continues beyond its trusted interval, and
-  // the design's derivative is the correction's tangent there (the forward fit's Jacobian).
+  // the design's derivative is the correction's tangent there (the forward fit's Jacobian): so
+  // for the edge-Hessian continuation; the stiffening one is A x wherever the edge's Hessian
+  // has no negative eigenvalue (rbf_fit.hpp).
   const MatX centres = energy_centres();
   const RbfFitOptions options = energy_options();
-  const RbfDesign design(centres, options, { 0.9, 1.15 });
+  const RbfDesign design(centres, options, { 0.9, 1.15, material::Continuation::edge_hessian });
   const VecX x = random_unknowns(design, 5);
   const material::RbfCorrection n = design.correction(x);
   EXPECT_EQ(n.parameters().trusted.min, 0.9);

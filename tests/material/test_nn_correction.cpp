@@ -8,6 +8,8 @@
 
 #include <support/finite_difference.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -531,24 +533,48 @@ TEST(NnCorrection, StressNetworkActivationsHaveExactGradients) {
 
 TEST(NnCorrectionEnergy, BeyondItsTrustedStretchesItKeepsTheStiffnessOfTheEdge) {
   // The same continuation as an RBF teacher's (material/trusted_stretches.hpp): the network
-  // itself inside, its second-order expansion at the nearest trusted point outside.
+  // itself inside, its second-order expansion at the nearest trusted point outside, with the
+  // edge's Hessian H (edge_hessian) or H bounded below by K₀ + H ⪰ β K₀ (bounded_softening; K₀
+  // a stiffness the network's edge Hessians fall below, so that the bound is active).
   const NnCorrection unbounded(energy_parameters({ 8, 8 }));
   NnCorrection::Parameters p = energy_parameters({ 8, 8 });
-  p.trusted = { 0.9, 1.2 };
-  const NnCorrection n(p);
-  const Vec3 inside(1.1, 1.0, 0.95);
-  EXPECT_EQ(n.correction(inside, Vec3::Zero()), unbounded.correction(inside, Vec3::Zero()));
-  for (const Vec3& s : { Vec3(1.5, 1.0, 0.95), Vec3(0.7, 1.1, 1.6) }) {
-    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
-    const Vec3 c = s.cwiseMax(0.9).cwiseMin(1.2);
-    Mat3 h, ds, unused;
-    unbounded.correction_gradient(c, Vec3::Zero(), h, unused);
-    const Vec3 expected = unbounded.correction(c, Vec3::Zero()) + h * (s - c);
-    const Vec3 got = n.correction_with_gradient(s, Vec3::Zero(), ds, unused);
-    EXPECT_LE((got - expected).norm(), 1e-12 * expected.norm());
-    EXPECT_LE((n.correction(s, Vec3::Zero()) - expected).norm(), 1e-12 * expected.norm());
-    EXPECT_LE((ds - h).norm(), 1e-12 * h.norm());
+  for (const Continuation continuation :
+      { Continuation::edge_hessian, Continuation::bounded_softening }) {
+    p.trusted = { 0.9, 1.2, continuation };
+    bool bound_active = false;
+    for (const Vec3& s : { Vec3(1.5, 1.0, 0.95), Vec3(0.7, 1.1, 1.6) }) {
+      SCOPED_TRACE(testing::Message()
+          << "stretches " << s.transpose() << ", continuation " << static_cast<int>(continuation));
+      const Vec3 c = s.cwiseMax(0.9).cwiseMin(1.2);
+      Mat3 edge, ds, unused;
+      unbounded.correction_gradient(c, Vec3::Zero(), edge, unused);
+      // K₀ = a multiple of I + 1 1ᵀ of which the edge Hessian removes 2/3 where it softens.
+      const Mat3 shape = Mat3::Identity() + Mat3::Ones();
+      const double scale = std::max(
+          1.0, -1.5 * Eigen::GeneralizedSelfAdjointEigenSolver<Mat3>(edge, shape).eigenvalues()(0));
+      p.trusted.nominal_stiffness = scale * shape;
+      const NnCorrection n(p);
+      EXPECT_EQ(n.correction(Vec3(1.1, 1.0, 0.95), Vec3::Zero()),
+          unbounded.correction(Vec3(1.1, 1.0, 0.95), Vec3::Zero()));
+      Mat3 h = edge;
+      if (continuation == Continuation::bounded_softening) {
+        const Mat3& k0 = p.trusted.nominal_stiffness;
+        const Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> g(edge, k0);
+        const double beta = p.trusted.kept_stiffness;
+        bound_active = bound_active || g.eigenvalues().minCoeff() < beta - 1;
+        h = k0 * g.eigenvectors() * g.eigenvalues().cwiseMax(beta - 1).asDiagonal()
+            * g.eigenvectors().transpose() * k0;
+      }
+      const Vec3 expected = unbounded.correction(c, Vec3::Zero()) + h * (s - c);
+      const Vec3 got = n.correction_with_gradient(s, Vec3::Zero(), ds, unused);
+      EXPECT_LE((got - expected).norm(), 1e-10 * expected.norm());
+      EXPECT_LE((n.correction(s, Vec3::Zero()) - expected).norm(), 1e-10 * expected.norm());
+      EXPECT_LE((ds - h).norm(), 1e-10 * edge.norm());
+    }
+    EXPECT_EQ(bound_active, continuation == Continuation::bounded_softening);
   }
+  p.trusted = { 0.9, 1.2, Continuation::edge_hessian };
+  const NnCorrection n(p);
   // Where every stretch is beyond the same end, N is the gradient of the continued energy.
   const Vec3 s(1.5, 1.35, 1.25);
   Eigen::MatrixXd stress(1, 3);

@@ -48,7 +48,10 @@ RbfCorrection::Parameters test_parameters(double epsilon) {
 }
 
 /// Analytic [∂N/∂σ ∂N/∂ḟ] (3×6) vs 4th-order central differences of N over (σ, ḟ).
-void expect_gradient_matches_fd(const RbfCorrection& n, const Vec3& s, const Vec3& r, double tol) {
+/// `floor`: the smallest Jacobian entry the tolerance is relative to (a continued correction can
+/// have a zero tangent, whose finite differences are round-off).
+void expect_gradient_matches_fd(
+    const RbfCorrection& n, const Vec3& s, const Vec3& r, double tol, double floor = 1e-8) {
   Mat3 ds, dr;
   n.correction_gradient(s, r, ds, dr);
   Eigen::MatrixXd J(3, 6);
@@ -58,7 +61,7 @@ void expect_gradient_matches_fd(const RbfCorrection& n, const Vec3& s, const Vec
   const FdFunction f = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
     return n.correction(y.head<3>(), y.tail<3>());
   };
-  expect_jacobian_matches(J, f, in, tol, 1e-5);
+  expect_jacobian_matches(J, f, in, tol, 1e-5, floor);
 }
 
 } // namespace
@@ -401,17 +404,50 @@ TEST(RbfCorrectionEnergy, ProjectedTangentOfTheCorrectedModelIsPositiveSemiDefin
 
 namespace {
 
-/// energy_correction() trusted in [0.9, 1.2] only.
-RbfCorrection trusted_energy_correction() {
+/// The corotated model the bounded continuation is learned on, E 1e5 Pa.
+const CorotatedModel& bounded_nominal() {
+  static const CorotatedModel model(Lame::from_young_poisson(1e5, 0.4));
+  return model;
+}
+
+/// [0.9, 1.2], continued as `continuation` says (bounded by bounded_nominal()'s rest stiffness).
+TrustedStretches trusted_interval(Continuation continuation) {
+  TrustedStretches t { 0.9, 1.2, continuation };
+  t.nominal_stiffness = bounded_nominal().principal_stress_derivative(Vec3::Ones());
+  return t;
+}
+
+/// energy_correction() trusted in [0.9, 1.2] only, continued as `continuation` says.
+RbfCorrection trusted_energy_correction(Continuation continuation = Continuation::edge_hessian) {
   RbfCorrection::Parameters p = energy_correction().parameters();
-  p.trusted.min = 0.9;
-  p.trusted.max = 1.2;
+  p.trusted = trusted_interval(continuation);
   return RbfCorrection(std::move(p));
+}
+
+/// A correction that removes more than bounded_nominal()'s stiffness near the trusted interval's
+/// lower edge (the weights of ProjectedTangentOfTheCorrectedModelIsPositiveSemiDefinite).
+RbfCorrection softening_correction(Continuation continuation) {
+  RbfCorrection::Parameters p = test_parameters(0.03);
+  p.energy_kernels = true;
+  p.quadratic[1] = 2 * p.quadratic[2];
+  p.weights *= 200;
+  p.trusted = trusted_interval(continuation);
+  return RbfCorrection(std::move(p));
+}
+
+/// The smallest eigenvalue of K₀^(−½) A K₀^(−½) for K₀ bounded_nominal()'s rest stiffness: A's
+/// stiffness relative to K₀ in its softest direction (generalized eigenvalues of (A, K₀)).
+double relative_to_rest_stiffness(const Mat3& a) {
+  const Mat3 k0 = bounded_nominal().principal_stress_derivative(Vec3::Ones());
+  return Eigen::GeneralizedSelfAdjointEigenSolver<Mat3>(0.5 * (a + a.transpose()), k0)
+      .eigenvalues()
+      .minCoeff();
 }
 
 } // namespace
 
 TEST(RbfCorrectionEnergy, BeyondItsTrustedStretchesItKeepsTheStiffnessOfTheEdge) {
+  // Continuation::edge_hessian (files written before "continuation"): the edge's whole Hessian.
   const RbfCorrection unbounded = energy_correction();
   const RbfCorrection n = trusted_energy_correction();
   Mat3 h, unused;
@@ -452,13 +488,69 @@ TEST(RbfCorrectionEnergy, BeyondItsTrustedStretchesItKeepsTheStiffnessOfTheEdge)
 
 TEST(RbfCorrectionEnergy, OutsideItsTrustedStretchesItIsStillAnEnergy) {
   // Where every stretch is beyond the same edge, c is fixed and N = ∇ΔΨ exactly (the continued
-  // energy is a quadratic there); its tangent matches finite differences of N.
-  const RbfCorrection n = trusted_energy_correction();
-  for (const Vec3& s : { Vec3(1.5, 1.35, 1.25), Vec3(0.8, 0.7, 0.85) }) {
+  // energy is a quadratic there); its tangent matches finite differences of N. Both
+  // continuations; the softening correction's edge Hessian is beyond the bound there.
+  for (const Continuation continuation :
+      { Continuation::edge_hessian, Continuation::bounded_softening })
+    for (const RbfCorrection& n :
+        { trusted_energy_correction(continuation), softening_correction(continuation) })
+      for (const Vec3& s : { Vec3(1.5, 1.35, 1.25), Vec3(0.8, 0.7, 0.85) }) {
+        SCOPED_TRACE(testing::Message() << "stretches " << s.transpose() << ", continuation "
+                                        << static_cast<int>(continuation));
+        expect_stress_is_energy_gradient(n, s);
+        expect_gradient_matches_fd(n, s, Vec3::Zero(), 1e-7);
+      }
+}
+
+TEST(RbfCorrectionEnergy, BeyondItsTrustedStretchesTheBoundedContinuationKeepsTheNominalStable) {
+  // Continuation::bounded_softening (what learning writes): beyond the edge the tangent is the
+  // edge's Hessian H bounded below so that K₀ + H ⪰ β K₀ (K₀ the nominal's rest stiffness), so
+  // the corrected corotated model (whose stretch block is K₀ everywhere) keeps at least β of its
+  // stiffness in every stretch direction however far the stretches go. The edge Hessian itself
+  // (edge_hessian) makes it unstable there. Checked through the generalized eigenproblem of
+  // (H, K₀), not the implementation's K₀^(½) route.
+  const RbfCorrection hessian = softening_correction(Continuation::edge_hessian);
+  const RbfCorrection bounded = softening_correction(Continuation::bounded_softening);
+  const double beta = bounded.parameters().trusted.kept_stiffness;
+  ASSERT_EQ(beta, kKeptStiffness);
+  const auto corrected_block = [&](const RbfCorrection& n, const Vec3& s) {
+    const CorrectedStress c = corrected_principal_stress(bounded_nominal(), &n, s, Vec3::Zero());
+    return principal_tangent(
+        { Mat3::Identity(), s, Mat3::Identity() }, c.stress, c.d_stretches, false)
+        .block;
+  };
+  const Vec3 c(1.0, 0.95, 0.9); // the edge point of the states below
+  Mat3 edge, unused;
+  hessian.correction_gradient(c, Vec3::Zero(), edge, unused);
+  const Mat3 k0 = bounded_nominal().principal_stress_derivative(Vec3::Ones());
+  ASSERT_LT(relative_to_rest_stiffness(k0 + edge), 0) << "the test needs an unstable edge";
+  // The expected tangent: H v = λ K₀ v with Vᵀ K₀ V = I, so H = K₀ V Λ Vᵀ K₀; raise λ to β − 1.
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> g(edge, k0);
+  const Mat3 expected_tangent = k0 * g.eigenvectors()
+      * g.eigenvalues().cwiseMax(beta - 1).asDiagonal() * g.eigenvectors().transpose() * k0;
+  for (const Vec3& s : { Vec3(1.0, 0.95, 0.8), Vec3(1.0, 0.95, 0.6), Vec3(1.0, 0.95, 0.4) }) {
     SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
-    expect_stress_is_energy_gradient(n, s);
-    expect_gradient_matches_fd(n, s, Vec3::Zero(), 1e-7);
+    Mat3 ds;
+    const Vec3 n = bounded.correction_with_gradient(s, Vec3::Zero(), ds, unused);
+    EXPECT_LE((ds - expected_tangent).norm(), 1e-9 * edge.norm());
+    EXPECT_LE(
+        (n - (bounded.elastic_correction(c) + expected_tangent * (s - c))).norm(), 1e-9 * n.norm());
+    EXPECT_NEAR(relative_to_rest_stiffness(corrected_block(bounded, s)), beta, 1e-9);
+    EXPECT_LT(relative_to_rest_stiffness(corrected_block(hessian, s)), 0) << "edge Hessian";
   }
+  // Inside, the two continuations agree, and N is continuous across the edge.
+  const Vec3 inside(1.1, 1.0, 0.95);
+  EXPECT_EQ(bounded.elastic_correction(inside), hessian.elastic_correction(inside));
+  const Vec3 just_outside(1.0, 0.95, 0.9 - 1e-9);
+  EXPECT_LE((bounded.elastic_correction(just_outside) - hessian.elastic_correction(c)).norm(),
+      1e-6 * hessian.elastic_correction(c).norm());
+  // A correction whose edge keeps more than β of K₀ is continued with its whole edge Hessian.
+  const RbfCorrection mild_hessian = trusted_energy_correction(Continuation::edge_hessian);
+  const RbfCorrection mild = trusted_energy_correction(Continuation::bounded_softening);
+  mild_hessian.correction_gradient(c, Vec3::Zero(), edge, unused);
+  ASSERT_GT(relative_to_rest_stiffness(k0 + edge), beta) << "the test needs a stable edge";
+  for (const Vec3& s : { Vec3(1.0, 0.95, 0.6), Vec3(1.5, 1.0, 0.95) })
+    EXPECT_EQ(mild.elastic_correction(s), mild_hessian.elastic_correction(s));
 }
 
 TEST(RbfCorrectionEnergy, RejectsAnInvalidTrustedInterval) {
@@ -466,6 +558,15 @@ TEST(RbfCorrectionEnergy, RejectsAnInvalidTrustedInterval) {
   p.trusted.min = 1.2;
   p.trusted.max = 0.9;
   EXPECT_THROW(RbfCorrection { p }, InputError);
+  p.trusted = trusted_interval(Continuation::bounded_softening);
+  EXPECT_NO_THROW(RbfCorrection { p });
+  p.trusted.kept_stiffness = 1.5;
+  EXPECT_THROW(RbfCorrection { p }, InputError) << "β beyond 1";
+  p.trusted.kept_stiffness = 0.5;
+  p.trusted.nominal_stiffness(0, 0) = -1;
+  EXPECT_THROW(RbfCorrection { p }, InputError) << "K₀ not positive definite";
+  p.trusted.nominal_stiffness.setZero();
+  EXPECT_THROW(RbfCorrection { p }, InputError) << "bounded without K₀";
   RbfCorrection::Parameters stress = test_parameters(0.03);
   stress.trusted.max = 1.2;
   EXPECT_THROW(RbfCorrection { stress }, InputError) << "stress kernels have no energy";

@@ -45,37 +45,34 @@ Json trusted_to_json(const material::TrustedStretches& t) {
       std::isfinite(t.max) ? Json(t.max) : Json(nullptr) });
 }
 
-/// A correction's "trusted_stretches"; absent (older files): unbounded.
-material::TrustedStretches trusted_from_json(const JsonObject& o) {
-  material::TrustedStretches t;
-  if (!o.has("trusted_stretches"))
-    return t;
-  const Json& j = o.json().at("trusted_stretches");
-  if (!j.is_array() || j.size() != 2 || !std::all_of(j.begin(), j.end(), [](const Json& v) {
-        return v.is_null() || v.is_number();
-      }))
-    o.fail("trusted_stretches", "expected [min, max] (numbers, or null for an unbounded end)");
-  if (!j[0].is_null())
-    t.min = j[0].get<double>();
-  if (!j[1].is_null())
-    t.max = j[1].get<double>();
-  return t;
+const char* to_string(material::Continuation c) {
+  return c == material::Continuation::edge_hessian ? "edge_hessian" : "bounded_softening";
+}
+
+/// "continuation" (and its bound) next to "trusted_stretches" in `out`.
+void continuation_to_json(const material::TrustedStretches& t, Json& out) {
+  out["trusted_stretches"] = trusted_to_json(t);
+  out["continuation"] = to_string(t.continuation);
+  if (t.continuation == material::Continuation::bounded_softening) {
+    out["nominal_stiffness"] = rows_to_json(t.nominal_stiffness);
+    out["kept_stiffness"] = t.kept_stiffness;
+  }
 }
 
 Json rbf_to_json(const material::RbfCorrection& c) {
   const auto& p = c.parameters();
   // JSON has no infinity: "no floor" (−∞) is written as null.
   const Json floor = std::isfinite(p.damping_floor) ? Json(p.damping_floor) : Json(nullptr);
-  return Json { { "type", "rbf" }, { "energy_kernels", p.energy_kernels }, { "epsilon", p.epsilon },
+  Json out { { "type", "rbf" }, { "energy_kernels", p.energy_kernels }, { "epsilon", p.epsilon },
     { "centres", rows_to_json(p.centres) }, { "weights", vector_to_json(p.weights) },
     { "own_slope", p.own_slope }, { "other_slope", p.other_slope }, { "constant", p.constant },
     { "quadratic", vector_to_json(p.quadratic) }, { "neo_hookean", vector_to_json(p.neo_hookean) },
     { "damping_weights", vector_to_json(p.damping_weights) },
     { "damping_slopes", vector_to_json(p.damping_slopes) },
     { "damping_constant", p.damping_constant },
-    { "damping_quadratic", vector_to_json(p.damping_quadratic) }, { "damping_floor", floor },
-    // [min, max]; null for an unbounded end (JSON has no infinity)
-    { "trusted_stretches", trusted_to_json(p.trusted) } };
+    { "damping_quadratic", vector_to_json(p.damping_quadratic) }, { "damping_floor", floor } };
+  continuation_to_json(p.trusted, out);
+  return out;
 }
 
 Json nn_to_json(const material::NnCorrection& c) {
@@ -91,7 +88,7 @@ Json nn_to_json(const material::NnCorrection& c) {
     { "output_scale", p.output_scale }, { "layers", std::move(layers) } };
   if (p.kind == material::NnKind::Energy) {
     out["polynomial"] = vector_to_json(p.polynomial);
-    out["trusted_stretches"] = trusted_to_json(p.trusted);
+    continuation_to_json(p.trusted, out);
   }
   if (p.damping)
     out["damping"] = rbf_to_json(*p.damping);
@@ -144,6 +141,34 @@ MatX read_rows(const JsonObject& o, const std::string& key, Eigen::Index rows, E
   return m;
 }
 
+/// A correction's "trusted_stretches" and how it is continued beyond them ("continuation", with
+/// "nominal_stiffness" and "kept_stiffness" for bounded_softening); absent (older files):
+/// unbounded, and continued with the edge's Hessian as those files were.
+material::TrustedStretches trusted_from_json(const JsonObject& o) {
+  material::TrustedStretches t;
+  const std::string name = o.string("continuation", "edge_hessian");
+  if (name == "bounded_softening") {
+    t.continuation = material::Continuation::bounded_softening;
+    t.nominal_stiffness = read_rows(o, "nominal_stiffness", 3, 3);
+    t.kept_stiffness = o.number("kept_stiffness");
+  } else if (name != "edge_hessian") {
+    o.fail(
+        "continuation", "expected \"bounded_softening\" or \"edge_hessian\", got \"" + name + "\"");
+  }
+  if (!o.has("trusted_stretches"))
+    return t;
+  const Json& j = o.json().at("trusted_stretches");
+  if (!j.is_array() || j.size() != 2 || !std::all_of(j.begin(), j.end(), [](const Json& v) {
+        return v.is_null() || v.is_number();
+      }))
+    o.fail("trusted_stretches", "expected [min, max] (numbers, or null for an unbounded end)");
+  if (!j[0].is_null())
+    t.min = j[0].get<double>();
+  if (!j[1].is_null())
+    t.max = j[1].get<double>();
+  return t;
+}
+
 /// Run a correction constructor; its InputError("rbf_correction.weights", ...) is re-thrown
 /// naming the file and the JSON field ("learned.json: correction.weights").
 template <typename Make> auto construct(const JsonObject& o, Make&& make) {
@@ -162,7 +187,7 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
   o.reject_unknown_keys({ "type", "energy_kernels", "epsilon", "centres", "weights", "own_slope",
       "other_slope", "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes",
       "damping_slope", "damping_constant", "damping_quadratic", "damping_floor",
-      "trusted_stretches" });
+      "trusted_stretches", "continuation", "nominal_stiffness", "kept_stiffness" });
   material::RbfCorrection::Parameters p;
   p.energy_kernels = o.boolean("energy_kernels", false); // absent: the stress kernels
   p.epsilon = o.number("epsilon");
@@ -202,7 +227,8 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
 
 std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "kind", "activation", "input_mean", "input_scale", "output_mean",
-      "output_scale", "polynomial", "layers", "damping", "trusted_stretches" });
+      "output_scale", "polynomial", "layers", "damping", "trusted_stretches", "continuation",
+      "nominal_stiffness", "kept_stiffness" });
   material::NnCorrection::Parameters p;
   // Absent: the stress network with ELU (files written before the energy network).
   p.kind = o.has("kind") && o.choice("kind", { "stress", "energy" }) == "energy"

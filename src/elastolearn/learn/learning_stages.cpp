@@ -119,12 +119,17 @@ MatX trajectory_stretches(std::span<const ReconstructionMesh> meshes,
 
 /// The corrections' trusted stretches (material/trusted_stretches.hpp): the interval of every
 /// principal stretch of `stretches`, the trajectories a correction is learned from. With energy
-/// kernels a correction continues beyond it with the stiffness at its edge; stress kernels are
-/// not continued.
-material::TrustedStretches trusted_interval(const MatX& stretches, const RbfFitOptions& rbf) {
+/// kernels a correction continues beyond it with the stiffness at its edge, keeping at least
+/// half of the nominal's rest stiffness (Continuation::bounded_softening); stress kernels are not
+/// continued.
+material::TrustedStretches trusted_interval(
+    const MatX& stretches, const RbfFitOptions& rbf, const material::ElasticModel& nominal) {
   if (!rbf.energy_kernels || stretches.size() == 0)
     return {};
-  return { stretches.minCoeff(), stretches.maxCoeff() };
+  material::TrustedStretches trusted { stretches.minCoeff(), stretches.maxCoeff() };
+  trusted.continuation = material::Continuation::bounded_softening;
+  trusted.nominal_stiffness = nominal.principal_stress_derivative(Vec3::Ones());
+  return trusted;
 }
 
 /// RBF centres: k-means over the stretch views of `stretches` (at most options.centres).
@@ -254,8 +259,8 @@ Reconstruction reconstruct_correction(std::span<const ReconstructionMesh> meshes
         { meshes[i], m.physics.dofs(), m.positions, m.velocities, m.targets, m.projection });
   }
   const MatX stretches = trajectory_stretches(meshes, trajectories, options);
-  const RbfDesign design(
-      rbf_centres(stretches, options, seed), options.rbf, trusted_interval(stretches, options.rbf));
+  const RbfDesign design(rbf_centres(stretches, options, seed), options.rbf,
+      trusted_interval(stretches, options.rbf, *nominal.elastic));
   const StressReconstructionResult reconstructed
       = reconstruct_rbf_correction(blocks, design, reconstruction);
   Reconstruction out;
@@ -294,7 +299,8 @@ ForwardFitStart forward_fit_start(std::span<const Motion> motions,
       = best ? MatX(best->parameters().centres) : rbf_centres(stretches, options, options.seed);
   // The best correction's own trusted interval, so that the design expresses it exactly.
   RbfDesign design(centres, options.rbf,
-      best ? best->parameters().trusted : trusted_interval(stretches, options.rbf));
+      best ? best->parameters().trusted
+           : trusted_interval(stretches, options.rbf, *meshes.front().nominal.elastic));
   VecX start = best ? design.unknowns(*best) : VecX(VecX::Zero(design.num_unknowns()));
   ForwardFitOptions fit_options = options.forward_fit;
   fit_options.max_iterations = remaining_steps;

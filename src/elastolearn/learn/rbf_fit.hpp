@@ -64,9 +64,15 @@ class RbfDesign {
   public:
   using OutputMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic>;
   /// `centres` m × 3 (m ≥ 1, finite). With energy kernels, `trusted` is the corrections' trusted
-  /// stretches (material/trusted_stretches.hpp): A(σ) continues beyond them as N does,
-  /// A(c) + ∂A/∂σ(c)(σ − c), so that N = A x holds everywhere. Throws InputError for invalid
-  /// options, centres or interval.
+  /// stretches (material/trusted_stretches.hpp): A(σ) continues beyond them with the edge's
+  /// Hessian, A(c) + ∂A/∂σ(c)(σ − c), linear in x. N = A x then holds everywhere for
+  /// Continuation::edge_hessian, and for bounded_softening wherever the edge's Hessian is within
+  /// the bound; where it is not, N is not linear in x beyond the edge, and A x is its
+  /// continuation with that Hessian unbounded. Only the forward fit's sensitivities evaluate A
+  /// there (the reconstruction's states are inside the interval by its definition), at states
+  /// its training motion reaches just beyond its start's interval; they are then approximate,
+  /// and its steps are accepted on simulated errors. Throws InputError for invalid options,
+  /// centres or interval.
   RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options,
       material::TrustedStretches trusted = {});
   int num_centres() const { return static_cast<int>(m_centres.rows()); }
