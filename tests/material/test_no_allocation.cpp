@@ -106,9 +106,9 @@ TEST(NoAllocation, LearnedCorrectionsDoNotAllocate) {
 #if !ELASTOLEARN_COUNT_MALLOC
   GTEST_SKIP() << "malloc cannot be interposed in this build (sanitizer or non-glibc)";
 #else
-  // The RBF (energy and stress kernels, with damping) and the network correction (energy and
-  // stress kind; the fixed-size kernels of 8-8 and the general loops of 5-7), as the element
-  // loops call them: N with its gradients, and Δα₁.
+  // The RBF (energy and stress kernels, with damping; continued beyond trusted stretches) and the
+  // network correction (energy and stress kind; the fixed-size kernels of 8-8 and the general loops
+  // of 5-7), as the element loops call them: N with its gradients, and Δα₁.
   std::vector<std::shared_ptr<const Correction>> corrections;
   RbfCorrection::Parameters rbf;
   rbf.centres = RbfCorrection::Centres::Constant(5, 3, 1.0);
@@ -119,6 +119,11 @@ TEST(NoAllocation, LearnedCorrectionsDoNotAllocate) {
     rbf.energy_kernels = energy;
     corrections.push_back(std::make_shared<RbfCorrection>(rbf));
   }
+  // Continued beyond [0.95, 1.05] with the bounded edge Hessian (the states below leave it).
+  RbfCorrection::Parameters continued = rbf;
+  continued.trusted = { 0.95, 1.05, Continuation::bounded_softening };
+  continued.trusted.nominal_stiffness = 1e4 * (Mat3::Identity() + Mat3::Ones());
+  corrections.push_back(std::make_shared<RbfCorrection>(continued));
   for (NnKind kind : { NnKind::Stress, NnKind::Energy })
     for (int width : { 8, 5 }) {
       NnCorrection::Parameters p;
