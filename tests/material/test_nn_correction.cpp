@@ -6,6 +6,7 @@
 #include <elastolearn/material/nn_correction.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 
+#include <support/bounded_hessian.hpp>
 #include <support/finite_difference.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -559,11 +560,11 @@ TEST(NnCorrectionEnergy, BeyondItsTrustedStretchesItKeepsTheStiffnessOfTheEdge) 
       Mat3 h = edge;
       if (continuation == Continuation::bounded_softening) {
         const Mat3& k0 = p.trusted.nominal_stiffness;
-        const Eigen::GeneralizedSelfAdjointEigenSolver<Mat3> g(edge, k0);
         const double beta = p.trusted.kept_stiffness;
-        bound_active = bound_active || g.eigenvalues().minCoeff() < beta - 1;
-        h = k0 * g.eigenvectors() * g.eigenvalues().cwiseMax(beta - 1).asDiagonal()
-            * g.eigenvectors().transpose() * k0;
+        bound_active = bound_active
+            || Eigen::GeneralizedSelfAdjointEigenSolver<Mat3>(edge, k0).eigenvalues().minCoeff()
+                < beta - 1;
+        h = bounded_hessian(edge, k0, beta);
       }
       const Vec3 expected = unbounded.correction(c, Vec3::Zero()) + h * (s - c);
       const Vec3 got = n.correction_with_gradient(s, Vec3::Zero(), ds, unused);

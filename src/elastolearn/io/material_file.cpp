@@ -146,14 +146,11 @@ MatX read_rows(const JsonObject& o, const std::string& key, Eigen::Index rows, E
 /// unbounded, and continued with the edge's Hessian as those files were.
 material::TrustedStretches trusted_from_json(const JsonObject& o) {
   material::TrustedStretches t;
-  const std::string name = o.string("continuation", "edge_hessian");
-  if (name == "bounded_softening") {
+  if (o.choice("continuation", { "edge_hessian", "bounded_softening" }, "edge_hessian")
+      == "bounded_softening") {
     t.continuation = material::Continuation::bounded_softening;
     t.nominal_stiffness = read_rows(o, "nominal_stiffness", 3, 3);
     t.kept_stiffness = o.number("kept_stiffness");
-  } else if (name != "edge_hessian") {
-    o.fail(
-        "continuation", "expected \"bounded_softening\" or \"edge_hessian\", got \"" + name + "\"");
   }
   if (!o.has("trusted_stretches"))
     return t;
