@@ -372,6 +372,34 @@ TEST(LearningRecipe, ATrainingSetHoldsOutTheTailOfEveryMotion) {
   EXPECT_EQ(r.candidates[0].validation.max, combined_error(tails).max);
 }
 
+TEST(LearningRecipe, TheHeldOutFramesTakeNoPartInLearning) {
+  // The same noisy droop twice, the second with its held-out frames (49–60) moved 5 mm: the
+  // parameter fit and the loop, smoothed positions included (the smoother is global in time),
+  // must learn exactly the same from both; only the validation errors differ. σ is given so
+  // that its estimate, which reads every frame, is the same too.
+  const Case c;
+  const double sigma = 1e-3 * c.nominal.mesh.bounding_box_diagonal();
+  const auto motions = c.motions(sigma);
+  auto moved = motions;
+  for (int t = 49; t <= 60; ++t)
+    moved[0].observed.positions[static_cast<size_t>(t)].array() += 5e-3;
+  RecipeOptions o = small_recipe();
+  o.noise = sigma;
+  o.parameter_fit.max_iterations = 2;
+  o.loop.max_iterations = 1;
+  o.loop.forward_fit.max_iterations = 0;
+  o.network.enabled = false;
+  const RecipeResult a = learn_material(motions, o), b = learn_material(moved, o);
+  ASSERT_GT(a.noise.smoothing_residual, 0.5 * sigma) << "the smoother must act for this test";
+  EXPECT_EQ(a.noise.smoothing_residual, b.noise.smoothing_residual);
+  EXPECT_EQ(a.parameter_fit.fitted.young, b.parameter_fit.fitted.young);
+  ASSERT_EQ(a.loop.history.size(), b.loop.history.size());
+  ASSERT_TRUE(a.loop.correction && b.loop.correction);
+  EXPECT_EQ(a.loop.correction->parameters().weights, b.loop.correction->parameters().weights);
+  EXPECT_EQ(a.loop.best_error, b.loop.best_error);
+  EXPECT_NE(a.candidates[0].validation.rms, b.candidates[0].validation.rms);
+}
+
 TEST(LearningRecipe, NoisyCaptureLearnsWithoutDivergenceAndBeatsTheNominal) {
   // σ = 0.2 % of the size (0.85 mm on the 0.42 m bar), estimated from the data.
   const Case c;

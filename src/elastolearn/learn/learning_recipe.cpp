@@ -131,10 +131,9 @@ struct Split {
 /// Every motion's last `validation_fraction` of frames is held out, the rest is trained on: the
 /// loop learns from every kind of motion given, and the validation sees every kind. (Holding out
 /// a whole motion instead would leave a training set of two motions one to learn from: a bend
-/// and a twist of a bar then fit ν to the bend alone.) `smoothed`: every motion's observation
-/// smoothed to the noise level, in order.
-Split split_motions(std::span<const Motion> motions, double validation_fraction,
-    std::vector<observe::Observation> smoothed) {
+/// and a twist of a bar then fit ν to the bend alone.) The training pieces' `smoothed` is left
+/// null: prepare_data smooths their frames alone.
+Split split_motions(std::span<const Motion> motions, double validation_fraction) {
   Split split;
   std::string pieces;
   for (size_t i = 0; i < motions.size(); ++i) {
@@ -149,8 +148,7 @@ Split split_motions(std::span<const Motion> motions, double validation_fraction,
     Motion train = m;
     train.scene.frames = train_frames;
     train.observed = frame_range(m.observed, 0, train_frames);
-    train.smoothed
-        = std::make_shared<const observe::Observation>(frame_range(smoothed[i], 0, train_frames));
+    train.smoothed = nullptr;
     split.training.push_back(std::move(train));
     HeldOut piece { m, train_frames + 1 };
     piece.motion.observed = frame_range(m.observed, train_frames + 1, frames);
@@ -367,11 +365,11 @@ int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& val
   return chosen;
 }
 
-/// Stages 0 and 1: σ (given or estimated), the positions smoothed to it, and the split into
-/// training and held-out data. Sets result.noise and the frame counts.
+/// Stages 0 and 1: σ (given or estimated), the split into training and held-out data, and the
+/// training positions smoothed to σ. Sets result.noise and the frame counts.
 Split prepare_data(std::span<const Motion> motions, const RecipeOptions& options,
     RecipeResult& result, const RecipeCallbacks& callbacks, double size) {
-  // Stage 0: the noise and the smoothed positions the loop follows.
+  // Stage 0: the noise.
   if (options.noise >= 0) {
     result.noise.sigma = options.noise;
     result.noise.estimated = false;
@@ -386,22 +384,23 @@ Split prepare_data(std::span<const Motion> motions, const RecipeOptions& options
     }
     result.noise.sigma = weight > 0 ? std::sqrt(sum / static_cast<double>(weight)) : 0;
   }
-  std::vector<observe::Observation> smoothed;
+
+  // Stage 1: training and validation data. The smoother is global in time, so it runs on the
+  // training frames alone: smoothing a whole motion would carry the held-out frames into the
+  // training positions near the split.
+  Split split = split_motions(motions, options.validation_fraction);
   double change = 0;
-  for (const Motion& m : motions) {
+  for (Motion& m : split.training) {
     auto s = observe::smooth_to_noise(m.observed, result.noise.sigma);
     change = std::max(change, s.rms_change);
-    smoothed.push_back(std::move(s.smoothed));
+    m.smoothed = std::make_shared<const observe::Observation>(std::move(s.smoothed));
   }
   result.noise.smoothing_residual = change;
   say(callbacks,
       format("noise: σ = %.3g m (%.3f %% of the size, ", result.noise.sigma,
           100 * result.noise.sigma / size)
-          + (result.noise.estimated ? "estimated" : "given") + "); positions smoothed in time by "
-          + format("%.3g m RMS", change));
-
-  // Stage 1: training and validation data.
-  Split split = split_motions(motions, options.validation_fraction, std::move(smoothed));
+          + (result.noise.estimated ? "estimated" : "given")
+          + "); training positions smoothed in time by " + format("%.3g m RMS", change));
   result.training_frames = split.training.front().scene.frames;
   result.validation_frames = 0;
   long seen = 0;

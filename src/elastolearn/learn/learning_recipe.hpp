@@ -2,12 +2,12 @@
 /// \file The one way to learn (docs/learning_recipe.md): from one or more recorded motions of an
 /// object, each a scene with the nominal material and its observations, produce the material that
 /// predicts held-out data best. The stages, each a function below:
-///   0. noise: σ of the observations, given or estimated (observe/noise_estimate.hpp); the
-///      positions the loop's space-time stages follow are smoothed in time to that level, never
+///   0. noise: σ of the observations, given or estimated (observe/noise_estimate.hpp);
+///   1. split: every motion's last `validation_fraction` of the frames are held out for
+///      validation, the rest is the training data. The training positions the loop's space-time
+///      stages follow are smoothed in time to σ (from the training frames alone), never
 ///      differentiated raw, while every comparison of a simulation with the data uses the
 ///      recorded positions (Motion::smoothed);
-///   1. split: every motion's last `validation_fraction` of the frames are held out for
-///      validation, the rest is the training data;
 ///   2. parameter fit: E, ν, α₀, α₁ of the nominal model fitted to the training data;
 ///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit;
 ///   4. validation: every candidate (the given nominal, the fitted nominal, each completed
