@@ -2,7 +2,7 @@
 /// \file The one way to learn (docs/learning_recipe.md): from one or more recorded motions of an
 /// object, each a scene with the nominal material and its observations, produce the material that
 /// predicts held-out data best. The stages, each a function below:
-///   0. noise: σ of the observations, given or estimated (observe/noise_estimate.hpp);
+///   0. noise: σ of the observations, given or estimated (observe/observation_noise.hpp);
 ///   1. split: every motion's last `validation_fraction` of the frames are held out for
 ///      validation, the rest is the training data. The training positions the loop's space-time
 ///      stages follow are smoothed in time to σ (from the training frames alone), never
