@@ -63,4 +63,10 @@ bool diverged(const learn::IterationRecord& r);
 /// An err_L [%] as "%.3f", or "diverged" for err_l's −1.
 std::string err(double e);
 
+/// Issue 19's target 1: learned err_L ≤ this × the parameter fit's.
+inline constexpr double kNeverWorseFactor = 1.05;
+
+/// The median of `values` (non-empty).
+double median(std::vector<double> values);
+
 } // namespace bench_learning
