@@ -89,7 +89,7 @@ int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_hal
 long g_seed = -1;
 double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1,
        g_kernel_smoothing = -1, g_full_space_weight = -1, g_damping_prior = -1,
-       g_elastic_prior = -1;
+       g_elastic_prior = -1, g_smoothness = -1;
 bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
      g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false;
 
@@ -118,6 +118,8 @@ void apply_overrides(learn::LearningOptions& o) {
     o.rbf.epsilon = g_kernel_smoothing;
   if (g_damping_regularization >= 0)
     o.rbf.damping_regularization = g_damping_regularization;
+  if (g_smoothness >= 0)
+    o.rbf.smoothness = g_smoothness;
   if (g_linear_tail)
     o.rbf.quadratic_tail = false;
   if (g_neo_hookean_tail)
@@ -463,6 +465,8 @@ int main(int argc, char** argv) {
       g_kernel_smoothing = std::stod(argv[++i]);
     else if (a == "--damping-regularization" && i + 1 < argc)
       g_damping_regularization = std::stod(argv[++i]);
+    else if (a == "--smoothness" && i + 1 < argc)
+      g_smoothness = std::stod(argv[++i]);
     else if (a == "--stress-kernels")
       g_recipe.loop.rbf.energy_kernels = false;
     else if (a == "--linear-tail")
@@ -499,6 +503,7 @@ int main(int argc, char** argv) {
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
                   "[--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
+                  "[--smoothness L] "
                   "[--stress-kernels] [--linear-tail] [--neo-hookean-tail] "
                   "[--damping-quadratic-tail] [--full-space] "
                   "[--pod-forward-only] [--no-damping] [--position-weight W] "

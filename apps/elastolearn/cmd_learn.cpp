@@ -327,6 +327,10 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--damping-regularization", l.rbf.damping_regularization,
          "Tikhonov weight of the damping correction's unknowns")
       ->capture_default_str();
+  cmd->add_option("--smoothness", l.rbf.smoothness,
+         "weight of the RBF's smoothness penalty (native-space seminorm of the kernel weights, "
+         "relative to the data; 0 = none)")
+      ->capture_default_str();
   cmd->add_option("--seed", l.seed, "k-means seed")->capture_default_str();
   cmd->add_option("--forward-fit", l.forward_fit.max_iterations,
          "Levenberg-Marquardt steps on the forward simulation's error after the loop (0 = none)")

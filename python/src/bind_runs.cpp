@@ -216,6 +216,8 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
         [](S& s, H v) {
           s.recipe.loop.rbf.damping_regularization = value<double>(v, "damping_regularization");
         } },
+    { "smoothness",
+        [](S& s, H v) { s.recipe.loop.rbf.smoothness = value<double>(v, "smoothness"); } },
     { "seed", [](S& s, H v) { s.recipe.loop.seed = value<std::uint64_t>(v, "seed"); } },
     { "forward_fit",
         [](S& s, H v) {

@@ -207,6 +207,25 @@ TEST(StressReconstruction, RecoversKnownRbfCorrectionFromNodalForces) {
   EXPECT_LT((half.unknowns - k.truth).norm(), 1e-6 * k.truth.norm());
 }
 
+TEST(StressReconstruction, SmoothnessPenaltyEntersTheNormalEquations) {
+  // A very strong smoothness penalty (RbfFitOptions::smoothness) leaves the elastic and damping
+  // kernel weights only their means; the reconstruction without it recovers the truth's
+  // (above). A penalty left out, or on the wrong block, keeps the truth's weights.
+  const KnownAnswer k(1e-13);
+  RbfFitOptions options = design_options(1e-13);
+  options.smoothness = 1e6;
+  const RbfDesign smooth(k.centres(), options);
+  const StressReconstructionResult r = reconstruct_rbf_correction(
+      k.geometry, k.dofs, smooth, k.frames.positions, k.frames.velocities, k.targets);
+  const int m = smooth.num_centres(), qe = smooth.elastic_unknowns();
+  const auto wiggle = [&](const VecX& x, int first) {
+    const VecX w = x.segment(first, m);
+    return (w.array() - w.mean()).matrix().norm();
+  };
+  EXPECT_LT(wiggle(r.unknowns, 0), 1e-3 * wiggle(k.truth, 0)) << "elastic weights";
+  EXPECT_LT(wiggle(r.unknowns, qe), 1e-3 * wiggle(k.truth, qe)) << "damping weights";
+}
+
 TEST(StressReconstruction, RecoversACurvedDampingCurveWithTheQuadraticDampingTail) {
   // A Δα₁ of the largest stretch alone, s₁ − 1 + 20 (s₁ − 1)² [s] (bar-damping1's truth minus
   // its nominal α₁), lies in the span of the quadratic damping tail: reconstructed from nodal

@@ -13,6 +13,20 @@ constexpr const char* k_format = "elastolearn-learning-checkpoint";
 /// versions 1 and 2 wrote flat records with flags, still read (read_flat_record).
 constexpr int k_version = 3;
 
+/// A checkpoint's options with the fields added since it was written set to the values every run
+/// had before (so that it still resumes under those options): rbf.smoothness 0.
+nlohmann::json with_former_defaults(nlohmann::json options) {
+  const auto fill = [](nlohmann::json& loop) {
+    if (loop.is_object() && loop.contains("rbf") && loop["rbf"].is_object()
+        && !loop["rbf"].contains("smoothness"))
+      loop["rbf"]["smoothness"] = 0.0;
+  };
+  fill(options);
+  if (options.is_object() && options.contains("loop"))
+    fill(options["loop"]);
+  return options;
+}
+
 nlohmann::json correction_json(const std::shared_ptr<const material::RbfCorrection>& c) {
   return c ? correction_to_json(*c) : nlohmann::json(nullptr);
 }
@@ -198,7 +212,8 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
             { "damping_polynomial", o.rbf.damping_polynomial },
             { "damping_quadratic_tail", o.rbf.damping_quadratic_tail },
             { "regularization", o.rbf.regularization },
-            { "damping_regularization", o.rbf.damping_regularization } } },
+            { "damping_regularization", o.rbf.damping_regularization },
+            { "smoothness", o.rbf.smoothness } } },
     { "reconstruction",
         { { "method", learn::reconstruction_method_name(o.reconstruction.method) },
             { "frame_stride", o.reconstruction.frame_stride },
@@ -329,7 +344,7 @@ learn::RecipeResume read_learning_checkpoint(
     in.fail("observations",
         "the checkpoint belongs to observations '" + in.string("observations") + "', not '"
             + inputs.observations + "'");
-  if (in.json().at("options") != inputs.options)
+  if (with_former_defaults(in.json().at("options")) != inputs.options)
     in.fail("options",
         "the checkpoint was made with other learning options: resume with the same options");
   learn::RecipeResume resume;

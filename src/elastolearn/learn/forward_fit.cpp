@@ -247,12 +247,14 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
         "forward_fit", "the starting correction's simulation diverged (" + current.message + ")");
   result.rms_history.push_back(current.error.rms);
   const int first_damping = design.elastic_unknowns(), n_damping = design.damping_unknowns();
-  // The priors ρ Σ (s_i w_i)² on the damping (ρ_d) and the elastic (ρ_e) unknowns, with s
-  // fixed by the current pass so that the trial and the current objective are measured alike
-  // (and a resumed fit, which recomputes the current pass, takes the same steps).
+  // The priors ρ Σ (s_i w_i)² on the damping (ρ_d) and the elastic (ρ_e) unknowns and the
+  // smoothness penalty wᵀ R w (RbfDesign::smoothness_penalty), with s and R fixed by the current
+  // pass so that the trial and the current objective are measured alike (and a resumed fit,
+  // which recomputes the current pass, takes the same steps).
   VecX prior_weights;
+  MatX smoothness;
   const auto objective = [&](const ForwardSensitivityPass& pass, const VecX& w) {
-    return pass.squared_error + w.dot(prior_weights.cwiseProduct(w));
+    return pass.squared_error + w.dot(prior_weights.cwiseProduct(w)) + w.dot(smoothness * w);
   };
   // The current point is result.unknowns with its pass `current`; a trial waits in trial_unknowns
   // and `trial`.
@@ -265,10 +267,12 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
         = options.elastic_prior * current.normal.diagonal().head(first_damping);
     prior_weights.segment(first_damping, n_damping)
         = options.damping_prior * current.normal.diagonal().segment(first_damping, n_damping);
+    smoothness = design.smoothness_penalty(current.normal);
     NormalEquations equations { current.normal,
-      current.gradient + prior_weights.cwiseProduct(result.unknowns),
+      current.gradient + prior_weights.cwiseProduct(result.unknowns) + smoothness * result.unknowns,
       objective(current, result.unknowns), current.error.samples };
     equations.hessian.diagonal() += prior_weights;
+    equations.hessian += smoothness;
     return equations;
   };
   const auto stability_of = [&](const VecX& unknowns) {

@@ -45,6 +45,7 @@ RecipeOptions::RecipeOptions() {
   loop.forward_fit.max_iterations = 3;
   loop.rbf.energy_kernels = true;
   loop.rbf.epsilon = 0.03;
+  loop.rbf.smoothness = 1e-2;
 }
 
 void RecipeOptions::validate() const {

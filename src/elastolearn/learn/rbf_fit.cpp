@@ -17,6 +17,20 @@ constexpr FieldErrors fail("rbf_fit");
 
 constexpr Eigen::Index k_chunk = 2048;
 
+/// −P K P with K_ij = kernel(i, j) (m × m) and P = I − 11ᵀ/m, symmetrised and scaled to unit
+/// trace; zero if its trace is not positive (one centre, or all centres equal).
+template <typename Kernel> MatX unit_trace_seminorm(int m, const Kernel& kernel) {
+  MatX k(m, m);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j)
+      k(i, j) = kernel(i, j);
+  const MatX p = MatX::Identity(m, m) - MatX::Constant(m, m, 1.0 / m);
+  MatX r = -p * k * p;
+  r = 0.5 * (r + r.transpose()).eval();
+  const double trace = r.trace();
+  return trace > 0 ? MatX(r / trace) : MatX(MatX::Zero(m, m));
+}
+
 } // namespace
 
 void RbfFitOptions::validate() const {
@@ -27,6 +41,8 @@ void RbfFitOptions::validate() const {
   if (!std::isfinite(damping_regularization) || damping_regularization < 0)
     fail(
         "damping_regularization", "must be finite and ≥ 0, got " + to_text(damping_regularization));
+  if (!std::isfinite(smoothness) || smoothness < 0)
+    fail("smoothness", "must be finite and ≥ 0, got " + to_text(smoothness));
   if (std::isnan(damping_floor) || damping_floor > 0)
     fail("damping_floor", "must be ≤ 0 (or −infinity), got " + to_text(damping_floor));
   if (damping_quadratic_tail && !damping_polynomial)
@@ -75,6 +91,21 @@ RbfDesign::RbfDesign(
   m_damping = options.fit_damping
       ? m + (options.damping_polynomial ? 4 : 0) + (options.damping_quadratic_tail ? 3 : 0)
       : 0;
+  const auto plain_kernel = [&](int i, int j) {
+    return material::rbf_kernel((centres.row(i) - centres.row(j)).squaredNorm(), options.epsilon);
+  };
+  const auto energy_kernel = [&](int i, int j) {
+    return material::energy_kernel(
+        centres.row(i).transpose(), centres.row(j).transpose(), options.epsilon);
+  };
+  if (options.smoothness == 0)
+    return;
+  if (options.energy_kernels)
+    m_elastic_seminorm = unit_trace_seminorm(m, energy_kernel);
+  else
+    m_elastic_seminorm = unit_trace_seminorm(m, plain_kernel);
+  if (m_damping > 0)
+    m_damping_seminorm = unit_trace_seminorm(m, plain_kernel);
 }
 
 namespace {
@@ -322,6 +353,22 @@ VecX RbfDesign::regularization_weights() const {
   return w;
 }
 
+MatX RbfDesign::smoothness_penalty(ConstRef<MatX> normal) const {
+  const Eigen::Index u = normal.rows();
+  ELASTOLEARN_CHECK(normal.cols() == u && (u == m_elastic || u == num_unknowns()),
+      "smoothness_penalty: the normal matrix must cover the elastic or all unknowns");
+  MatX penalty = MatX::Zero(u, u);
+  if (m_options.smoothness == 0)
+    return penalty;
+  const int m = num_centres();
+  penalty.topLeftCorner(m, m)
+      = m_options.smoothness * normal.topLeftCorner(m, m).trace() * m_elastic_seminorm;
+  if (u > m_elastic && m_damping > 0)
+    penalty.block(m_elastic, m_elastic, m, m) = m_options.smoothness
+        * normal.block(m_elastic, m_elastic, m, m).trace() * m_damping_seminorm;
+  return penalty;
+}
+
 VecX solve_regularised_normal_equations(
     MatX normal, ConstRef<VecX> rhs, ConstRef<VecX> regularization, long samples) {
   const Eigen::Index u = normal.rows();
@@ -372,6 +419,7 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
     rhs.noalias() += rows.transpose() * targets.head(3 * c);
   }
   normal.triangularView<Eigen::StrictlyUpper>() = normal.transpose();
+  normal += design.smoothness_penalty(normal);
   VecX x = VecX::Zero(design.num_unknowns());
   x.head(u)
       = solve_regularised_normal_equations(normal, rhs, design.regularization_weights().head(u), n);

@@ -46,6 +46,12 @@ struct RbfFitOptions {
   /// true trajectory: 1e-3 biased Δα₁ at σ₁ = 1.05 by −24 % (0.076 for 0.1 s), 1e-9 recovered
   /// 0.1005 (force misfit 7 % → 1.3 % of the target); 1e-6 keeps a little damping of noise.
   double damping_regularization = 1e-6;
+  /// Weight λ ≥ 0 of the smoothness penalty (RbfDesign::smoothness_penalty): the native-space
+  /// seminorm of the kernel part, the smoothing-spline regulariser of a kernel fit. Where the
+  /// samples do not pin the correction down, it keeps the function from taking whatever shape
+  /// the centres give it. λ is relative to the data: the penalty's trace over each block of
+  /// kernel weights is λ × the normal matrix's, so it does not depend on units or sample count.
+  double smoothness = 0;
   /// Floor of Δα₁ written into the correction (material::RbfCorrection::damping_floor) [s].
   double damping_floor = -std::numeric_limits<double>::infinity();
   /// Throws InputError("rbf_fit.<field>", ...) for an out-of-range field.
@@ -93,6 +99,15 @@ class RbfDesign {
   void damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd> out) const;
   /// Tikhonov weight of each unknown (regularization, or damping_regularization).
   VecX regularization_weights() const;
+  /// The smoothness penalty xᵀ R x to add to a least-squares objective whose normal matrix (JᵀJ)
+  /// is `normal`, over the first normal.rows() unknowns (elastic_unknowns() or num_unknowns()).
+  /// Per block of m kernel weights w (the elastic ones; Δα₁'s when `normal` covers them), the
+  /// native-space seminorm −(Pw)ᵀ K_c (Pw) of Σ w_i K(·, c_i): K_c the kernel between the centres
+  /// (the energy kernel, or φ(‖c_i − c_j‖) for stress kernels and Δα₁), conditionally positive
+  /// definite of order 1 (multiquadric), and P = I − 11ᵀ/m removing the weights' mean, the one
+  /// direction it does not see. Each block is scaled to trace λ × that block of `normal`; the
+  /// tails are not penalised. Positive semidefinite; zero for λ = 0 or a single centre.
+  MatX smoothness_penalty(ConstRef<MatX> normal) const;
   /// The correction whose unknowns are `x` (length num_unknowns()).
   material::RbfCorrection correction(ConstRef<VecX> x) const;
   /// The unknowns of a correction over this design's centres (inverse of `correction`). Throws
@@ -113,6 +128,9 @@ class RbfDesign {
   material::RbfCorrection::Centres m_centres;
   RbfFitOptions m_options;
   VecX m_rest_kernels; ///< r_i = φ_i(1, 1, 1) under stress_free_rest, else 0
+  /// −P K_c P of smoothness_penalty, scaled to unit trace (zero if its trace is 0), elastic and
+  /// damping (empty without damping unknowns, and both empty for smoothness 0).
+  MatX m_elastic_seminorm, m_damping_seminorm;
   int m_constant = -1; ///< column of the pressure c, or −1
   int m_quadratic = -1; ///< first column of q (or, with energy kernels, of its 3 energies), or −1
   int m_neo_hookean = -1; ///< first column of r, or −1

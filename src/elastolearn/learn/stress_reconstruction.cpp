@@ -162,6 +162,7 @@ StressReconstructionResult reconstruct_rbf_correction(std::span<const Reconstruc
   const double assembly_seconds = seconds_since(start);
 
   const auto solve_start = Clock::now();
+  normal += design.smoothness_penalty(normal);
   VecX x = solve_regularised_normal_equations(
       std::move(normal), rhs, design.regularization_weights(), samples);
   material::RbfCorrection correction = design.correction(x);
