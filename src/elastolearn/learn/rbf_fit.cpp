@@ -91,21 +91,19 @@ RbfDesign::RbfDesign(
   m_damping = options.fit_damping
       ? m + (options.damping_polynomial ? 4 : 0) + (options.damping_quadratic_tail ? 3 : 0)
       : 0;
-  const auto plain_kernel = [&](int i, int j) {
-    return material::rbf_kernel((centres.row(i) - centres.row(j)).squaredNorm(), options.epsilon);
-  };
-  const auto energy_kernel = [&](int i, int j) {
-    return material::energy_kernel(
-        centres.row(i).transpose(), centres.row(j).transpose(), options.epsilon);
-  };
-  if (options.smoothness == 0)
-    return;
-  if (options.energy_kernels)
-    m_elastic_seminorm = unit_trace_seminorm(m, energy_kernel);
-  else
-    m_elastic_seminorm = unit_trace_seminorm(m, plain_kernel);
-  if (m_damping > 0)
-    m_damping_seminorm = unit_trace_seminorm(m, plain_kernel);
+  if (options.smoothness > 0) {
+    const auto plain_kernel = [&](int i, int j) {
+      return material::rbf_kernel((centres.row(i) - centres.row(j)).squaredNorm(), options.epsilon);
+    };
+    const auto energy_kernel = [&](int i, int j) {
+      return material::energy_kernel(
+          centres.row(i).transpose(), centres.row(j).transpose(), options.epsilon);
+    };
+    m_elastic_seminorm = options.energy_kernels ? unit_trace_seminorm(m, energy_kernel)
+                                                : unit_trace_seminorm(m, plain_kernel);
+    if (m_damping > 0)
+      m_damping_seminorm = unit_trace_seminorm(m, plain_kernel);
+  }
 }
 
 namespace {
