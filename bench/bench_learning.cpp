@@ -89,9 +89,10 @@ int g_modes = -1, g_kernels = -1, g_iterations = -1, g_patience = -1, g_free_hal
 long g_seed = -1;
 double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1,
        g_kernel_smoothing = -1, g_full_space_weight = -1, g_damping_prior = -1,
-       g_elastic_prior = -1, g_smoothness = -1;
+       g_elastic_prior = -1, g_smoothness = -1, g_forward_fit_tolerance = -1;
 bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
-     g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false;
+     g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false,
+     g_no_backtrack = false;
 
 void apply_overrides(learn::LearningOptions& o) {
   if (g_modes > 0)
@@ -128,6 +129,10 @@ void apply_overrides(learn::LearningOptions& o) {
     o.rbf.damping_quadratic_tail = true;
   if (g_full_space)
     o.full_space = true;
+  if (g_no_backtrack)
+    o.backtrack = false;
+  if (g_forward_fit_tolerance >= 0)
+    o.forward_fit.function_tolerance = g_forward_fit_tolerance;
   if (g_pod_forward_only)
     o.pod_with_constrained = false;
   if (g_no_damping)
@@ -479,6 +484,10 @@ int main(int argc, char** argv) {
       g_full_space = true;
     else if (a == "--pod-forward-only")
       g_pod_forward_only = true;
+    else if (a == "--no-backtrack")
+      g_no_backtrack = true;
+    else if (a == "--forward-fit-tolerance" && i + 1 < argc)
+      g_forward_fit_tolerance = std::stod(argv[++i]);
     else if (a == "--no-damping")
       g_no_damping = true;
     else if (a == "--position-weight" && i + 1 < argc)
@@ -501,7 +510,8 @@ int main(int argc, char** argv) {
                   "[--scan C [--scan-noise S] [--outliers F]] "
                   "[--modes "
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
-                  "[--forward-fit F] [--damping-prior RHO] [--elastic-prior RHO] [--seed S] "
+                  "[--forward-fit F] [--forward-fit-tolerance T] [--no-backtrack] [--damping-prior "
+                  "RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
                   "[--smoothness L] "
                   "[--stress-kernels] [--linear-tail] [--neo-hookean-tail] "
@@ -563,12 +573,14 @@ int main(int argc, char** argv) {
   std::printf("bench_learning%s: %zu case(s), %u hardware threads\n", quick ? " --quick" : "",
       names.size(), std::thread::hardware_concurrency());
   apply_overrides(g_recipe.loop);
-  std::printf("the recipe: ≤ %d POD modes, %d kernels (%s), ≤ %d iterations, patience %d, %d "
-              "forward-fit steps, parameter fit %s\n",
+  std::printf("the recipe: ≤ %d POD modes, %d kernels (%s), ≤ %d iterations, patience %d, "
+              "backtracking %s, ≤ %d forward-fit steps (tolerance %g), smoothness %g, parameter "
+              "fit %s\n",
       g_recipe.loop.pod.max_modes, g_recipe.loop.centres,
       g_recipe.loop.rbf.energy_kernels ? "energy" : "stress", g_recipe.loop.max_iterations,
-      g_recipe.loop.patience, g_recipe.loop.forward_fit.max_iterations,
-      g_recipe.fit_parameters ? "on" : "off");
+      g_recipe.loop.patience, g_recipe.loop.backtrack ? "on" : "off",
+      g_recipe.loop.forward_fit.max_iterations, g_recipe.loop.forward_fit.function_tolerance,
+      g_recipe.loop.rbf.smoothness, g_recipe.fit_parameters ? "on" : "off");
   std::vector<Row> rows, clean_rows;
   int status = 0;
   for (const auto& name : names) {

@@ -132,6 +132,8 @@ void print_iteration(const learn::IterationRecord& record, double size, const ch
         f.message().c_str(),
         std::get<learn::LoopRecord>(record).damped_update() ? "trying half its step"
                                                             : "the loop stops");
+  else if (std::get<learn::LoopRecord>(record).damped_update())
+    std::printf(" (no better than the best, %.1f s): trying half its step\n", f.seconds());
   else
     std::printf(" (final forward check, %.1f s)\n", f.seconds());
   std::fflush(stdout);

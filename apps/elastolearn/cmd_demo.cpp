@@ -106,6 +106,8 @@ void run_demo(const fs::path& out, double fraction) {
     else if (const auto* stages = learn::stages_of(r))
       std::printf(
           ", control force %.3e N, %.1f s\n", stages->control_force_rms, learn::seconds_of(r));
+    else if (std::get<learn::LoopRecord>(r).damped_update())
+      std::printf("  (no better than the best: trying half its step)\n");
     else
       std::printf("  (last forward check)\n");
     std::fflush(stdout);

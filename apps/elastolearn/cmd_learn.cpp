@@ -34,6 +34,7 @@ struct LearnOptions {
   bool no_damping = false;
   bool linear_tail = false;
   bool no_parameter_fit = false;
+  bool no_backtrack = false;
   std::string network_kind = "auto";
   elastolearn::learn::RecipeOptions recipe;
 };
@@ -83,8 +84,10 @@ void print_loop_iteration(const elastolearn::learn::LoopRecord& r, double diagon
           t->step_kept > 0 ? ("kept " + elastolearn::to_text(t->step_kept) + " of it").c_str()
                            : "dropped it (the next iteration simulates the nominal)");
   } else {
-    std::printf("%4d %12.4f %12.4f %14s %6s %6s %9.2f   (last forward check)\n", r.iteration,
-        100 * f.error().rms / diagonal, 100 * f.error().max / diagonal, "-", "-", "-", f.seconds());
+    std::printf("%4d %12.4f %12.4f %14s %6s %6s %9.2f   (%s)\n", r.iteration,
+        100 * f.error().rms / diagonal, 100 * f.error().max / diagonal, "-", "-", "-", f.seconds(),
+        r.damped_update() ? "no better than the best: trying half of this correction's step"
+                          : "last forward check");
   }
 }
 
@@ -131,6 +134,8 @@ void run_learn(const LearnOptions& o) {
   loop.rbf.fit_damping = !o.no_damping;
   loop.rbf.quadratic_tail = !o.linear_tail;
   options.fit_parameters = !o.no_parameter_fit;
+  if (o.no_backtrack)
+    loop.backtrack = false;
   options.network.kind = learn::network_kind_from_name(o.network_kind, "--network-kind");
   options.validate();
 
@@ -292,8 +297,12 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--patience", l.patience, "stop after this many iterations without improvement")
       ->capture_default_str();
   cmd->add_option("--free-halvings", l.free_halvings,
-         "diverging corrections in a row halved towards the best one before patience counts them")
+         "failed corrections in a row (diverged, or no better than the best when backtracking) "
+         "halved towards the best one before patience counts them")
       ->capture_default_str();
+  cmd->add_flag("--no-backtrack", o->no_backtrack,
+      "run the loop's stages from a correction that is no better than the best (paper §3) "
+      "instead of halving it towards the best");
   cmd->add_option("--modes", l.pod.max_modes, "POD modes r of the space-time optimisation")
       ->capture_default_str();
   cmd->add_option("--pod-stride", l.pod.frame_stride, "use every k-th frame for POD")
@@ -334,6 +343,10 @@ void add_learn_command(CLI::App& root) {
   cmd->add_option("--seed", l.seed, "k-means seed")->capture_default_str();
   cmd->add_option("--forward-fit", l.forward_fit.max_iterations,
          "Levenberg-Marquardt steps on the forward simulation's error after the loop (0 = none)")
+      ->capture_default_str();
+  cmd->add_option("--forward-fit-tolerance", l.forward_fit.function_tolerance,
+         "forward fit: stop after an accepted step that lowers the error by less than this "
+         "fraction (0 = take every step)")
       ->capture_default_str();
   cmd->add_option("--damping-prior", l.forward_fit.damping_prior,
          "forward fit: Tikhonov weight (Jacobi-scaled) pulling the damping correction towards 0")

@@ -97,14 +97,14 @@ def learn(scene, observations=None, *, clouds=None, output=None, checkpoint=None
 
     options (keyword, the command line's flags with underscores; ``learn_options()`` lists them;
     a flag is a bool): noise (σ [m], None: estimated), validation_fraction, no_parameter_fit,
-    parameter_fit_iterations, max_iterations, patience, free_halvings, modes, pod_stride,
-    full_space, pod_forward_only, kernels, position_weight, space_time_iterations,
+    parameter_fit_iterations, max_iterations, patience, free_halvings, no_backtrack, modes,
+    pod_stride, full_space, pod_forward_only, kernels, position_weight, space_time_iterations,
     regularization, reconstruction ("normal_equations" | "lsqr"), frame_stride,
     unprojected_reconstruction, full_space_weight, no_damping, linear_tail,
-    damping_regularization, smoothness, seed, forward_fit, damping_prior, elastic_prior,
-    kernel_smoothing, stress_kernels, neo_hookean_tail, damping_quadratic_tail, allow_rest_stress, no_network
-    (stage 5 off: keep the RBF), network_kind, network_motion_scales, network_samples,
-    network_rate_jitter.
+    damping_regularization, smoothness, seed, forward_fit, forward_fit_tolerance, damping_prior,
+    elastic_prior, kernel_smoothing, stress_kernels, neo_hookean_tail, damping_quadratic_tail,
+    allow_rest_stress, no_network (stage 5 off: keep the RBF), network_kind,
+    network_motion_scales, network_samples, network_rate_jitter.
 
     Returns the learned ``Material``; ``material.training["recipe"]`` holds what the recipe
     decided (noise, parameter fit, candidates and their validation errors, the choice).

@@ -172,6 +172,8 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
     { "patience", [](S& s, H v) { s.recipe.loop.patience = value<int>(v, "patience"); } },
     { "free_halvings",
         [](S& s, H v) { s.recipe.loop.free_halvings = value<int>(v, "free_halvings"); } },
+    { "no_backtrack",
+        [](S& s, H v) { s.recipe.loop.backtrack = !value<bool>(v, "no_backtrack"); } },
     { "modes", [](S& s, H v) { s.recipe.loop.pod.max_modes = value<int>(v, "modes"); } },
     { "pod_stride",
         [](S& s, H v) { s.recipe.loop.pod.frame_stride = value<int>(v, "pod_stride"); } },
@@ -219,6 +221,10 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
     { "smoothness",
         [](S& s, H v) { s.recipe.loop.rbf.smoothness = value<double>(v, "smoothness"); } },
     { "seed", [](S& s, H v) { s.recipe.loop.seed = value<std::uint64_t>(v, "seed"); } },
+    { "forward_fit_tolerance",
+        [](S& s, H v) {
+          s.recipe.loop.forward_fit.function_tolerance = value<double>(v, "forward_fit_tolerance");
+        } },
     { "forward_fit",
         [](S& s, H v) {
           s.recipe.loop.forward_fit.max_iterations = value<int>(v, "forward_fit");

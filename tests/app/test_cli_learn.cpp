@@ -79,7 +79,8 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
       0);
   const auto learned = run("learn " + path("scene.json") + " --observations " + path("obs.h5")
       + " -o " + path("learned.json")
-      + " --max-iterations 3 --kernels 15 --modes 10 --network-samples 4000 --report "
+      + " --max-iterations 3 --kernels 15 --modes 10 --forward-fit 3 --network-samples 4000 "
+        "--report "
       + path("report") + " -q");
   ASSERT_EQ(learned.exit_code, 0) << learned.output;
   EXPECT_NE(learned.output.find("learned material:"), std::string::npos) << learned.output;
@@ -87,8 +88,9 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   EXPECT_TRUE(fs::exists(path("learned.json.checkpoint.json")));
   const auto file = elastolearn::io::read_material_file(path("learned.json"));
   ASSERT_NE(file.correction, nullptr) << "a correction beat the nominal model";
-  // At most iterations 0–3 of the loop (patience may end it sooner), then the recipe's three
-  // forward-fit steps.
+  // At most iterations 0–3 of the loop (patience may end it sooner), then three forward-fit
+  // steps (fewer than the recipe's eight: on these exact data the deeper fit reaches a teacher
+  // that the small network reproduces only to a few per cent of its sub-micrometre error).
   int loop_records = 0, forward_fit_records = 0;
   for (const auto& r : file.training.at("history"))
     ++(r.at("kind") == "forward_fit" ? forward_fit_records : loop_records);
@@ -164,7 +166,8 @@ TEST_F(CliLearnTest, LearnsAndEvaluates) {
   // --resume of a finished run changes nothing and says where it resumed.
   const auto resumed = run("learn " + path("scene.json") + " --observations " + path("obs.h5")
       + " -o " + path("learned2.json") + " --checkpoint " + path("learned.json.checkpoint.json")
-      + " --max-iterations 3 --kernels 15 --modes 10 --network-samples 4000 --resume -q");
+      + " --max-iterations 3 --kernels 15 --modes 10 --forward-fit 3 --network-samples 4000 "
+        "--resume -q");
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
   EXPECT_NE(resumed.output.find("resuming"), std::string::npos);
   const auto again = elastolearn::io::read_material_file(path("learned2.json"));

@@ -97,6 +97,12 @@ void expect_resume_equals_whole(Fixture& f, int stop_after) {
   elastolearn::test::expect_same_steps(resumed.history, whole.history);
   ASSERT_TRUE(resumed.best);
   expect_same(*resumed.best, *whole.best); // bit-identical: every stage is deterministic
+  // Every correction a completed step simulated, which the recipe's validation draws from.
+  ASSERT_EQ(resumed.tried.size(), whole.tried.size());
+  for (const auto& [iteration, correction] : whole.tried) {
+    ASSERT_TRUE(resumed.tried.contains(iteration)) << iteration;
+    expect_same(*resumed.tried.at(iteration), *correction);
+  }
 }
 
 TEST(LearningCheckpoint, ResumedRunEqualsUninterruptedRun) {
@@ -116,9 +122,10 @@ TEST(LearningCheckpoint, RefusesACheckpointOfOtherInputs) {
   Fixture f;
   learn::LearningState state;
   state.next_iteration = 3;
-  state.divergences_in_a_row = 2;
+  state.failed_steps_in_a_row = 2;
   state.forward_fit_steps = 1;
   state.forward_fit_damping = 3.3e-3;
+  state.forward_fit_converged = true;
   learn::ParameterFitReport fit;
   fit.fitted = { 1.25e6, 0.41, 0.5, 0.02 };
   fit.final_rms = 1.5e-4;
@@ -131,9 +138,10 @@ TEST(LearningCheckpoint, RefusesACheckpointOfOtherInputs) {
   EXPECT_EQ(resume.parameter_fit.final_rms, 1.5e-4);
   EXPECT_EQ(resume.parameter_fit.stop, learn::FitStop::Converged);
   EXPECT_EQ(read.next_iteration, 3);
-  EXPECT_EQ(read.divergences_in_a_row, 2);
+  EXPECT_EQ(read.failed_steps_in_a_row, 2);
   EXPECT_EQ(read.forward_fit_steps, 1);
   EXPECT_EQ(read.forward_fit_damping, 3.3e-3);
+  EXPECT_TRUE(read.forward_fit_converged);
   auto other = f.inputs;
   other.scene = "other.json";
   EXPECT_THROW(read_learning_checkpoint(f.file, other), InputError);

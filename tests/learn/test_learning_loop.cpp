@@ -68,6 +68,31 @@ double swing_error(const sim::Scene& truth, const sim::Scene& model) {
       .max;
 }
 
+/// The corotated bar (E = 1e6 Pa) drooping for 20 frames, observed at its surface: the data of
+/// a loop resumed at iteration 1 (resumed_at_iteration_1).
+struct OwnDroop {
+  sim::Scene scene = [] {
+    auto s = bar_scene(bar(material::ElasticModelType::Corotated, 1e6), false);
+    s.frames = 20;
+    return s;
+  }();
+  observe::Observation observed = observe_surface(scene);
+};
+
+/// A loop state resumed at iteration 1: C_1 a uniaxial slope `own_slope` [Pa] (no kernels), the
+/// best so far the nominal (iteration 0) with forward error `best_error` [m].
+LearningState resumed_at_iteration_1(double own_slope, double best_error) {
+  material::RbfCorrection::Parameters p;
+  p.centres.resize(0, 3);
+  p.own_slope = own_slope;
+  LearningState state;
+  state.next_iteration = 1;
+  state.correction = std::make_shared<material::RbfCorrection>(p);
+  state.best_error = best_error;
+  state.best_iteration = 0;
+  return state;
+}
+
 TEST(LearningLoop, LearnsNeoHookeanFromAWrongCorotatedNominal) {
   const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
   const auto nominal = bar(material::ElasticModelType::Corotated, 1.75e6);
@@ -190,23 +215,15 @@ TEST(LearningLoop, DivergingCorrectionsAreHalvedBeforePatienceCountsThem) {
   // Resume at iteration 1 with a correction whose simulation diverges: a uniaxial softening of
   // 40× the nominal's stiffness (E = 1e6 Pa), so that ½ and ¼ of it diverge as well. The first
   // `free_halvings` divergences in a row are halved without counting against patience (1 here).
-  auto scene = bar_scene(bar(material::ElasticModelType::Corotated, 1e6), false);
-  scene.frames = 20;
-  const auto observed = observe_surface(scene);
-  material::RbfCorrection::Parameters p;
-  p.centres.resize(0, 3);
-  p.own_slope = -40e6;
-  const auto unstable = std::make_shared<material::RbfCorrection>(p);
+  const OwnDroop data;
+  const double own_slope = -40e6;
   for (const int free_halvings : { 0, 2 }) {
     LearningOptions options = small_options();
     options.patience = 1;
     options.free_halvings = free_halvings;
-    LearningState state;
-    state.next_iteration = 1;
-    state.correction = unstable;
-    state.best_error = 1.0; // the nominal's, say; nothing below will beat it
-    state.best_iteration = 0;
-    ASSERT_TRUE(run_learning(scene, observed, options, state));
+    // The nominal's error, say: no simulation that completes would be worse.
+    LearningState state = resumed_at_iteration_1(own_slope, 1.0);
+    ASSERT_TRUE(run_learning(data.scene, data.observed, options, state));
     ASSERT_EQ(state.history.size(), static_cast<size_t>(free_halvings + 1))
         << "free_halvings " << free_halvings;
     // Every correction diverged: halved (a damped update) while halvings are free, then the
@@ -221,14 +238,83 @@ TEST(LearningLoop, DivergingCorrectionsAreHalvedBeforePatienceCountsThem) {
       else
         EXPECT_TRUE(std::holds_alternative<LoopEnd>(r->next)) << "step " << i;
     }
-    EXPECT_EQ(state.divergences_in_a_row, free_halvings + 1);
+    EXPECT_EQ(state.failed_steps_in_a_row, free_halvings + 1);
     EXPECT_EQ(state.iterations_without_improvement, 1);
     EXPECT_TRUE(state.finished);
     // The last correction tried is 2^-free_halvings of the first (the best is the nominal).
     const double scale = std::ldexp(1.0, -free_halvings);
-    EXPECT_NEAR(state.correction->parameters().own_slope, scale * p.own_slope,
-        1e-9 * std::abs(p.own_slope));
+    EXPECT_NEAR(
+        state.correction->parameters().own_slope, scale * own_slope, 1e-9 * std::abs(own_slope));
   }
+}
+
+TEST(LearningLoop, BacktrackingHalvesACompletedCorrectionThatIsNoBetter) {
+  // The data are the nominal's own motion, so any correction is worse than none. Resume at
+  // iteration 1 with a stiffening that simulates fine: backtracking treats it as a failed step
+  // (halved towards the best, no trajectory stages), without it the stages run from it.
+  const OwnDroop data;
+  const double own_slope = 2e6;
+  for (const bool backtrack : { false, true }) {
+    LearningOptions options = small_options();
+    options.patience = 2;
+    options.free_halvings = 1;
+    options.backtrack = backtrack;
+    // The nominal's error: it reproduces its own data.
+    LearningState state = resumed_at_iteration_1(own_slope, 1e-12);
+    ASSERT_TRUE(run_learning(data.scene, data.observed, options, state));
+    ASSERT_FALSE(state.history.empty());
+    const auto* first = std::get_if<LoopRecord>(&state.history.front());
+    ASSERT_TRUE(first);
+    EXPECT_EQ(first->forward.status(), ForwardStatus::completed);
+    EXPECT_GT(first->forward.error().rms, state.best_error);
+    EXPECT_EQ(state.best_iteration, 0) << "backtrack " << backtrack;
+    if (!backtrack) {
+      EXPECT_TRUE(first->stages()) << "the stages run from a worse correction";
+      continue;
+    }
+    // Whole, ½ and ¼ of the step, all completed and worse: the first halving is free, the next
+    // two count against patience 2.
+    ASSERT_EQ(state.history.size(), 3u);
+    for (size_t i = 0; i < state.history.size(); ++i) {
+      const auto* r = std::get_if<LoopRecord>(&state.history[i]);
+      ASSERT_TRUE(r);
+      EXPECT_EQ(r->forward.status(), ForwardStatus::completed) << "step " << i;
+      if (i + 1 < state.history.size())
+        EXPECT_TRUE(r->damped_update()) << "step " << i;
+      else
+        EXPECT_TRUE(std::holds_alternative<LoopEnd>(r->next));
+    }
+    EXPECT_EQ(state.failed_steps_in_a_row, 3);
+    EXPECT_TRUE(state.finished);
+    EXPECT_NEAR(state.correction->parameters().own_slope, 0.25 * own_slope, 1e-9 * own_slope);
+  }
+}
+
+TEST(LearningLoop, AConvergedForwardFitStopsAndStaysStopped) {
+  // A tolerance no step can meet (each accepted step would have to lower the error by 99 %):
+  // the forward fit stops after its first accepted step, and running the finished state again
+  // takes no further step (as a resumed run must not).
+  const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
+  const auto nominal = bar(material::ElasticModelType::Corotated, 1.75e6);
+  auto scene = bar_scene(nominal, false);
+  scene.frames = 40;
+  auto truth_scene = bar_scene(truth, false);
+  truth_scene.frames = 40;
+  const auto observed = observe_surface(truth_scene);
+  LearningOptions options = small_options();
+  options.max_iterations = 0;
+  options.forward_fit.max_iterations = 6;
+  options.forward_fit.function_tolerance = 0.99;
+  LearningState state;
+  ASSERT_TRUE(run_learning(scene, observed, options, state));
+  ASSERT_TRUE(state.forward_fit_converged);
+  ASSERT_LT(state.forward_fit_steps, options.forward_fit.max_iterations);
+  const ForwardFitRecord* last = forward_fit_of(state.history.back());
+  ASSERT_TRUE(last);
+  EXPECT_TRUE(last->accepted);
+  const size_t steps = state.history.size();
+  ASSERT_TRUE(run_learning(scene, observed, options, state));
+  EXPECT_EQ(state.history.size(), steps);
 }
 
 TEST(LearningLoop, TruthEqualToNominalLearnsAlmostNothing) {

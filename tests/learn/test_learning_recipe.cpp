@@ -304,6 +304,16 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);
+  // The forward fit's candidate is its last accepted step.
+  std::vector<int> accepted, validated;
+  for (const IterationRecord& h : r.loop.history)
+    if (const ForwardFitRecord* step = forward_fit_of(h); step && step->accepted)
+      accepted.push_back(step->iteration);
+  for (const Candidate& k : r.candidates)
+    if (k.kind == CandidateKind::ForwardFit)
+      validated.push_back(k.iteration);
+  ASSERT_FALSE(accepted.empty()) << "the forward fit improved on the loop";
+  EXPECT_EQ(validated, std::vector<int> { accepted.back() });
   // Stage 5 distilled the chosen RBF and validated the network as the last candidate; on this
   // noise-free case it predicts the held-out data as well as its teacher and replaces it.
   ASSERT_TRUE(r.network.has_value());
@@ -439,6 +449,11 @@ TEST(LearningRecipe, ResumedRunEqualsTheWholeRun) {
   EXPECT_EQ(resumed.parameter_fit.fitted.young, whole.parameter_fit.fitted.young);
   ASSERT_EQ(resumed.loop.history.size(), whole.loop.history.size());
   EXPECT_EQ(resumed.loop.best_error, whole.loop.best_error);
+  // The same candidates (the loop's and every accepted forward-fit step's), the same choice.
+  ASSERT_EQ(resumed.candidates.size(), whole.candidates.size());
+  for (size_t i = 0; i < whole.candidates.size(); ++i)
+    EXPECT_EQ(resumed.candidates[i].validation.rms, whole.candidates[i].validation.rms) << i;
+  EXPECT_EQ(resumed.chosen, whole.chosen);
   EXPECT_EQ(resumed.choice().validation.rms, whole.choice().validation.rms);
 }
 

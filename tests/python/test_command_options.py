@@ -212,7 +212,7 @@ def test_learn_flags_set_what_the_cli_sets(learning_case, cli, tmp_path):
                  unprojected_reconstruction=True, full_space_weight=0.2, no_damping=True,
                  linear_tail=True, stress_kernels=True, neo_hookean_tail=True,
                  allow_rest_stress=True, validation_fraction=0.25, frame_stride=2,
-                 smoothness=0.05)
+                 smoothness=0.05, no_backtrack=True, forward_fit_tolerance=0.05)
     r = cli("learn", scene, "--observations", observations, "-o", tmp_path / "cli.json", "-q",
             *cli_flags(flags))
     assert r.returncode == 0, r.stdout + r.stderr

@@ -14,12 +14,19 @@ constexpr const char* k_format = "elastolearn-learning-checkpoint";
 constexpr int k_version = 3;
 
 /// A checkpoint's options with the fields added since it was written set to the values every run
-/// had before (so that it still resumes under those options): rbf.smoothness 0.
+/// had before (so that it still resumes under those options): rbf.smoothness 0, backtrack
+/// false, forward_fit.function_tolerance 0.
 nlohmann::json with_former_defaults(nlohmann::json options) {
   const auto fill = [](nlohmann::json& loop) {
-    if (loop.is_object() && loop.contains("rbf") && loop["rbf"].is_object()
-        && !loop["rbf"].contains("smoothness"))
+    if (!loop.is_object())
+      return;
+    if (loop.contains("rbf") && loop["rbf"].is_object() && !loop["rbf"].contains("smoothness"))
       loop["rbf"]["smoothness"] = 0.0;
+    if (loop.contains("patience") && !loop.contains("backtrack"))
+      loop["backtrack"] = false;
+    if (loop.contains("forward_fit") && loop["forward_fit"].is_object()
+        && !loop["forward_fit"].contains("function_tolerance"))
+      loop["forward_fit"]["function_tolerance"] = 0.0;
   };
   fill(options);
   if (options.is_object() && options.contains("loop"))
@@ -191,7 +198,7 @@ nlohmann::json iteration_record_to_json(const learn::IterationRecord& record) {
 
 nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
   return { { "max_iterations", o.max_iterations }, { "patience", o.patience },
-    { "free_halvings", o.free_halvings },
+    { "free_halvings", o.free_halvings }, { "backtrack", o.backtrack },
     { "pod",
         { { "max_modes", o.pod.max_modes }, { "energy_fraction", o.pod.energy_fraction },
             { "first_frame", o.pod.first_frame }, { "frame_count", o.pod.frame_count },
@@ -226,7 +233,8 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
     { "forward_fit",
         { { "max_iterations", o.forward_fit.max_iterations }, { "damping", o.forward_fit.damping },
             { "damping_prior", o.forward_fit.damping_prior },
-            { "elastic_prior", o.forward_fit.elastic_prior } } } };
+            { "elastic_prior", o.forward_fit.elastic_prior },
+            { "function_tolerance", o.forward_fit.function_tolerance } } } };
 }
 
 nlohmann::json recipe_options_to_json(const learn::RecipeOptions& o) {
@@ -297,6 +305,9 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
   nlohmann::json history = nlohmann::json::array();
   for (const auto& r : state.history)
     history.push_back(iteration_record_to_json(r));
+  nlohmann::json tried = nlohmann::json::array();
+  for (const auto& [iteration, correction] : state.tried)
+    tried.push_back({ { "iteration", iteration }, { "correction", correction_json(correction) } });
   const nlohmann::json j = { { "format", std::string(k_format) + "/" + std::to_string(k_version) },
     { "inputs",
         { { "scene", inputs.scene }, { "observations", inputs.observations },
@@ -308,9 +319,11 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
             { "best", correction_json(state.best) }, { "best_error", state.best_error },
             { "best_iteration", state.best_iteration },
             { "iterations_without_improvement", state.iterations_without_improvement },
-            { "divergences_in_a_row", state.divergences_in_a_row }, { "finished", state.finished },
-            { "forward_fit_steps", state.forward_fit_steps },
-            { "forward_fit_damping", state.forward_fit_damping }, { "history", history } } } };
+            { "failed_steps_in_a_row", state.failed_steps_in_a_row },
+            { "finished", state.finished }, { "forward_fit_steps", state.forward_fit_steps },
+            { "forward_fit_damping", state.forward_fit_damping },
+            { "forward_fit_converged", state.forward_fit_converged }, { "history", history },
+            { "tried", tried } } } };
   write_json_file(path, j);
 }
 
@@ -357,12 +370,19 @@ learn::RecipeResume read_learning_checkpoint(
   state.best_error = s.number("best_error");
   state.best_iteration = s.integer("best_iteration");
   state.iterations_without_improvement = s.integer("iterations_without_improvement");
-  state.divergences_in_a_row = s.integer("divergences_in_a_row");
+  // Checkpoints written before backtracking counted divergences only, under their own name.
+  state.failed_steps_in_a_row = s.has("failed_steps_in_a_row") ? s.integer("failed_steps_in_a_row")
+                                                               : s.integer("divergences_in_a_row");
   state.finished = s.boolean("finished", false);
   state.forward_fit_steps = s.integer("forward_fit_steps");
   state.forward_fit_damping = s.number("forward_fit_damping");
+  state.forward_fit_converged = s.boolean("forward_fit_converged", false);
   for (const auto& r : s.objects("history"))
     state.history.push_back(version >= 3 ? read_record(r) : read_flat_record(r));
+  // Older checkpoints kept the best correction only.
+  if (s.has("tried"))
+    for (const auto& t : s.objects("tried"))
+      state.tried[t.integer("iteration")] = read_correction(t, "correction");
   return resume;
 }
 

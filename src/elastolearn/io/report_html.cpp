@@ -54,15 +54,17 @@ std::string convergence_table(const LearningReport& r) {
     const learn::SpaceTimeStages* stages = learn::stages_of(h);
     const learn::ForwardFitRecord* step = learn::forward_fit_of(h);
     const auto* loop = std::get_if<learn::LoopRecord>(&h);
-    const char* kind = step     ? (step->accepted ? "forward fit, accepted"
-                                   : forward.status() == learn::ForwardStatus::unstable
-                                   ? "forward fit, rejected unsimulated (unstable)"
-                                   : forward.completed() ? "forward fit, rejected"
-                                                         : "forward fit, diverged (rejected)")
-        : stages                ? "loop"
-        : loop->damped_update() ? "diverged (half its step next)"
-        : forward.completed()   ? "last forward check"
-                                : "diverged (the loop stops)";
+    const char* kind = step ? (step->accepted ? "forward fit, accepted"
+                               : forward.status() == learn::ForwardStatus::unstable
+                               ? "forward fit, rejected unsimulated (unstable)"
+                               : forward.completed() ? "forward fit, rejected"
+                                                     : "forward fit, diverged (rejected)")
+        : stages            ? "loop"
+        : loop->damped_update()
+        ? (forward.completed() ? "no better than the best (half its step next)"
+                               : "diverged (half its step next)")
+        : forward.completed() ? "last forward check"
+                              : "diverged (the loop stops)";
     out += "<tr><td>" + std::to_string(learn::iteration_of(h)) + "</td><td class=\"l\">" + kind
         + "</td>";
     if (forward.completed()) {

@@ -45,6 +45,8 @@ void ForwardFitOptions::validate() const {
         "forward_fit.max_iterations", "must be ≥ 0, got " + std::to_string(max_iterations));
   if (!std::isfinite(damping) || damping <= 0)
     throw InputError("forward_fit.damping", "must be finite and > 0");
+  if (!std::isfinite(function_tolerance) || function_tolerance < 0)
+    throw InputError("forward_fit.function_tolerance", "must be finite and ≥ 0");
   if (!std::isfinite(damping_prior) || damping_prior < 0)
     throw InputError("forward_fit.damping_prior", "must be finite and ≥ 0");
   if (!std::isfinite(elastic_prior) || elastic_prior < 0)
@@ -321,7 +323,7 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
   // regularised solve with μ as its (dimensionless) Tikhonov weight. Every trial counts against
   // max_iterations; the equations change only with an accepted step's pass.
   const int unlimited = std::numeric_limits<int>::max();
-  result.accepted = levenberg_marquardt(problem,
+  const LevenbergMarquardtSummary summary = levenberg_marquardt(problem,
       { .max_iterations = unlimited,
           .max_steps = options.max_iterations,
           .max_rejections = unlimited,
@@ -330,8 +332,10 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
           .damping_decrease = 3,
           .min_damping = 0,
           .damping_increase = 10,
-          .failed_damping_increase = 10 })
-                        .accepted;
+          .failed_damping_increase = 10,
+          .function_tolerance = options.function_tolerance });
+  result.accepted = summary.accepted;
+  result.converged = summary.stop == LevenbergMarquardtStop::converged;
   result.seconds = seconds_since(started);
   return result;
 }

@@ -69,6 +69,10 @@ inline constexpr int kStabilityStepHalvings = 4;
 
 struct ForwardFitOptions {
   int max_iterations = 0; ///< trial steps (one forward simulation each) after the start
+  /// Stop after an accepted step that lowers the objective by less than this fraction of it
+  /// (0: take all max_iterations trial steps). Once the error is at the noise's floor, or the
+  /// correction's capacity is spent, further steps cost a simulation each and change little.
+  double function_tolerance = 0;
   /// Initial Levenberg–Marquardt damping μ on the Jacobi-scaled normal equations; ÷3 after an
   /// accepted step, ×10 after a rejected one.
   double damping = 1e-2;
@@ -103,6 +107,9 @@ struct ForwardFitResult {
   VecX unknowns; ///< the best found (the start if no step improved)
   std::vector<double> rms_history; ///< RMS error of each simulation, the start first (−1: diverged)
   int accepted = 0; ///< steps that lowered the error
+  /// An accepted step lowered the objective by less than options.function_tolerance: the fit
+  /// stopped there, before max_iterations.
+  bool converged = false;
   double seconds = 0;
 };
 

@@ -81,12 +81,12 @@ struct SpaceTimeStages {
   }
 };
 
-/// C_k's forward simulation diverged and C_{k+1} = ½ (C_k + best) is tried next (no trajectory
-/// stages).
+/// C_k's forward simulation diverged, or (LearningOptions::backtrack) its error was not below
+/// the best one's, and C_{k+1} = ½ (C_k + best) is tried next (no trajectory stages).
 struct DampedUpdate { };
 
 /// The loop ended with this iteration's forward simulation: the last check of the last
-/// correction, or a divergence past LearningOptions::free_halvings. No C_{k+1}.
+/// correction, or a failed step past LearningOptions::free_halvings and patience. No C_{k+1}.
 struct LoopEnd { };
 
 /// What followed C_k's forward simulation in a loop iteration.

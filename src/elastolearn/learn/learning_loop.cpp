@@ -121,10 +121,12 @@ LearningState after_forward(
     next.best_error = error;
     next.best_iteration = k;
   }
-  next.divergences_in_a_row = completed ? 0 : state.divergences_in_a_row + 1;
-  if (better_forward || (completed && control_forces_still_shrinking(state.history)))
+  const bool overshot = !completed || (options.backtrack && !better_forward);
+  next.failed_steps_in_a_row = overshot ? state.failed_steps_in_a_row + 1 : 0;
+  if (better_forward
+      || (completed && !options.backtrack && control_forces_still_shrinking(state.history)))
     next.iterations_without_improvement = 0;
-  else if (next.divergences_in_a_row == 0 || next.divergences_in_a_row > options.free_halvings)
+  else if (next.failed_steps_in_a_row == 0 || next.failed_steps_in_a_row > options.free_halvings)
     ++next.iterations_without_improvement;
   if (next.iterations_without_improvement >= options.patience || k >= options.max_iterations)
     next.finished = true;
@@ -218,20 +220,22 @@ std::optional<TrajectoryStagesResult> trajectory_stages(std::span<const Motion> 
 bool run_forward_fit(std::span<const Motion> motions, std::span<const ReconstructionMesh> meshes,
     const LearningOptions& options, LearningState& state, const LearningCallbacks& callbacks) {
   const int remaining = options.forward_fit.max_iterations - state.forward_fit_steps;
-  if (remaining <= 0)
+  if (remaining <= 0 || state.forward_fit_converged)
     return true;
   if (callbacks.interrupted && callbacks.interrupted())
     return false;
   const ForwardFitStart fit = forward_fit_start(motions, meshes, state.best, options, remaining,
       state.forward_fit_damping, callbacks.progress);
   bool stopped = false;
-  fit_to_observations(motions, meshes, fit.design, fit.start, fit.options, callbacks.progress,
+  const ForwardFitResult result = fit_to_observations(motions, meshes, fit.design, fit.start,
+      fit.options, callbacks.progress,
       [&](const ForwardSensitivityPass& trial, bool accepted, const VecX& kept, double damping) {
         const ForwardFitRecord record
             = forward_fit_record(state.next_iteration, trial, accepted, fit.design);
         // The kept unknowns are the best correction (the start's, until a step is accepted).
         state.correction = std::make_shared<material::RbfCorrection>(fit.design.correction(kept));
         if (accepted) {
+          state.tried[record.iteration] = state.correction;
           state.best = state.correction;
           state.best_error = trial.error.rms;
           state.best_iteration = record.iteration;
@@ -247,6 +251,13 @@ bool run_forward_fit(std::span<const Motion> motions, std::span<const Reconstruc
         stopped = callbacks.interrupted && callbacks.interrupted();
         return !stopped;
       });
+  if (result.converged) {
+    // Recorded so that a run resumed after this point does not take more steps.
+    state.forward_fit_converged = true;
+    if (callbacks.checkpoint)
+      callbacks.checkpoint(state);
+    return true;
+  }
   return !stopped || state.forward_fit_steps >= options.forward_fit.max_iterations;
 }
 
@@ -274,10 +285,13 @@ bool run_learning(std::span<const Motion> motions, const LearningOptions& option
           "the nominal model's forward simulation failed: "
               + forward.runs[static_cast<size_t>(forward.diverged_motion)].message);
     LearningState next = after_forward(state, forward.outcome, options); // committed at the end
+    if (forward.outcome.completed() && state.correction)
+      next.tried[k] = state.correction;
     LoopNext what_next = LoopEnd {};
-    if (!forward.outcome.completed() && !next.finished) {
-      // C_k overshot (a simulation diverged): halve the step from the best correction and try
-      // that. Deterministic, so a resumed run takes the same path.
+    if (next.failed_steps_in_a_row > 0 && !next.finished) {
+      // C_k overshot (a simulation diverged or, backtracking, it is no better than the best):
+      // halve the step from the best correction and try that. Deterministic, so a resumed run takes
+      // the same path.
       next.correction = std::make_shared<material::RbfCorrection>(
           material::blend(*state.correction, next.best.get(), 0.5));
       what_next = DampedUpdate {};

@@ -33,6 +33,7 @@
 #include <elastolearn/sim/scene.hpp>
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
@@ -50,6 +51,13 @@ struct LearningOptions {
   /// at a quarter (on the full-size sphere-tension case: docs/design_notes.md). Each halving
   /// still counts as an iteration.
   int free_halvings = 2;
+  /// A correction whose forward error is not below the best one's is treated as one that
+  /// diverged: halved towards the best (a damped update, no trajectory stages), so the loop
+  /// only ever starts its stages from its best correction. Without it (paper §3) a worse
+  /// correction still counts as progress while its control forces shrink, and the next stages
+  /// start from it; the reconstruction's first whole step typically raises the forward error
+  /// (docs/benchmarks_learning.md, "What limits the results").
+  bool backtrack = false;
   PodOptions pod; ///< reduced basis (max_modes, frame window and stride)
   /// POD snapshots from the constrained simulation too, not only the forward one, so that span Φ
   /// contains the observed shapes the current model does not reach (docs/learning_loop.md: a
@@ -99,13 +107,20 @@ struct LearningState {
   double best_error = -1; ///< its RMS forward error [m] (−1: none yet)
   int best_iteration = -1;
   int iterations_without_improvement = 0;
-  int divergences_in_a_row = 0; ///< forward simulations diverged in a row
+  /// Steps that failed in a row: their forward simulation diverged, or (with
+  /// LearningOptions::backtrack) its error was not below the best one's.
+  int failed_steps_in_a_row = 0;
   bool finished = false; ///< the loop (its space-time iterations) ended
   int forward_fit_steps = 0; ///< forward-fit steps taken after it
   double forward_fit_damping = -1; ///< its current μ (−1: not started)
+  bool forward_fit_converged = false; ///< it stopped at ForwardFitOptions::function_tolerance
   /// Every step so far, in order: the loop's iterations (LoopRecord), then the forward fit's
   /// steps (ForwardFitRecord).
   std::vector<IterationRecord> history;
+  /// The correction each completed step simulated, by iteration: the loop's C_k (none for the
+  /// nominal) and every accepted forward-fit step's. The recipe validates some of them, so a
+  /// checkpoint keeps them all and a resumed run chooses among the same candidates.
+  std::map<int, std::shared_ptr<const material::RbfCorrection>> tried;
 };
 
 struct LearningCallbacks {

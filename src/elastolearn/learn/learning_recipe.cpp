@@ -18,7 +18,6 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <map>
 
 namespace elastolearn::learn {
 
@@ -42,7 +41,9 @@ RecipeOptions::RecipeOptions() {
   // As fit-parameters: with 10, 12 of random seed 9's 30 fits stopped at the cap, one of them
   // (a truth in the nominal's family, exact data) at 0.28 % where 20 reach the truth exactly.
   parameter_fit.max_iterations = 20;
-  loop.forward_fit.max_iterations = 3;
+  loop.forward_fit.max_iterations = 8;
+  loop.forward_fit.function_tolerance = 0.01;
+  loop.backtrack = true;
   loop.rbf.energy_kernels = true;
   loop.rbf.epsilon = 0.03;
   loop.rbf.smoothness = 1e-2;
@@ -508,23 +509,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // compare with the recorded ones.
   for (Motion& m : split.training)
     m.scene.material = result.fitted_nominal;
-  std::map<int, std::shared_ptr<const material::RbfCorrection>> tried; // C_k per iteration
-  std::shared_ptr<const material::RbfCorrection> current = result.loop.correction; // next C_k
-  LearningCallbacks loop_callbacks = callbacks.loop;
-  loop_callbacks.checkpoint = [&](const LearningState& s) {
-    const IterationRecord& r = s.history.back();
-    if (const ForwardFitRecord* step = forward_fit_of(r)) {
-      if (step->accepted)
-        tried[step->iteration] = s.correction;
-    } else {
-      if (forward_of(r).completed() && current)
-        tried[iteration_of(r)] = current;
-      current = s.correction;
-    }
-    if (callbacks.loop.checkpoint)
-      callbacks.loop.checkpoint(s);
-  };
-  if (!run_learning(split.training, options.loop, result.loop, loop_callbacks)) {
+  if (!run_learning(split.training, options.loop, result.loop, callbacks.loop)) {
     result.interrupted = true;
     return result;
   }
@@ -576,29 +561,26 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     add(CandidateKind::FittedNominal, -1, nullptr);
   // The loop's corrections with the lowest training errors, and the forward fit's last
   // accepted step: each validation costs a simulation of the held-out data.
-  std::vector<const IterationRecord*> loop_records;
-  const IterationRecord* forward_fit = nullptr;
+  std::vector<const IterationRecord*> loop_records, forward_fit_steps;
   for (const auto& r : result.loop.history) {
+    const auto& tried = result.loop.tried;
     const auto it = tried.find(iteration_of(r));
     if (it == tried.end() || !it->second || !forward_of(r).completed())
       continue;
-    if (forward_fit_of(r))
-      forward_fit = &r;
-    else
-      loop_records.push_back(&r);
+    (forward_fit_of(r) ? forward_fit_steps : loop_records).push_back(&r);
   }
   std::sort(loop_records.begin(), loop_records.end(),
       [](const IterationRecord* a, const IterationRecord* b) {
         return forward_of(*a).error().rms < forward_of(*b).error().rms;
       });
   loop_records.resize(std::min(loop_records.size(), kLoopCandidates));
-  if (forward_fit)
-    loop_records.push_back(forward_fit);
+  if (!forward_fit_steps.empty())
+    loop_records.push_back(forward_fit_steps.back());
   for (const IterationRecord* r : loop_records)
     add(forward_fit_of(*r) ? CandidateKind::ForwardFit : CandidateKind::Loop, iteration_of(*r),
-        tried.at(iteration_of(*r)));
+        result.loop.tried.at(iteration_of(*r)));
   // A resumed run knows the earlier iterations only through the best one.
-  if (result.loop.best && tried.find(result.loop.best_iteration) == tried.end())
+  if (result.loop.best && !result.loop.tried.contains(result.loop.best_iteration))
     add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best);
   const int reference = options.fit_parameters ? 1 : 0;
   std::vector<VecX> held_out_observed, trained_observed;

@@ -10,8 +10,9 @@
 ///      recorded positions (Motion::smoothed);
 ///   2. parameter fit: E, ν, α₀, α₁ of the nominal model fitted to the training data;
 ///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit;
-///   4. validation: every candidate (the given nominal, the fitted nominal, each completed
-///      correction of the loop and of the forward fit) simulates the held-out data; among those
+///   4. validation: every candidate (the given nominal, the fitted nominal, the loop's
+///      corrections with the lowest training errors and the forward fit's last accepted step)
+///      simulates the held-out data; among those
 ///      whose material survives a larger motion (kLargerMotion) and that beat the fitted nominal
 ///      by more than noise could (z ≥ kSignificance), the one with the smallest RMS error there
 ///      is the result; the fitted nominal if none. Where the held-out data cannot resolve a
