@@ -290,6 +290,30 @@ TEST(LearningLoop, BacktrackingHalvesACompletedCorrectionThatIsNoBetter) {
   }
 }
 
+TEST(LearningLoop, ANominalNoBetterThanTheNominalEndsTheLoop) {
+  // A reconstruction dropped as unstable leaves C_1 = the nominal, no better than iteration 0's:
+  // with the best the nominal too there is no step to halve, and the loop ends there (it once
+  // dereferenced the missing correction to halve it).
+  const OwnDroop data;
+  for (const bool backtrack : { false, true }) {
+    LearningOptions options = small_options();
+    options.backtrack = backtrack;
+    LearningState state = resumed_at_iteration_1(0.0, 0.0); // nothing is below 0
+    state.correction = nullptr;
+    ASSERT_TRUE(run_learning(data.scene, data.observed, options, state));
+    ASSERT_FALSE(state.history.empty());
+    const auto* first = std::get_if<LoopRecord>(&state.history.front());
+    ASSERT_TRUE(first);
+    EXPECT_EQ(first->forward.status(), ForwardStatus::completed);
+    if (backtrack) {
+      EXPECT_TRUE(std::holds_alternative<LoopEnd>(first->next));
+      EXPECT_EQ(state.history.size(), 1u);
+    }
+    EXPECT_TRUE(state.finished);
+    EXPECT_EQ(state.best_iteration, 0);
+  }
+}
+
 TEST(LearningLoop, AConvergedForwardFitStopsAndStaysStopped) {
   // A tolerance no step can meet (each accepted step would have to lower the error by 99 %):
   // the forward fit stops after its first accepted step, and running the finished state again

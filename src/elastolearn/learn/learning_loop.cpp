@@ -288,12 +288,17 @@ bool run_learning(std::span<const Motion> motions, const LearningOptions& option
     if (forward.outcome.completed() && state.correction)
       next.tried[k] = state.correction;
     LoopNext what_next = LoopEnd {};
-    if (next.failed_steps_in_a_row > 0 && !next.finished) {
+    if (next.failed_steps_in_a_row > 0 && !next.finished && !state.correction && !next.best) {
+      // C_k is the nominal (a reconstruction whose step was dropped as unstable) and so is the
+      // best: there is no step to shorten, and the stages would repeat iteration 0's.
+      next.finished = true;
+    } else if (next.failed_steps_in_a_row > 0 && !next.finished) {
       // C_k overshot (a simulation diverged or, backtracking, it is no better than the best):
-      // halve the step from the best correction and try that. Deterministic, so a resumed run takes
-      // the same path.
-      next.correction = std::make_shared<material::RbfCorrection>(
-          material::blend(*state.correction, next.best.get(), 0.5));
+      // halve the step from the best correction and try that (½ best if C_k is the nominal).
+      // Deterministic, so a resumed run takes the same path.
+      next.correction = std::make_shared<material::RbfCorrection>(state.correction
+              ? material::blend(*state.correction, next.best.get(), 0.5)
+              : material::blend(*next.best, nullptr, 0.5));
       what_next = DampedUpdate {};
     } else if (!next.finished) {
       // 2–6. The trajectory stages: C_{k+1}.
