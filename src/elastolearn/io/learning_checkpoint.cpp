@@ -22,6 +22,7 @@ nlohmann::json with_former_defaults(nlohmann::json options) {
       return;
     if (loop.contains("rbf") && loop["rbf"].is_object() && !loop["rbf"].contains("smoothness"))
       loop["rbf"]["smoothness"] = 0.0;
+    // "patience" marks the loop's object (the recipe's options hold it under "loop").
     if (loop.contains("patience") && !loop.contains("backtrack"))
       loop["backtrack"] = false;
     if (loop.contains("forward_fit") && loop["forward_fit"].is_object()

@@ -106,7 +106,8 @@ void set_up(std::span<const Motion> motions, const LearningOptions& options, Loo
 }
 
 /// The state after iteration k's forward simulation `forward` (the loop's bookkeeping): the
-/// best correction, patience and divergence counters, and whether the loop ends. Progress is a
+/// corrections tried, the best one, the patience and failed-step counters, and whether the loop
+/// ends. Progress is a
 /// better forward error, or (paper §3) control forces that still shrink clearly although the
 /// forward error does not show it yet; the best correction is chosen by the former.
 LearningState after_forward(
@@ -116,6 +117,8 @@ LearningState after_forward(
   const bool completed = forward.completed();
   const double error = completed ? forward.error().rms : std::numeric_limits<double>::infinity();
   const bool better_forward = completed && (next.best_error < 0 || error < next.best_error);
+  if (completed && state.correction)
+    next.tried[k] = state.correction;
   if (better_forward) {
     next.best = state.correction;
     next.best_error = error;
@@ -131,6 +134,18 @@ LearningState after_forward(
   if (next.iterations_without_improvement >= options.patience || k >= options.max_iterations)
     next.finished = true;
   return next;
+}
+
+/// ½ (c + best), either of them null for the nominal; null when both are: C_k is then the
+/// nominal itself (its reconstruction was dropped as unstable) and so is the best, and there is
+/// no step to shorten.
+std::shared_ptr<const material::RbfCorrection> halfway(
+    const std::shared_ptr<const material::RbfCorrection>& c,
+    const std::shared_ptr<const material::RbfCorrection>& best) {
+  if (!c && !best)
+    return nullptr;
+  return std::make_shared<material::RbfCorrection>(
+      c ? material::blend(*c, best.get(), 0.5) : material::blend(*best, nullptr, 0.5));
 }
 
 /// What stages 2–6 give: C_{k+1} and their record.
@@ -285,21 +300,16 @@ bool run_learning(std::span<const Motion> motions, const LearningOptions& option
           "the nominal model's forward simulation failed: "
               + forward.runs[static_cast<size_t>(forward.diverged_motion)].message);
     LearningState next = after_forward(state, forward.outcome, options); // committed at the end
-    if (forward.outcome.completed() && state.correction)
-      next.tried[k] = state.correction;
     LoopNext what_next = LoopEnd {};
-    if (next.failed_steps_in_a_row > 0 && !next.finished && !state.correction && !next.best) {
-      // C_k is the nominal (a reconstruction whose step was dropped as unstable) and so is the
-      // best: there is no step to shorten, and the stages would repeat iteration 0's.
-      next.finished = true;
-    } else if (next.failed_steps_in_a_row > 0 && !next.finished) {
+    if (next.failed_steps_in_a_row > 0 && !next.finished) {
       // C_k overshot (a simulation diverged or, backtracking, it is no better than the best):
-      // halve the step from the best correction and try that (½ best if C_k is the nominal).
-      // Deterministic, so a resumed run takes the same path.
-      next.correction = std::make_shared<material::RbfCorrection>(state.correction
-              ? material::blend(*state.correction, next.best.get(), 0.5)
-              : material::blend(*next.best, nullptr, 0.5));
-      what_next = DampedUpdate {};
+      // halve the step from the best correction and try that. Deterministic, so a resumed run
+      // takes the same path.
+      next.correction = halfway(state.correction, next.best);
+      if (next.correction)
+        what_next = DampedUpdate {};
+      else
+        next.finished = true;
     } else if (!next.finished) {
       // 2–6. The trajectory stages: C_{k+1}.
       auto stages

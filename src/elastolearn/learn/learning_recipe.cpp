@@ -561,26 +561,31 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     add(CandidateKind::FittedNominal, -1, nullptr);
   // The loop's corrections with the lowest training errors, and the forward fit's last
   // accepted step: each validation costs a simulation of the held-out data.
-  std::vector<const IterationRecord*> loop_records, forward_fit_steps;
+  const auto& tried = result.loop.tried;
+  std::vector<const IterationRecord*> loop_records;
+  const IterationRecord* forward_fit = nullptr;
   for (const auto& r : result.loop.history) {
-    const auto& tried = result.loop.tried;
     const auto it = tried.find(iteration_of(r));
     if (it == tried.end() || !it->second || !forward_of(r).completed())
       continue;
-    (forward_fit_of(r) ? forward_fit_steps : loop_records).push_back(&r);
+    if (forward_fit_of(r))
+      forward_fit = &r;
+    else
+      loop_records.push_back(&r);
   }
   std::sort(loop_records.begin(), loop_records.end(),
       [](const IterationRecord* a, const IterationRecord* b) {
         return forward_of(*a).error().rms < forward_of(*b).error().rms;
       });
   loop_records.resize(std::min(loop_records.size(), kLoopCandidates));
-  if (!forward_fit_steps.empty())
-    loop_records.push_back(forward_fit_steps.back());
+  if (forward_fit)
+    loop_records.push_back(forward_fit);
   for (const IterationRecord* r : loop_records)
     add(forward_fit_of(*r) ? CandidateKind::ForwardFit : CandidateKind::Loop, iteration_of(*r),
-        result.loop.tried.at(iteration_of(*r)));
-  // A resumed run knows the earlier iterations only through the best one.
-  if (result.loop.best && !result.loop.tried.contains(result.loop.best_iteration))
+        tried.at(iteration_of(*r)));
+  // A run resumed from a checkpoint older than LearningState::tried knows the earlier
+  // iterations only through the best one.
+  if (result.loop.best && !tried.contains(result.loop.best_iteration))
     add(CandidateKind::Loop, result.loop.best_iteration, result.loop.best);
   const int reference = options.fit_parameters ? 1 : 0;
   std::vector<VecX> held_out_observed, trained_observed;
