@@ -4,6 +4,7 @@
 // a different, larger motion (an upward swing). Also: truth = nominal learns ≈ nothing.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
+#include <elastolearn/learn/learning_stages.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
@@ -312,6 +313,28 @@ TEST(LearningLoop, ANominalNoBetterThanTheNominalEndsTheLoop) {
     EXPECT_TRUE(state.finished);
     EXPECT_EQ(state.best_iteration, 0);
   }
+}
+
+TEST(LearningLoop, TheForwardFitKeepsTheCallersStabilitySamples) {
+  // The recipe asks for stability where its validation will check the forward fit's last step
+  // (around the held-out frames' stretches); the forward fit adds the samples of its own
+  // motions' runs to those and must not replace them.
+  const OwnDroop d;
+  const Motion motion { "droop", d.scene, d.observed };
+  const ReconstructionMesh mesh(d.scene.mesh, d.scene.material);
+  LearningOptions options = small_options();
+  const auto start = [&] {
+    return forward_fit_start(std::span(&motion, 1), std::span(&mesh, 1), nullptr, options, 3, -1)
+        .options.stability_stretches;
+  };
+  const MatX own = start();
+  ASSERT_GT(own.rows(), 0);
+  const MatX required = (MatX(2, 3) << 1.3, 1.0, 0.9, 0.7, 0.8, 1.1).finished();
+  options.forward_fit.stability_stretches = required;
+  const MatX both = start();
+  ASSERT_EQ(both.rows(), own.rows() + 2);
+  EXPECT_EQ(MatX(both.topRows(own.rows())), own);
+  EXPECT_EQ(MatX(both.bottomRows(2)), required);
 }
 
 TEST(LearningLoop, AConvergedForwardFitStopsAndStaysStopped) {

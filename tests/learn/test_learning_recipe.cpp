@@ -301,6 +301,9 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
       EXPECT_TRUE(k.larger_motion.checked);
       // Checked where a motion of another kind may go (the fitted nominal's reachable grid).
       EXPECT_GT(k.stability.samples, 0);
+      // The forward fit only took steps stable there.
+      if (k.kind == CandidateKind::ForwardFit)
+        EXPECT_TRUE(k.stability.stable());
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);
@@ -397,7 +400,7 @@ TEST(LearningRecipe, TheHeldOutFramesTakeNoPartInLearning) {
   o.noise = sigma;
   o.parameter_fit.max_iterations = 2;
   o.loop.max_iterations = 1;
-  o.loop.forward_fit.max_iterations = 0;
+  o.loop.forward_fit.max_iterations = 1;
   o.network.enabled = false;
   const RecipeResult a = learn_material(motions, o), b = learn_material(moved, o);
   ASSERT_GT(a.noise.smoothing_residual, 0.5 * sigma) << "the smoother must act for this test";
@@ -407,6 +410,15 @@ TEST(LearningRecipe, TheHeldOutFramesTakeNoPartInLearning) {
   ASSERT_TRUE(a.loop.correction && b.loop.correction);
   EXPECT_EQ(a.loop.correction->parameters().weights, b.loop.correction->parameters().weights);
   EXPECT_EQ(a.loop.best_error, b.loop.best_error);
+  // The forward fit's step too (its stability samples come from simulating the held-out
+  // frames, never from their observations).
+  ASSERT_EQ(a.loop.tried.size(), b.loop.tried.size());
+  for (const auto& [iteration, correction] : a.loop.tried) {
+    const auto& other = b.loop.tried.at(iteration);
+    ASSERT_EQ(correction == nullptr, other == nullptr);
+    if (correction)
+      EXPECT_EQ(correction->parameters().weights, other->parameters().weights) << iteration;
+  }
   EXPECT_NE(a.candidates[0].validation.rms, b.candidates[0].validation.rms);
 }
 

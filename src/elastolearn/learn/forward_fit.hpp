@@ -97,7 +97,9 @@ struct ForwardFitOptions {
   /// Principal stretches (N × 3) where every trial's material must be stable
   /// (material_stability.hpp); a trial that is not is shortened (kStabilityStepHalvings), and
   /// rejected without being simulated if no shorter step is stable (its simulation would diverge
-  /// or stall). Empty: no check.
+  /// or stall). Empty: no check. In the loop (LearningOptions::forward_fit) these are kept and
+  /// the samples of the best correction's own runs added (the recipe sets the stretches its
+  /// validation requires stability at).
   MatX stability_stretches;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;

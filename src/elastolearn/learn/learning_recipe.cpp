@@ -195,15 +195,31 @@ struct CandidatePredictions {
   VecX training; ///< of the training observations (as recorded)
 };
 
+/// Where every correction must be stable, in the validation (Candidate::stability) and in the
+/// forward fit before it: learn::reachable_stretches around the runs of the reference material
+/// (the fitted nominal, or the given one without a fit) over every whole motion, training and
+/// held-out frames. Simulating the held-out frames uses none of their observations. Empty if a
+/// run diverged (the reference then is no candidate either).
+MatX reference_reachable_stretches(const Split& split, const fem::MaterialModel& reference,
+    const StretchSampleOptions& sampling, const ProgressCallback& progress) {
+  std::vector<MatX> run_stretches;
+  for (const HeldOut& piece : split.validation) {
+    sim::Scene scene = piece.motion.scene;
+    scene.material = reference;
+    const sim::ForwardRun run = sim::simulate_positions(scene, progress);
+    if (!run.completed)
+      return {};
+    run_stretches.push_back(
+        collect_stretches(ReconstructionMesh(scene.mesh, reference), run.positions, sampling));
+  }
+  return reachable_stretches(*reference.elastic, stacked_rows(run_stretches, 3));
+}
+
 /// The candidate's error on the held-out data (completed false if a simulation diverged) and,
 /// for a correction, its run of the larger motion. Each motion is simulated once, whole: the
-/// run predicts its training frames too (c.training). `stretches` (if non-null) receives the
-/// principal stretches of its held-out motions' runs (collect_stretches with `sampling`, stacked;
-/// empty if a simulation diverged).
-CandidatePredictions validate_candidate(Candidate& c, const Split& split,
-    const fem::MaterialModel& nominal, MatX* stretches = nullptr,
-    const StretchSampleOptions& sampling = {}) {
-  std::vector<MatX> run_stretches;
+/// run predicts its training frames too (c.training).
+CandidatePredictions validate_candidate(
+    Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
   std::vector<ErrorSummary> errors, training_errors;
   std::vector<VecX> predictions, training_predictions;
   // The held-out motion's scene with the candidate's material.
@@ -221,9 +237,6 @@ CandidatePredictions validate_candidate(Candidate& c, const Split& split,
       c.failure = piece.motion.name + ": " + run.message;
       return {};
     }
-    if (stretches)
-      run_stretches.push_back(collect_stretches(
-          ReconstructionMesh(piece.motion.scene.mesh, nominal), run.positions, sampling));
     const std::vector<VecX> compared(
         run.positions.begin() + piece.first_frame, run.positions.end());
     errors.push_back(observation_error(compared, piece.motion.observed));
@@ -236,8 +249,6 @@ CandidatePredictions validate_candidate(Candidate& c, const Split& split,
   }
   c.validation = combined_error(errors);
   c.training = combined_error(training_errors);
-  if (stretches)
-    *stretches = stacked_rows(run_stretches, 3);
   if (c.correction) {
     for (const HeldOut& piece : split.validation) {
       // The first substepped frame of the first motion that needed substeps is kept.
@@ -509,7 +520,14 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // compare with the recorded ones.
   for (Motion& m : split.training)
     m.scene.material = result.fitted_nominal;
-  if (!run_learning(split.training, options.loop, result.loop, callbacks.loop)) {
+  // The forward fit's steps must be stable where the validation will require it, else its last
+  // step, the main candidate, is not eligible and its steps were spent for nothing.
+  const MatX reachable
+      = reference_reachable_stretches(split, options.fit_parameters ? result.fitted_nominal : given,
+          options.loop.stretch_samples, callbacks.loop.progress);
+  LearningOptions loop_options = options.loop;
+  loop_options.forward_fit.stability_stretches = reachable;
+  if (!run_learning(split.training, loop_options, result.loop, callbacks.loop)) {
     result.interrupted = true;
     return result;
   }
@@ -523,9 +541,6 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
                      .num_unknowns()
                : 0;
   };
-  const CandidateKind reference_kind
-      = options.fit_parameters ? CandidateKind::FittedNominal : CandidateKind::Nominal;
-  MatX reachable; // where a correction must be stable: around the reference's held-out runs
   auto add = [&](CandidateKind kind, int iteration,
                  std::shared_ptr<const material::Correction> correction) {
     Candidate c;
@@ -535,13 +550,9 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     const fem::MaterialModel& material
         = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
     c.unknowns = fitted_unknowns(c.correction.get());
-    MatX reference_stretches;
-    CandidatePredictions p = validate_candidate(c, split, material,
-        kind == reference_kind ? &reference_stretches : nullptr, options.loop.stretch_samples);
+    CandidatePredictions p = validate_candidate(c, split, material);
     held_out.predictions.push_back(std::move(p.held_out));
     trained.predictions.push_back(std::move(p.training));
-    if (kind == reference_kind)
-      reachable = reachable_stretches(*material.elastic, reference_stretches);
     if (c.correction && c.completed)
       c.stability = material_stability(*material.elastic, c.correction.get(), reachable);
     std::string label = "candidate " + to_string(kind);

@@ -9,7 +9,9 @@
 ///      differentiated raw, while every comparison of a simulation with the data uses the
 ///      recorded positions (Motion::smoothed);
 ///   2. parameter fit: E, ν, α₀, α₁ of the nominal model fitted to the training data;
-///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit;
+///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit, whose
+///      steps must be stable where stage 4 will check its last one (the reachable stretches of
+///      the fitted nominal's runs of the whole motions);
 ///   4. validation: every candidate (the given nominal, the fitted nominal, the loop's
 ///      corrections with the lowest training errors and the forward fit's last accepted step)
 ///      simulates the held-out data; among those

@@ -185,13 +185,16 @@ Vec3 RbfCorrection::energy_kernels_sum(const Vec3& stretches, Mat3* hessian) con
                 dy = stretches[1] - m_energy_y.segment<4>(j),
                 dz = stretches[2] - m_energy_z.segment<4>(j);
     const Lanes r2 = dx * dx + dy * dy + dz * dz + eps2;
-    // ε = 0 at a copy: the subgradient 0 (Eigen's select would not run packed).
-    const Lanes inv = (r2 > 0).select(m_energy_w.segment<4>(j) / r2.sqrt(), 0.0);
+    // ε = 0 at a copy: the subgradient 0 (Eigen's select would not run packed). One division per
+    // copy, 1/φ: the square root and the divisions bound this loop, the simulator's hottest with
+    // a learned correction.
+    const Lanes inv_phi = (r2 > 0).select(r2.sqrt().inverse(), 0.0);
+    const Lanes inv = m_energy_w.segment<4>(j) * inv_phi;
     gx += inv * dx;
     gy += inv * dy;
     gz += inv * dz;
     if (hessian) {
-      const Lanes inv3 = (r2 > 0).select(inv / r2, 0.0);
+      const Lanes inv3 = inv * inv_phi * inv_phi;
       diag += inv;
       hxx += inv3 * dx * dx;
       hyy += inv3 * dy * dy;
