@@ -302,8 +302,9 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
       // Checked where a motion of another kind may go (the fitted nominal's reachable grid).
       EXPECT_GT(k.stability.samples, 0);
       // The forward fit only took steps stable there.
-      if (k.kind == CandidateKind::ForwardFit)
+      if (k.kind == CandidateKind::ForwardFit) {
         EXPECT_TRUE(k.stability.stable());
+      }
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);
@@ -416,8 +417,9 @@ TEST(LearningRecipe, TheHeldOutFramesTakeNoPartInLearning) {
   for (const auto& [iteration, correction] : a.loop.tried) {
     const auto& other = b.loop.tried.at(iteration);
     ASSERT_EQ(correction == nullptr, other == nullptr);
-    if (correction)
+    if (correction) {
       EXPECT_EQ(correction->parameters().weights, other->parameters().weights) << iteration;
+    }
   }
   EXPECT_NE(a.candidates[0].validation.rms, b.candidates[0].validation.rms);
 }

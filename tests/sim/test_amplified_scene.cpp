@@ -59,9 +59,11 @@ TEST(AmplifiedScene, ScalesEveryDriveSoThatASmallMotionScalesLinearly) {
 
 TEST(AmplifiedScene, ScalesKeyframesAndARecordedInitialState) {
   sim::Scene scene = stiff_bar();
-  scene.keyframes.push_back({ .vertices = mesh::vertices_with_max_coordinate(scene.mesh, 0, 1e-9),
-      .amplitude = Vec3(0, 1e-5, 0),
-      .frequency = 100 });
+  sim::KeyframeMotion cap;
+  cap.vertices = mesh::vertices_with_max_coordinate(scene.mesh, 0, 1e-9);
+  cap.amplitude = Vec3(0, 1e-5, 0);
+  cap.frequency = 100;
+  scene.keyframes.push_back(cap);
   scene.loads.clear();
   // Start from a frame of the swing, recorded.
   const auto swing = sim::simulate_positions(scene);
