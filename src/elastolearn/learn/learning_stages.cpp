@@ -306,15 +306,14 @@ ForwardFitStart forward_fit_start(std::span<const Motion> motions,
   fit_options.max_iterations = remaining_steps;
   if (damping > 0)
     fit_options.damping = damping;
-  // The caller's samples (the recipe's: where its validation requires stability) stay
-  // required, next to the best correction's own runs'.
-  if (stretches.rows() > 0) {
-    std::vector<MatX> samples { stability_samples(
-        *motions.front().scene.material.elastic, stretches) };
-    if (options.forward_fit.stability_stretches.rows() > 0)
-      samples.push_back(options.forward_fit.stability_stretches);
-    fit_options.stability_stretches = stacked_rows(samples, 3);
-  }
+  // The best correction's own runs' samples, and the caller's (the recipe's: where its
+  // validation requires stability), which stay required.
+  std::vector<MatX> samples;
+  if (stretches.rows() > 0)
+    samples.push_back(stability_samples(*motions.front().scene.material.elastic, stretches));
+  if (options.forward_fit.stability_stretches.rows() > 0)
+    samples.push_back(options.forward_fit.stability_stretches);
+  fit_options.stability_stretches = stacked_rows(samples, 3);
   return { std::move(design), std::move(start), std::move(fit_options) };
 }
 
