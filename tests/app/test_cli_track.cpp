@@ -17,6 +17,12 @@ namespace {
 using elastolearn::test::run;
 using CliTrackTest = elastolearn::test::CliTestFolder;
 
+/// "'<folder>/": a shell-quoted path prefix into `folder` (built with append: GCC 12 warns
+/// -Wstringop-overflow on "'" + ... wrongly).
+std::string quoted_prefix(const std::filesystem::path& folder) {
+  return std::string("'").append(folder.string()).append("/");
+}
+
 /// A bar swinging under gravity (Young's modulus `young` [Pa]).
 std::string scene(int frames, const std::string& young = "1e5") {
   return R"({
@@ -42,8 +48,7 @@ TEST_F(CliTrackTest, TracksScansOfASimulationAndWritesATrajectory) {
   write("bar.json", scene(10));
   write("stiff.json", scene(10, "2e5")); // the nominal: E 2× too stiff
   write("cam.json", kCameras);
-  // append, not "'" + ...: GCC 12 warns -Wstringop-overflow on that wrongly
-  const std::string d = std::string("'").append(m_dir.string()).append("/");
+  const std::string d = quoted_prefix(m_dir);
   auto r = run("simulate " + d + "stiff.json' -o " + d + "stiff.h5' -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = run("simulate " + d + "bar.json' -o " + d + "bar.h5' -q");
@@ -87,8 +92,7 @@ TEST_F(CliTrackTest, CloudsWithOtherFramesThanTheSceneAreOneError) {
   write("bar.json", scene(10));
   write("short.json", scene(6));
   write("cam.json", kCameras);
-  // append, not "'" + ...: GCC 12 warns -Wstringop-overflow on that wrongly
-  const std::string d = std::string("'").append(m_dir.string()).append("/");
+  const std::string d = quoted_prefix(m_dir);
   ASSERT_EQ(run("simulate " + d + "bar.json' -o " + d + "bar.h5' -q").exit_code, 0);
   ASSERT_EQ(
       run("scan " + d + "bar.h5' --camera " + d + "cam.json' -q -o " + d + "c.h5'").exit_code, 0);
