@@ -91,8 +91,8 @@ double g_damping_regularization = -1, g_regularization = -1, g_position_weight =
        g_kernel_smoothing = -1, g_full_space_weight = -1, g_damping_prior = -1,
        g_elastic_prior = -1, g_smoothness = -1, g_forward_fit_tolerance = -1;
 bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
-     g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false,
-     g_no_backtrack = false;
+     g_full_space = false, g_no_damping = false, g_smooth_clamp = false, g_pod_forward_only = false,
+     g_unprojected = false, g_no_backtrack = false;
 
 void apply_overrides(learn::LearningOptions& o) {
   if (g_modes > 0)
@@ -121,6 +121,8 @@ void apply_overrides(learn::LearningOptions& o) {
     o.rbf.damping_regularization = g_damping_regularization;
   if (g_smoothness >= 0)
     o.rbf.smoothness = g_smoothness;
+  if (g_smooth_clamp)
+    o.rbf.continuation = material::Continuation::smooth_clamp;
   if (g_linear_tail)
     o.rbf.quadratic_tail = false;
   if (g_neo_hookean_tail)
@@ -490,6 +492,8 @@ int main(int argc, char** argv) {
       g_forward_fit_tolerance = std::stod(argv[++i]);
     else if (a == "--no-damping")
       g_no_damping = true;
+    else if (a == "--smooth-clamp")
+      g_smooth_clamp = true;
     else if (a == "--position-weight" && i + 1 < argc)
       g_position_weight = std::stod(argv[++i]);
     else if (a == "--unprojected-reconstruction")
@@ -516,7 +520,7 @@ int main(int argc, char** argv) {
                   "[--smoothness L] "
                   "[--stress-kernels] [--linear-tail] [--neo-hookean-tail] "
                   "[--damping-quadratic-tail] [--full-space] "
-                  "[--pod-forward-only] [--no-damping] [--position-weight W] "
+                  "[--pod-forward-only] [--no-damping] [--smooth-clamp] [--position-weight W] "
                   "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\n"
                   "       bench_learning --random N [--seed S] [--random-case I] [--draw-only] "
                   "[--noise PCT] [--data DIR]\n       (either form) [--test-candidates]\ncases:");
@@ -555,8 +559,11 @@ int main(int argc, char** argv) {
         "--noise-pair\n");
     return 2;
   }
+  apply_overrides(g_recipe.loop);
   if (random_cases > 0 || random_case >= 0) {
     RandomRunOptions options;
+    options.recipe = g_recipe; // the expert flags apply to every case alike
+    options.recipe.loop.seed = learn::RecipeOptions().loop.seed; // --seed is the draw's here
     options.count = random_cases;
     options.only = random_case;
     options.seed = g_seed;
@@ -572,7 +579,6 @@ int main(int argc, char** argv) {
     names = kCases;
   std::printf("bench_learning%s: %zu case(s), %u hardware threads\n", quick ? " --quick" : "",
       names.size(), std::thread::hardware_concurrency());
-  apply_overrides(g_recipe.loop);
   std::printf("the recipe: ≤ %d POD modes, %d kernels (%s), ≤ %d iterations, patience %d, "
               "backtracking %s, ≤ %d forward-fit steps (tolerance %g), smoothness %g, parameter "
               "fit %s\n",

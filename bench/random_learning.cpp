@@ -1,6 +1,7 @@
 // The random cases of `bench_learning --random N --seed S` (issue 19): per drawn case
-// (random_cases.hpp), simulate the truth, learn with the one recipe and its default options, and
-// compare nominal / fitted / learned on the test motion; then the table and issue 19's targets.
+// (random_cases.hpp), simulate the truth, learn with the one recipe (options.recipe: its defaults
+// unless an expert flag changed them), and compare nominal / fitted / learned on the test motion;
+// then the table and issue 19's targets.
 #include "random_learning.hpp"
 
 #include "learning_bench_support.hpp"
@@ -61,7 +62,7 @@ struct Undrawable : std::runtime_error {
 };
 
 /// Print case `index` of `seed`; unless options.draw_only, simulate its truth, learn with the
-/// recipe (default options), and measure nominal / fitted / learned on the test motion (with
+/// recipe (options.recipe), and measure nominal / fitted / learned on the test motion (with
 /// options.test_candidates, every validated candidate too).
 RandomRow run_random_case(std::uint64_t seed, int index, const RandomRunOptions& options) {
   const bool run = !options.draw_only;
@@ -163,11 +164,12 @@ RandomRow run_random_case(std::uint64_t seed, int index, const RandomRunOptions&
       o.mesh.surface_vertices().size());
   std::fflush(stdout);
 
-  // The one recipe, default options: nothing here knows the case.
+  // The one recipe (default options unless an expert flag changed them for every case):
+  // nothing here knows the case.
   const learn::RecipeCallbacks callbacks = printing_callbacks(o.diagonal, "   recipe: ");
   t0 = Clock::now();
-  const auto result
-      = learn::learn_material(std::span<const learn::Motion>(&motion, 1), {}, callbacks);
+  const auto result = learn::learn_material(
+      std::span<const learn::Motion>(&motion, 1), options.recipe, callbacks);
   row.learn_seconds = seconds_since(t0);
   row.fit_seconds = result.parameter_fit.seconds;
   row.fit_diverged = result.parameter_fit.diverged;

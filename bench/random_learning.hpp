@@ -1,6 +1,9 @@
 #pragma once
 // `bench_learning --random N --seed S [--random-case I] [--draw-only]` (issue 19): random cases
-// drawn by random_cases.hpp, each learned by the one recipe with its default options.
+// drawn by random_cases.hpp, each learned by the one recipe (its default options unless an
+// expert flag changes them, for every case alike).
+#include <elastolearn/learn/learning_recipe.hpp>
+
 #include <filesystem>
 
 namespace bench_learning {
@@ -15,6 +18,9 @@ struct RandomRunOptions {
   /// --noise PCT: observation noise σ in % of the diagonal instead of the drawn level (every other
   /// draw unchanged), so that runs at two levels compare the same cases; −1: the drawn level.
   double noise_percent = -1;
+  /// The recipe every case learns with: its defaults unless an expert flag changed them, alike
+  /// for every case.
+  elastolearn::learn::RecipeOptions recipe;
 };
 
 /// --random N / --random-case I: runs `count` random cases of the seed, or with `only` ≥ 0 only

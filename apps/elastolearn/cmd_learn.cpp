@@ -31,6 +31,7 @@ struct LearnOptions {
   bool resume = false;
   bool quiet = false;
   std::string reconstruction = "normal_equations";
+  std::string continuation = "bounded_softening";
   bool no_damping = false;
   bool linear_tail = false;
   bool no_parameter_fit = false;
@@ -131,6 +132,9 @@ void run_learn(const LearnOptions& o) {
   learn::LearningOptions& loop = options.loop;
   loop.reconstruction.method
       = learn::reconstruction_method_from_name(o.reconstruction, "--reconstruction");
+  loop.rbf.continuation = o.continuation == "smooth_clamp"
+      ? material::Continuation::smooth_clamp
+      : material::Continuation::bounded_softening;
   loop.rbf.fit_damping = !o.no_damping;
   loop.rbf.quadratic_tail = !o.linear_tail;
   options.fit_parameters = !o.no_parameter_fit;
@@ -335,6 +339,12 @@ void add_learn_command(CLI::App& root) {
       "RBF with a linear polynomial tail only (default: quadratic)");
   cmd->add_option("--damping-regularization", l.rbf.damping_regularization,
          "Tikhonov weight of the damping correction's unknowns")
+      ->capture_default_str();
+  cmd->add_option("--continuation", o->continuation,
+         "how a correction continues beyond the stretches it was learned from: "
+         "bounded_softening (the edge's stiffness, keeping half the nominal's) | smooth_clamp "
+         "(exact: the ends' uniaxial stress and stiffness; docs/learning_recipe.md)")
+      ->check(CLI::IsMember({ "bounded_softening", "smooth_clamp" }))
       ->capture_default_str();
   cmd->add_option("--smoothness", l.rbf.smoothness,
          "weight of the RBF's smoothness penalty (native-space seminorm of the kernel weights, "

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <initializer_list>
 #include <random>
 
 using namespace elastolearn;
@@ -396,6 +397,37 @@ TEST(RbfFit, NeoHookeanTailExtrapolatesNeoHookeanMinusCorotatedIntoStrongCompres
   }
 }
 
+namespace {
+
+/// A x = N, d x = Δα₁ (with damping unknowns) and the design's derivative = the correction's
+/// tangent at `states`, for the correction of unknowns `x`.
+void expect_design_is_the_correction(
+    const RbfDesign& design, const VecX& x, std::initializer_list<Vec3> states) {
+  const material::RbfCorrection n = design.correction(x);
+  const int u = design.elastic_unknowns();
+  RbfDesign::OutputMatrix a(3, u), b(3, u);
+  RbfDesign::OutputGradient d(9, u);
+  for (const Vec3& s : states) {
+    SCOPED_TRACE(testing::Message() << "σ = " << s.transpose());
+    design.output_matrix(s, a);
+    design.output_matrix(s, b, d);
+    const Vec3 expected = n.correction(s, Vec3::Zero());
+    EXPECT_LE((a * x.head(u) - expected).norm(), 1e-9 * expected.norm());
+    EXPECT_LE((b * x.head(u) - expected).norm(), 1e-9 * expected.norm());
+    Mat3 tangent, unused;
+    n.correction_gradient(s, Vec3::Zero(), tangent, unused);
+    EXPECT_LE(((d * x.head(u)).reshaped(3, 3) - tangent).norm(), 1e-9 * tangent.norm());
+    if (design.damping_unknowns() > 0) {
+      Eigen::RowVectorXd row(design.damping_unknowns());
+      design.damping_row(s, row);
+      const double alpha = row * x.tail(design.damping_unknowns());
+      EXPECT_NEAR(alpha, n.stiffness_damping(s), 1e-12 * (1 + std::abs(alpha)));
+    }
+  }
+}
+
+} // namespace
+
 TEST(RbfDesign, BeyondTheTrustedStretchesTheDesignContinuesAsTheCorrection) {
   // A x = N everywhere, also where the correction continues beyond its trusted interval, and
   // the design's derivative is the correction's tangent there (the forward fit's Jacobian): so
@@ -409,22 +441,23 @@ TEST(RbfDesign, BeyondTheTrustedStretchesTheDesignContinuesAsTheCorrection) {
   EXPECT_EQ(n.parameters().trusted.min, 0.9);
   EXPECT_EQ(n.parameters().trusted.max, 1.15);
   EXPECT_LE((design.unknowns(n) - x).norm(), 1e-12 * x.norm());
-  const int u = design.elastic_unknowns();
-  RbfDesign::OutputMatrix a(3, u), b(3, u);
-  RbfDesign::OutputGradient d(9, u);
-  for (const Vec3& s : { Vec3(1.5, 0.93, 0.97), Vec3(0.6, 1.3, 1.0), Vec3(1.05, 1.0, 0.95) }) {
-    SCOPED_TRACE(testing::Message() << "σ = " << s.transpose());
-    design.output_matrix(s, a);
-    design.output_matrix(s, b, d);
-    const Vec3 expected = n.correction(s, Vec3::Zero());
-    EXPECT_LE((a * x.head(u) - expected).norm(), 1e-9 * expected.norm());
-    EXPECT_LE((b * x.head(u) - expected).norm(), 1e-9 * expected.norm());
-    Mat3 tangent, unused;
-    n.correction_gradient(s, Vec3::Zero(), tangent, unused);
-    const Mat3 from_design = (d * x.head(u)).reshaped(3, 3);
-    EXPECT_LE((from_design - tangent).norm(), 1e-9 * tangent.norm());
-  }
+  expect_design_is_the_correction(
+      design, x, { Vec3(1.5, 0.93, 0.97), Vec3(0.6, 1.3, 1.0), Vec3(1.05, 1.0, 0.95) });
   EXPECT_THROW(RbfDesign(centres, options).unknowns(n), InputError) << "another interval";
+  // The smooth clamp is linear in x where its end stiffness is above its floor (here
+  // everywhere), so A x = N and the derivatives agree exactly, in the transition and far
+  // beyond, one end or both; Δα₁ is read at φ(σ) too.
+  material::TrustedStretches clamp { 0.9, 1.15, material::Continuation::smooth_clamp };
+  clamp.clamp_width = 0.1;
+  clamp.nominal_stiffness = 1e12 * (Mat3::Identity() + Mat3::Ones()); // the floor is inactive
+  clamp.kept_stiffness = 0;
+  RbfFitOptions damped = options;
+  damped.fit_damping = true;
+  const RbfDesign clamped(centres, damped, clamp);
+  ASSERT_GT(clamped.damping_unknowns(), 0);
+  expect_design_is_the_correction(clamped, random_unknowns(clamped, 6),
+      { Vec3(1.5, 0.93, 0.97), Vec3(0.6, 1.3, 1.0), Vec3(1.2, 1.0, 0.95), Vec3(1.18, 1.17, 0.86),
+          Vec3(1.05, 1.0, 0.95) });
   RbfFitOptions stress = options;
   stress.energy_kernels = false;
   EXPECT_THROW(RbfDesign(centres, stress, { 0.9, 1.15 }), InputError);

@@ -565,7 +565,142 @@ TEST(RbfCorrectionEnergy, RejectsAnInvalidTrustedInterval) {
   EXPECT_THROW(RbfCorrection { p }, InputError) << "K₀ not positive definite";
   p.trusted.nominal_stiffness.setZero();
   EXPECT_THROW(RbfCorrection { p }, InputError) << "bounded without K₀";
+  p.trusted = trusted_interval(Continuation::smooth_clamp);
+  EXPECT_NO_THROW(RbfCorrection { p });
+  p.trusted.clamp_width = 0;
+  EXPECT_THROW(RbfCorrection { p }, InputError) << "no transition";
+  p.trusted.clamp_width = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(RbfCorrection { p }, InputError) << "NaN width";
   RbfCorrection::Parameters stress = test_parameters(0.03);
   stress.trusted.max = 1.2;
   EXPECT_THROW(RbfCorrection { stress }, InputError) << "stress kernels have no energy";
+}
+
+namespace {
+
+/// energy_correction() trusted in [0.9, 1.2], continued by the smooth clamp (w = 0.1).
+RbfCorrection clamped_correction() {
+  RbfCorrection::Parameters p = energy_correction().parameters();
+  p.trusted = trusted_interval(Continuation::smooth_clamp);
+  p.trusted.clamp_width = 0.1;
+  return RbfCorrection(std::move(p));
+}
+
+/// Far beyond, in the transition, at a tie beyond, and beyond both ends at once; none at the
+/// transition's far end max + w, where the third derivative of φ jumps and central differences
+/// lose their order.
+const std::vector<Vec3> k_clamped_states { Vec3(1.6, 1.0, 0.95), Vec3(1.25, 1.02, 0.95),
+  Vec3(1.24, 1.24, 0.92), Vec3(1.4, 1.33, 0.6), Vec3(0.85, 1.1, 1.6), Vec3(1.8, 1.01, 0.99) };
+
+} // namespace
+
+TEST(RbfCorrectionEnergy, TheSmoothClampIsAnExactEnergyEverywhere) {
+  // ΔΨ(φ(σ)) + Σ gᵢ(σᵢ − φᵢ): N is its gradient and the tangent N's derivative, symmetric, at
+  // every state beyond the interval, mixed ones included (stretches inside and outside at once).
+  const RbfCorrection n = clamped_correction();
+  for (const Vec3& s : k_clamped_states) {
+    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+    expect_stress_is_energy_gradient(n, s);
+    // Beyond both ends every stretch is saturated and the tangent is zero: its differences are
+    // round-off, ~1e-16 |N| / h ≈ 1e-8 Pa: the floor 1e7 Pa allows 1 Pa of error wherever the
+    // tangent is smaller (elsewhere it is ~1e4–1e6 Pa).
+    expect_gradient_matches_fd(n, s, Vec3::Zero(), 1e-7, 1e7);
+    Mat3 ds, dr;
+    n.correction_gradient(s, Vec3::Zero(), ds, dr);
+    EXPECT_LE((ds - ds.transpose()).norm(), 1e-10 * ds.norm()) << ds;
+  }
+}
+
+TEST(RbfCorrectionEnergy, TheEdgeExpansionsTangentIsNotTheirStressDerivativeInMixedStates) {
+  // What the smooth clamp fixes: beyond one end with the other stretches inside, the expansion
+  // N(c) + H(c)(σ − c) moves its point c with those stretches, so ∂N/∂σ has third derivatives of
+  // ΔΨ times the distance beyond the end, which its tangent H(c) leaves out: the stretch that
+  // Newton's matrix and the stability check see is not the stress field's.
+  const RbfCorrection n = trusted_energy_correction(Continuation::bounded_softening);
+  const Vec3 s(1.8, 1.01, 0.97);
+  Mat3 ds, dr;
+  n.correction_gradient(s, Vec3::Zero(), ds, dr);
+  Mat3 fd;
+  const double h = 1e-6;
+  for (int j = 0; j < 3; ++j) {
+    Vec3 up = s, down = s;
+    up[j] += h;
+    down[j] -= h;
+    fd.col(j) = (n.elastic_correction(up) - n.elastic_correction(down)) / (2 * h);
+  }
+  EXPECT_GT((fd - ds).norm(), 0.1 * ds.norm()) << "tangent\n" << ds << "\nN's derivative\n" << fd;
+}
+
+TEST(RbfCorrectionEnergy, FarBeyondTheSmoothClampContinuesTheEndsUniaxialStressAndStiffness) {
+  const RbfCorrection unbounded = energy_correction();
+  const RbfCorrection n = clamped_correction();
+  const TrustedStretches& t = n.parameters().trusted;
+  // Inside: the formula itself.
+  const Vec3 inside(1.1, 1.0, 0.95);
+  EXPECT_EQ(n.elastic_correction(inside), unbounded.elastic_correction(inside));
+  // Beyond max + w along σ₁: N₁ is the end's stress and stiffness continued from
+  // (max + w/2, 1, 1), the formula's N₁ and ∂N₁/∂σ₁ there (above the floor for this correction);
+  // the other stretches see the formula at (max + w/2, σ₂, σ₃).
+  Mat3 end_hessian, unused;
+  const double g
+      = unbounded.correction_with_gradient(t.end_point(true), Vec3::Zero(), end_hessian, unused)[0];
+  const double k = end_hessian(0, 0);
+  const Mat3 k0 = bounded_nominal().principal_stress_derivative(Vec3::Ones());
+  ASSERT_GT(k, -0.5 * (k0(0, 0) - k0(0, 1))) << "the test needs an end above the floor";
+  for (const double s1 : { 1.31, 1.6, 3.0 }) {
+    SCOPED_TRACE(testing::Message() << "σ₁ " << s1);
+    const Vec3 s(s1, 1.01, 0.99);
+    Mat3 ds;
+    const Vec3 stress = n.correction_with_gradient(s, Vec3::Zero(), ds, unused);
+    const Vec3 at_phi = unbounded.elastic_correction(Vec3(1.25, 1.01, 0.99));
+    EXPECT_NEAR(stress[0], g + k * (s1 - 1.25), 1e-12 * (std::abs(g) + std::abs(k)));
+    EXPECT_NEAR(stress[1], at_phi[1], 1e-12 * at_phi.norm());
+    EXPECT_NEAR(stress[2], at_phi[2], 1e-12 * at_phi.norm());
+    EXPECT_NEAR(ds(0, 0), k, 1e-12 * std::abs(k));
+    EXPECT_EQ(ds.row(0).tail<2>().norm(), 0);
+    EXPECT_EQ(ds.col(0).tail<2>().norm(), 0);
+    // So the twist of the two stretches inside stays the formula's there, however far σ₁ goes
+    // (an expansion at the edge adds third derivatives of ΔΨ times the distance to it).
+    Mat3 h;
+    unbounded.correction_gradient(Vec3(1.25, 1.01, 0.99), Vec3::Zero(), h, unused);
+    EXPECT_LE((ds.bottomRightCorner<2, 2>() - h.bottomRightCorner<2, 2>()).norm(), 1e-9 * h.norm());
+    // Δα₁ is the data's near the edge too, not its tails' far beyond.
+    EXPECT_EQ(n.stiffness_damping(s), unbounded.stiffness_damping(Vec3(1.25, 1.01, 0.99)));
+  }
+  // C² at both ends of the transition: the tangent is continuous at max and at max + w.
+  for (const double edge : { 1.2, 1.3 }) {
+    SCOPED_TRACE(testing::Message() << "edge " << edge);
+    Mat3 below, above;
+    const double step = 1e-7;
+    n.correction_gradient(Vec3(edge - step, 1.0, 0.95), Vec3::Zero(), below, unused);
+    n.correction_gradient(Vec3(edge + step, 1.0, 0.95), Vec3::Zero(), above, unused);
+    EXPECT_LE((above - below).norm(), 1e-4 * below.norm());
+  }
+}
+
+TEST(RbfCorrectionEnergy, FarBeyondTheSmoothClampTheCorrectedModelKeepsItsShearStiffness) {
+  // A correction that removes more than the nominal's stiffness near the interval's lower end:
+  // far beyond it, along the stretch beyond, the corrected corotated model keeps β of its rest
+  // shear stiffness 2μ (the end stiffness at its floor), where the edge Hessian's expansion is
+  // unstable.
+  RbfCorrection::Parameters p = softening_correction(Continuation::edge_hessian).parameters();
+  p.trusted = trusted_interval(Continuation::smooth_clamp);
+  const RbfCorrection n(std::move(p));
+  const RbfCorrection hessian = softening_correction(Continuation::edge_hessian);
+  const Mat3 k0 = bounded_nominal().principal_stress_derivative(Vec3::Ones());
+  const double floor = -(1 - kKeptStiffness) * (k0(0, 0) - k0(0, 1));
+  Mat3 end_hessian, unused;
+  hessian.correction_gradient(
+      n.parameters().trusted.end_point(false), Vec3::Zero(), end_hessian, unused);
+  ASSERT_LT(end_hessian(0, 0), floor) << "the test needs an end below the floor";
+  for (const Vec3& s : { Vec3(1.0, 0.95, 0.6), Vec3(1.0, 0.95, 0.4) }) {
+    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+    const CorrectedStress c = corrected_principal_stress(bounded_nominal(), &n, s, Vec3::Zero());
+    const Mat3 k = bounded_nominal().principal_stress_derivative(s);
+    EXPECT_NEAR(c.d_stretches(2, 2), k(2, 2) + floor, 1e-9 * k.norm());
+    EXPECT_GT(c.d_stretches(2, 2), 0);
+    const CorrectedStress e
+        = corrected_principal_stress(bounded_nominal(), &hessian, s, Vec3::Zero());
+    EXPECT_LT(e.d_stretches(2, 2), 0) << "the edge Hessian's expansion";
+  }
 }

@@ -46,17 +46,27 @@ Json trusted_to_json(const material::TrustedStretches& t) {
 }
 
 const char* to_string(material::Continuation c) {
-  return c == material::Continuation::edge_hessian ? "edge_hessian" : "bounded_softening";
+  switch (c) {
+  case material::Continuation::edge_hessian:
+    return "edge_hessian";
+  case material::Continuation::bounded_softening:
+    return "bounded_softening";
+  case material::Continuation::smooth_clamp:
+    return "smooth_clamp";
+  }
+  return "edge_hessian";
 }
 
 /// "continuation" (and its bound) next to "trusted_stretches" in `out`.
 void continuation_to_json(const material::TrustedStretches& t, Json& out) {
   out["trusted_stretches"] = trusted_to_json(t);
   out["continuation"] = to_string(t.continuation);
-  if (t.continuation == material::Continuation::bounded_softening) {
+  if (t.continuation != material::Continuation::edge_hessian) {
     out["nominal_stiffness"] = rows_to_json(t.nominal_stiffness);
     out["kept_stiffness"] = t.kept_stiffness;
   }
+  if (t.continuation == material::Continuation::smooth_clamp)
+    out["clamp_width"] = t.clamp_width;
 }
 
 Json rbf_to_json(const material::RbfCorrection& c) {
@@ -142,16 +152,21 @@ MatX read_rows(const JsonObject& o, const std::string& key, Eigen::Index rows, E
 }
 
 /// A correction's "trusted_stretches" and how it is continued beyond them ("continuation", with
-/// "nominal_stiffness" and "kept_stiffness" for bounded_softening); absent (older files):
+/// "nominal_stiffness" and "kept_stiffness" for bounded_softening and smooth_clamp,
+/// "clamp_width" for smooth_clamp); absent (older files):
 /// unbounded, and continued with the edge's Hessian as those files were.
 material::TrustedStretches trusted_from_json(const JsonObject& o) {
   material::TrustedStretches t;
-  if (o.choice("continuation", { "edge_hessian", "bounded_softening" }, "edge_hessian")
-      == "bounded_softening") {
-    t.continuation = material::Continuation::bounded_softening;
+  const std::string continuation = o.choice(
+      "continuation", { "edge_hessian", "bounded_softening", "smooth_clamp" }, "edge_hessian");
+  if (continuation != "edge_hessian") {
+    t.continuation = continuation == "smooth_clamp" ? material::Continuation::smooth_clamp
+                                                    : material::Continuation::bounded_softening;
     t.nominal_stiffness = read_rows(o, "nominal_stiffness", 3, 3);
     t.kept_stiffness = o.number("kept_stiffness");
   }
+  if (t.continuation == material::Continuation::smooth_clamp)
+    t.clamp_width = o.number("clamp_width");
   if (!o.has("trusted_stretches"))
     return t;
   const Json& j = o.json().at("trusted_stretches");
@@ -184,7 +199,7 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
   o.reject_unknown_keys({ "type", "energy_kernels", "epsilon", "centres", "weights", "own_slope",
       "other_slope", "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes",
       "damping_slope", "damping_constant", "damping_quadratic", "damping_floor",
-      "trusted_stretches", "continuation", "nominal_stiffness", "kept_stiffness" });
+      "trusted_stretches", "continuation", "nominal_stiffness", "kept_stiffness", "clamp_width" });
   material::RbfCorrection::Parameters p;
   p.energy_kernels = o.boolean("energy_kernels", false); // absent: the stress kernels
   p.epsilon = o.number("epsilon");
@@ -225,7 +240,7 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
 std::shared_ptr<const material::Correction> nn_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "kind", "activation", "input_mean", "input_scale", "output_mean",
       "output_scale", "polynomial", "layers", "damping", "trusted_stretches", "continuation",
-      "nominal_stiffness", "kept_stiffness" });
+      "nominal_stiffness", "kept_stiffness", "clamp_width" });
   material::NnCorrection::Parameters p;
   // Absent: the stress network with ELU (files written before the energy network).
   p.kind = o.has("kind") && o.choice("kind", { "stress", "energy" }) == "energy"

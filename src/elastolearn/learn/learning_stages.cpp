@@ -119,15 +119,15 @@ MatX trajectory_stretches(std::span<const ReconstructionMesh> meshes,
 
 /// The corrections' trusted stretches (material/trusted_stretches.hpp): the interval of every
 /// principal stretch of `stretches`, the trajectories a correction is learned from. With energy
-/// kernels a correction continues beyond it with the stiffness at its edge, keeping at least
-/// half of the nominal's rest stiffness (Continuation::bounded_softening); stress kernels are not
-/// continued.
+/// kernels a correction is continued beyond it as rbf.continuation says, either keeping at least
+/// half of the nominal's rest stiffness in every direction (bounded_softening) or half of its
+/// shear stiffness along a stretch beyond (smooth_clamp); stress kernels are not continued.
 material::TrustedStretches trusted_interval(
     const MatX& stretches, const RbfFitOptions& rbf, const material::ElasticModel& nominal) {
   if (!rbf.energy_kernels || stretches.size() == 0)
     return {};
   material::TrustedStretches trusted { stretches.minCoeff(), stretches.maxCoeff() };
-  trusted.continuation = material::Continuation::bounded_softening;
+  trusted.continuation = rbf.continuation;
   trusted.nominal_stiffness = nominal.principal_stress_derivative(Vec3::Ones());
   return trusted;
 }

@@ -34,6 +34,8 @@ template <typename Kernel> MatX unit_trace_seminorm(int m, const Kernel& kernel)
 } // namespace
 
 void RbfFitOptions::validate() const {
+  if (continuation == material::Continuation::edge_hessian)
+    fail("continuation", "learning continues with bounded_softening or smooth_clamp");
   if (!std::isfinite(epsilon) || epsilon < 0)
     fail("epsilon", "must be finite and ≥ 0, got " + to_text(epsilon));
   if (!std::isfinite(regularization) || regularization < 0)
@@ -104,6 +106,17 @@ RbfDesign::RbfDesign(
     if (m_damping > 0)
       m_damping_seminorm = unit_trace_seminorm(m, plain_kernel);
   }
+  if (m_trusted.continuation == material::Continuation::smooth_clamp) {
+    m_end_rows.setZero(4, m_elastic);
+    OutputMatrix a(3, m_elastic);
+    OutputGradient d(9, m_elastic);
+    for (int end = 0; end < 2; ++end)
+      if (std::isfinite(end == 0 ? m_trusted.max : m_trusted.min)) {
+        formula_matrix(m_trusted.end_point(end == 0), a, d);
+        m_end_rows.row(end) = a.row(0);
+        m_end_rows.row(2 + end) = d.row(0);
+      }
+  }
 }
 
 namespace {
@@ -120,13 +133,54 @@ const Eigen::Matrix<double, 4, 3>& energy_tail_map() {
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
   if (m_trusted.nearest(stretches) != stretches) {
-    // Outside the trusted interval (energy kernels only): the continuation needs ∂A/∂σ. Per
+    if (m_trusted.continuation == material::Continuation::smooth_clamp) {
+      formula_columns(m_trusted.formula_stretches(stretches), out);
+      clamp_rows(stretches, out);
+      return;
+    }
+    // Outside the trusted interval (energy kernels only): the expansion needs ∂A/∂σ. Per
     // thread, sized once per design size: no allocation in the per-element loops.
     thread_local OutputGradient gradient;
     gradient.resize(9, out.cols());
     output_matrix(stretches, out, gradient);
     return;
   }
+  formula_columns(stretches, out);
+}
+
+void RbfDesign::clamp_rows(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
+  for (int k = 0; k < 3; ++k) {
+    const material::ClampedStretch c = m_trusted.smooth_clamp(stretches[k]);
+    if (c.slope == 1 && c.curvature == 0)
+      continue;
+    const int end = stretches[k] > m_trusted.max ? 0 : 1;
+    out.row(k) = c.slope * out.row(k)
+        + (1 - c.slope)
+            * (m_end_rows.row(end) + (stretches[k] - c.value) * m_end_rows.row(2 + end));
+  }
+}
+
+void RbfDesign::clamp_gradient(const Vec3& stretches, Eigen::Ref<const OutputMatrix> out,
+    Eigen::Ref<OutputGradient> gradient) const {
+  // Row 3j + k is ∂A(k, ·)/∂σ_j: φ'_k φ'_j ∂A(k, ·)/∂φ_j, plus, for j = k,
+  // φ''_k (A_k(φ) − G_k − d_k K_k) + (1 − φ'_k)² K_k.
+  for (int k = 0; k < 3; ++k) {
+    const material::ClampedStretch c = m_trusted.smooth_clamp(stretches[k]);
+    if (c.slope == 1 && c.curvature == 0)
+      continue;
+    for (int j = 0; j < 3; ++j) {
+      gradient.row(3 * j + k) *= c.slope;
+      gradient.row(3 * k + j) *= c.slope;
+    }
+    const int end = stretches[k] > m_trusted.max ? 0 : 1;
+    const double d = stretches[k] - c.value;
+    gradient.row(3 * k + k)
+        += c.curvature * (out.row(k) - m_end_rows.row(end) - d * m_end_rows.row(2 + end))
+        + (1 - c.slope) * (1 - c.slope) * m_end_rows.row(2 + end);
+  }
+}
+
+void RbfDesign::formula_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
   if (m_options.energy_kernels)
     for (Eigen::Index i = 0; i < m_centres.rows(); ++i)
       out.col(i) = material::energy_kernel_gradient(
@@ -165,6 +219,12 @@ void RbfDesign::view_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
     Eigen::Ref<OutputGradient> gradient) const {
   const Vec3 c = m_trusted.nearest(stretches);
+  if (c != stretches && m_trusted.continuation == material::Continuation::smooth_clamp) {
+    formula_matrix(m_trusted.formula_stretches(stretches), out, gradient);
+    clamp_gradient(stretches, out, gradient);
+    clamp_rows(stretches, out);
+    return;
+  }
   formula_matrix(c, out, gradient);
   if (c == stretches)
     return;
@@ -232,7 +292,7 @@ void RbfDesign::damping_row(const Vec3& stretches, Eigen::Ref<Eigen::RowVectorXd
   if (m_damping == 0)
     return;
   const Eigen::Index m = m_centres.rows();
-  Vec3 s = stretches;
+  Vec3 s = m_trusted.formula_stretches(stretches);
   std::sort(s.data(), s.data() + 3, std::greater<>());
   for (Eigen::Index i = 0; i < m; ++i)
     out[i]

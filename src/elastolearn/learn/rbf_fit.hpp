@@ -16,6 +16,10 @@ struct RbfFitOptions {
   /// gradient of an energy, its tangent symmetric; the quadratic tail then has 3 unknowns (the
   /// cubic energies), not 4.
   bool energy_kernels = false;
+  /// How learning continues an energy correction beyond its trusted stretches
+  /// (material/trusted_stretches.hpp): the edge's bounded Hessian (the recipe), or the exact
+  /// smooth clamp (`learn --continuation smooth_clamp`).
+  material::Continuation continuation = material::Continuation::bounded_softening;
   bool elastic_polynomial
       = true; ///< fit the linear tail a, b (and c, see below) of the elastic part
   /// Keep the rest shape stress-free: N(1, 1, 1) = 0, as for every hyperelastic model. The
@@ -70,15 +74,14 @@ class RbfDesign {
   public:
   using OutputMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic>;
   /// `centres` m × 3 (m ≥ 1, finite). With energy kernels, `trusted` is the corrections' trusted
-  /// stretches (material/trusted_stretches.hpp): A(σ) continues beyond them with the edge's
-  /// Hessian, A(c) + ∂A/∂σ(c)(σ − c), linear in x. N = A x then holds everywhere for
-  /// Continuation::edge_hessian, and for bounded_softening wherever the edge's Hessian is within
-  /// the bound; where it is not, N is not linear in x beyond the edge, and A x is its
-  /// continuation with that Hessian unbounded. Only the forward fit's sensitivities evaluate A
-  /// there (the reconstruction's states are inside the interval by its definition), at states
-  /// its training motion reaches just beyond its start's interval; they are then approximate,
-  /// and its steps are accepted on simulated errors. Throws InputError for invalid options,
-  /// centres or interval.
+  /// stretches (material/trusted_stretches.hpp), and A(σ) continues beyond them as the
+  /// correction does. Continuation::smooth_clamp is linear in x, so N = A x everywhere (and
+  /// Δα₁ = d x, read at φ(σ) too), except beyond an end whose stiffness is at its floor (the
+  /// forward fit's steps are accepted on simulated errors). The expansions continue A with the
+  /// edge's Hessian,
+  /// A(c) + ∂A/∂σ(c)(σ − c): N = A x everywhere for edge_hessian, and for bounded_softening
+  /// wherever the edge's Hessian is within the bound (elsewhere A x is its continuation with that
+  /// Hessian unbounded). Throws InputError for invalid options, centres or interval.
   RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options,
       material::TrustedStretches trusted = {});
   int num_centres() const { return static_cast<int>(m_centres.rows()); }
@@ -119,6 +122,16 @@ class RbfDesign {
   const material::TrustedStretches& trusted() const { return m_trusted; }
 
   private:
+  /// A(σ) without the continuation.
+  void formula_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const;
+  /// smooth_clamp beyond the trusted stretches: `out` holds A at φ(σ) and becomes the
+  /// continuation's, row k φ'_k A_k(φ) + (1 − φ'_k)(G_k + d_k K_k) with G_k, K_k the end rows of
+  /// the end σ_k is beyond and d_k = σ_k − φ_k (material::smoothly_clamped_correction; linear in
+  /// x where the end stiffness is above its floor).
+  void clamp_rows(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const;
+  /// Its derivative: `gradient` holds ∂A/∂φ at φ(σ) and `out` A there (before clamp_rows).
+  void clamp_gradient(const Vec3& stretches, Eigen::Ref<const OutputMatrix> out,
+      Eigen::Ref<OutputGradient> gradient) const;
   /// A(σ) and its derivative, without the continuation.
   void formula_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
       Eigen::Ref<OutputGradient> gradient) const;
@@ -137,6 +150,9 @@ class RbfDesign {
   int m_elastic = 0;
   int m_damping = 0;
   material::TrustedStretches m_trusted;
+  /// smooth_clamp: at TrustedStretches::end_point above and below, row 0 of A (rows 0 and 1:
+  /// G, the end stress) and of ∂A/∂σ₀ (rows 2 and 3: K, the end stiffness, without its floor).
+  Eigen::Matrix<double, 4, Eigen::Dynamic> m_end_rows;
 };
 
 /// Stress samples: row j is one element at one frame.

@@ -414,6 +414,9 @@ NnCorrection::NnCorrection(Parameters p)
     m_energy_kernel.insert(m_energy_kernel.end(), W2 + w * w, W2 + w * w + w);
     m_energy_kernel.insert(m_energy_kernel.end(), w3, w3 + w);
   }
+  if (m_p.kind == NnKind::Energy)
+    m_ends
+        = clamp_ends(m_p.trusted, [&](const Vec3& s, Mat3* h) { return energy_correction(s, h); });
 }
 
 Lanes NnCorrection::stress_lanes(const Lanes* x, Lanes* d_x) const {
@@ -684,7 +687,7 @@ double NnCorrection::elastic_energy(const Vec3& stretches) const {
   if (m_p.kind != NnKind::Energy)
     fail("kind", "a stress network has no energy");
   return continued_energy(
-      m_p.trusted, stretches, [&](const Vec3& s) { return formula_energy(s); },
+      m_p.trusted, m_ends, stretches, [&](const Vec3& s) { return formula_energy(s); },
       [&](const Vec3& s, Mat3* h) { return energy_correction(s, h); });
 }
 
@@ -718,7 +721,7 @@ double NnCorrection::formula_energy(const Vec3& stretches) const {
 
 Vec3 NnCorrection::correction(const Vec3& stretches, const Vec3& stretch_rates) const {
   if (m_p.kind == NnKind::Energy)
-    return continued_correction(m_p.trusted, stretches, nullptr,
+    return continued_correction(m_p.trusted, m_ends, stretches, nullptr,
         [&](const Vec3& s, Mat3* h) { return energy_correction(s, h); });
   return stress_correction(stretches, stretch_rates, nullptr, nullptr);
 }
@@ -727,7 +730,7 @@ Vec3 NnCorrection::correction_with_gradient(
     const Vec3& s, const Vec3& f, Mat3& d_stretches, Mat3& d_stretch_rates) const {
   if (m_p.kind == NnKind::Energy) {
     d_stretch_rates.setZero();
-    return continued_correction(m_p.trusted, s, &d_stretches,
+    return continued_correction(m_p.trusted, m_ends, s, &d_stretches,
         [&](const Vec3& c, Mat3* h) { return energy_correction(c, h); });
   }
   return stress_correction(s, f, &d_stretches, &d_stretch_rates);

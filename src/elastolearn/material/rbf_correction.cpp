@@ -170,6 +170,7 @@ RbfCorrection::RbfCorrection(Parameters p)
     m_damping_z.head(m) = m_p.centres.col(2);
     m_damping_w.head(m) = m_p.damping_weights;
   }
+  m_ends = clamp_ends(m_p.trusted, [&](const Vec3& s, Mat3* h) { return formula(s, h); });
 }
 
 Vec3 RbfCorrection::energy_kernels_sum(const Vec3& stretches, Mat3* hessian) const {
@@ -217,7 +218,7 @@ double RbfCorrection::elastic_energy(const Vec3& stretches) const {
   if (!m_p.energy_kernels)
     fail("energy_kernels", "the correction is not an energy (stress kernels)");
   return continued_energy(
-      m_p.trusted, stretches, [&](const Vec3& s) { return formula_energy(s); },
+      m_p.trusted, m_ends, stretches, [&](const Vec3& s) { return formula_energy(s); },
       [&](const Vec3& s, Mat3* h) { return formula(s, h); });
 }
 
@@ -313,8 +314,9 @@ Vec3 RbfCorrection::elastic_views(const Mat3& y, Mat3* d_y) const {
 }
 
 double RbfCorrection::stiffness_damping(const Vec3& stretches) const {
-  const auto p = descending_order(stretches);
-  const Vec3 s(stretches[p[0]], stretches[p[1]], stretches[p[2]]);
+  const Vec3 at = m_p.trusted.formula_stretches(stretches);
+  const auto p = descending_order(at);
+  const Vec3 s(at[p[0]], at[p[1]], at[p[2]]);
   const Vec3 e = s - Vec3::Ones();
   double alpha
       = m_p.damping_slopes.dot(e) + m_p.damping_constant + m_p.damping_quadratic.dot(e.cwiseAbs2());
@@ -340,8 +342,8 @@ Vec3 RbfCorrection::correction(const Vec3& stretches, const Vec3& /*stretch_rate
 Vec3 RbfCorrection::correction_with_gradient(const Vec3& stretches, const Vec3& /*stretch_rates*/,
     Mat3& d_stretches, Mat3& d_stretch_rates) const {
   d_stretch_rates.setZero();
-  return continued_correction(
-      m_p.trusted, stretches, &d_stretches, [&](const Vec3& s, Mat3* h) { return formula(s, h); });
+  return continued_correction(m_p.trusted, m_ends, stretches, &d_stretches,
+      [&](const Vec3& s, Mat3* h) { return formula(s, h); });
 }
 
 Vec3 RbfCorrection::formula(const Vec3& stretches, Mat3* d_stretches) const {
@@ -378,8 +380,8 @@ std::unique_ptr<Correction> RbfCorrection::clone() const {
 }
 
 Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
-  return continued_correction(
-      m_p.trusted, stretches, nullptr, [&](const Vec3& s, Mat3* h) { return formula(s, h); });
+  return continued_correction(m_p.trusted, m_ends, stretches, nullptr,
+      [&](const Vec3& s, Mat3* h) { return formula(s, h); });
 }
 
 bool RbfCorrection::has_damping() const {
