@@ -132,9 +132,7 @@ void run_learn(const LearnOptions& o) {
   learn::LearningOptions& loop = options.loop;
   loop.reconstruction.method
       = learn::reconstruction_method_from_name(o.reconstruction, "--reconstruction");
-  loop.rbf.continuation = o.continuation == "smooth_clamp"
-      ? material::Continuation::smooth_clamp
-      : material::Continuation::bounded_softening;
+  loop.rbf.continuation = material::continuation_from_name(o.continuation, "--continuation");
   loop.rbf.fit_damping = !o.no_damping;
   loop.rbf.quadratic_tail = !o.linear_tail;
   options.fit_parameters = !o.no_parameter_fit;

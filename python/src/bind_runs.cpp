@@ -218,6 +218,11 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
         [](S& s, H v) {
           s.recipe.loop.rbf.damping_regularization = value<double>(v, "damping_regularization");
         } },
+    { "continuation",
+        [](S& s, H v) {
+          s.recipe.loop.rbf.continuation = material::continuation_from_name(
+              value<std::string>(v, "continuation"), "continuation");
+        } },
     { "smoothness",
         [](S& s, H v) { s.recipe.loop.rbf.smoothness = value<double>(v, "smoothness"); } },
     { "seed", [](S& s, H v) { s.recipe.loop.seed = value<std::uint64_t>(v, "seed"); } },

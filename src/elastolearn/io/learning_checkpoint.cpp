@@ -14,14 +14,16 @@ constexpr const char* k_format = "elastolearn-learning-checkpoint";
 constexpr int k_version = 3;
 
 /// A checkpoint's options with the fields added since it was written set to the values every run
-/// had before (so that it still resumes under those options): rbf.smoothness 0, backtrack
-/// false, forward_fit.function_tolerance 0.
+/// had before (so that it still resumes under those options): rbf.smoothness 0,
+/// rbf.continuation bounded_softening, backtrack false, forward_fit.function_tolerance 0.
 nlohmann::json with_former_defaults(nlohmann::json options) {
   const auto fill = [](nlohmann::json& loop) {
     if (!loop.is_object())
       return;
     if (loop.contains("rbf") && loop["rbf"].is_object() && !loop["rbf"].contains("smoothness"))
       loop["rbf"]["smoothness"] = 0.0;
+    if (loop.contains("rbf") && loop["rbf"].is_object() && !loop["rbf"].contains("continuation"))
+      loop["rbf"]["continuation"] = "bounded_softening";
     // "patience" marks the loop's object (the recipe's options hold it under "loop").
     if (loop.contains("patience") && !loop.contains("backtrack"))
       loop["backtrack"] = false;
@@ -221,7 +223,8 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
             { "damping_quadratic_tail", o.rbf.damping_quadratic_tail },
             { "regularization", o.rbf.regularization },
             { "damping_regularization", o.rbf.damping_regularization },
-            { "smoothness", o.rbf.smoothness } } },
+            { "smoothness", o.rbf.smoothness },
+            { "continuation", material::continuation_name(o.rbf.continuation) } } },
     { "reconstruction",
         { { "method", learn::reconstruction_method_name(o.reconstruction.method) },
             { "frame_stride", o.reconstruction.frame_stride },

@@ -45,22 +45,10 @@ Json trusted_to_json(const material::TrustedStretches& t) {
       std::isfinite(t.max) ? Json(t.max) : Json(nullptr) });
 }
 
-const char* to_string(material::Continuation c) {
-  switch (c) {
-  case material::Continuation::edge_hessian:
-    return "edge_hessian";
-  case material::Continuation::bounded_softening:
-    return "bounded_softening";
-  case material::Continuation::smooth_clamp:
-    return "smooth_clamp";
-  }
-  return "edge_hessian";
-}
-
 /// "continuation" (and its bound) next to "trusted_stretches" in `out`.
 void continuation_to_json(const material::TrustedStretches& t, Json& out) {
   out["trusted_stretches"] = trusted_to_json(t);
-  out["continuation"] = to_string(t.continuation);
+  out["continuation"] = material::continuation_name(t.continuation);
   if (t.continuation != material::Continuation::edge_hessian) {
     out["nominal_stiffness"] = rows_to_json(t.nominal_stiffness);
     out["kept_stiffness"] = t.kept_stiffness;

@@ -42,6 +42,31 @@ enum class Continuation {
   smooth_clamp, ///< ΔΨ(φ(σ)) + each end's uniaxial stress and stiffness beyond it (exact)
 };
 
+/// The continuation's name in files and options ("edge_hessian", "bounded_softening",
+/// "smooth_clamp").
+inline const char* continuation_name(Continuation c) {
+  switch (c) {
+  case Continuation::edge_hessian:
+    return "edge_hessian";
+  case Continuation::bounded_softening:
+    return "bounded_softening";
+  case Continuation::smooth_clamp:
+    return "smooth_clamp";
+  }
+  return "edge_hessian";
+}
+
+/// The continuation named `name`; throws InputError(`field`, ...) naming the choices otherwise.
+inline Continuation continuation_from_name(const std::string& name, const std::string& field) {
+  for (const Continuation c :
+      { Continuation::edge_hessian, Continuation::bounded_softening, Continuation::smooth_clamp })
+    if (name == continuation_name(c))
+      return c;
+  throw InputError(field,
+      "unknown continuation \"" + name
+          + "\" (expected edge_hessian, bounded_softening or smooth_clamp)");
+}
+
 /// The fraction β of the nominal's rest stiffness a continued correction keeps (learning's).
 inline constexpr double kKeptStiffness = 0.5;
 
