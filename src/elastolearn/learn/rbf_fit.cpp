@@ -107,14 +107,15 @@ RbfDesign::RbfDesign(
       m_damping_seminorm = unit_trace_seminorm(m, plain_kernel);
   }
   if (m_trusted.continuation == material::Continuation::smooth_clamp) {
-    m_end_rows.setZero(4, m_elastic);
+    m_end_stress.setZero(2, m_elastic);
+    m_end_stiffness.setZero(2, m_elastic);
     OutputMatrix a(3, m_elastic);
     OutputGradient d(9, m_elastic);
     for (int end = 0; end < 2; ++end)
       if (std::isfinite(end == 0 ? m_trusted.max : m_trusted.min)) {
         formula_matrix(m_trusted.end_point(end == 0), a, d);
-        m_end_rows.row(end) = a.row(0);
-        m_end_rows.row(2 + end) = d.row(0);
+        m_end_stress.row(end) = a.row(0);
+        m_end_stiffness.row(end) = d.row(0);
       }
   }
 }
@@ -153,10 +154,10 @@ void RbfDesign::clamp_rows(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) 
     const material::ClampedStretch c = m_trusted.smooth_clamp(stretches[k]);
     if (c.slope == 1 && c.curvature == 0)
       continue;
-    const int end = stretches[k] > m_trusted.max ? 0 : 1;
+    const int end = end_row(stretches[k]);
     out.row(k) = c.slope * out.row(k)
         + (1 - c.slope)
-            * (m_end_rows.row(end) + (stretches[k] - c.value) * m_end_rows.row(2 + end));
+            * (m_end_stress.row(end) + (stretches[k] - c.value) * m_end_stiffness.row(end));
   }
 }
 
@@ -172,11 +173,11 @@ void RbfDesign::clamp_gradient(const Vec3& stretches, Eigen::Ref<const OutputMat
       gradient.row(3 * j + k) *= c.slope;
       gradient.row(3 * k + j) *= c.slope;
     }
-    const int end = stretches[k] > m_trusted.max ? 0 : 1;
+    const int end = end_row(stretches[k]);
     const double d = stretches[k] - c.value;
     gradient.row(3 * k + k)
-        += c.curvature * (out.row(k) - m_end_rows.row(end) - d * m_end_rows.row(2 + end))
-        + (1 - c.slope) * (1 - c.slope) * m_end_rows.row(2 + end);
+        += c.curvature * (out.row(k) - m_end_stress.row(end) - d * m_end_stiffness.row(end))
+        + (1 - c.slope) * (1 - c.slope) * m_end_stiffness.row(end);
   }
 }
 

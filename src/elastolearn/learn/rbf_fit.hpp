@@ -78,10 +78,10 @@ class RbfDesign {
   /// correction does. Continuation::smooth_clamp is linear in x, so N = A x everywhere (and
   /// Δα₁ = d x, read at φ(σ) too), except beyond an end whose stiffness is at its floor (the
   /// forward fit's steps are accepted on simulated errors). The expansions continue A with the
-  /// edge's Hessian,
-  /// A(c) + ∂A/∂σ(c)(σ − c): N = A x everywhere for edge_hessian, and for bounded_softening
-  /// wherever the edge's Hessian is within the bound (elsewhere A x is its continuation with that
-  /// Hessian unbounded). Throws InputError for invalid options, centres or interval.
+  /// edge's Hessian, A(c) + ∂A/∂σ(c)(σ − c): N = A x everywhere for edge_hessian, and for
+  /// bounded_softening wherever the edge's Hessian is within the bound (elsewhere A x is its
+  /// continuation with that Hessian unbounded). Throws InputError for invalid options, centres
+  /// or interval.
   RbfDesign(ConstRef<MatX> centres, const RbfFitOptions& options,
       material::TrustedStretches trusted = {});
   int num_centres() const { return static_cast<int>(m_centres.rows()); }
@@ -150,9 +150,11 @@ class RbfDesign {
   int m_elastic = 0;
   int m_damping = 0;
   material::TrustedStretches m_trusted;
-  /// smooth_clamp: at TrustedStretches::end_point above and below, row 0 of A (rows 0 and 1:
-  /// G, the end stress) and of ∂A/∂σ₀ (rows 2 and 3: K, the end stiffness, without its floor).
-  Eigen::Matrix<double, 4, Eigen::Dynamic> m_end_rows;
+  /// smooth_clamp: at TrustedStretches::end_point above (row 0) and below (row 1), row 0 of A
+  /// (G, the end stress) and of ∂A/∂σ₀ (K, the end stiffness, without its floor).
+  Eigen::Matrix<double, 2, Eigen::Dynamic> m_end_stress, m_end_stiffness;
+  /// The row of m_end_stress and m_end_stiffness for a stretch beyond an end.
+  int end_row(double stretch) const { return stretch > m_trusted.max ? 0 : 1; }
 };
 
 /// Stress samples: row j is one element at one frame.

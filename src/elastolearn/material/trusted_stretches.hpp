@@ -147,8 +147,8 @@ struct TrustedStretches {
             * m.eigenvectors().transpose())
         * from_metric;
   }
-  /// Throws InputError(`field`, ...) unless min ≤ max (neither NaN) and, for
-  /// bounded_softening, K₀ is symmetric positive definite and 0 ≤ β ≤ 1.
+  /// Throws InputError(`field`, ...) unless min ≤ max (neither NaN), for bounded_softening and
+  /// smooth_clamp K₀ is symmetric positive definite and 0 ≤ β ≤ 1, and for smooth_clamp w > 0.
   void validate(const std::string& field) const {
     if (std::isnan(min) || std::isnan(max) || !(min <= max))
       throw InputError(field, "must be an interval [min, max] with min ≤ max");
@@ -245,10 +245,10 @@ template <typename Formula>
 Vec3 continued_correction(const TrustedStretches& trusted, const ClampEnds& ends,
     const Vec3& stretches, Mat3* tangent, const Formula& formula) {
   const Vec3 c = trusted.nearest(stretches);
-  if (c != stretches && trusted.continuation == Continuation::smooth_clamp)
-    return smoothly_clamped_correction(trusted, ends, stretches, tangent, formula);
   if (c == stretches)
     return formula(stretches, tangent);
+  if (trusted.continuation == Continuation::smooth_clamp)
+    return smoothly_clamped_correction(trusted, ends, stretches, tangent, formula);
   Mat3 edge;
   const Vec3 n = formula(c, &edge);
   const Mat3 hessian = trusted.continued_hessian(edge);
