@@ -30,7 +30,7 @@ class CliCloudsTest : public elastolearn::test::CliTestFolder {
 };
 
 /// A bar swinging under gravity, 6 frames.
-const char* kScene = R"({
+const char* kSwingingBar = R"({
   "format": "elastolearn-scene/1",
   "mesh": {"type": "box", "size": [0.2, 0.05, 0.05], "cells": [4, 1, 1]},
   "material": {"model": "corotated", "young": 1e5, "poisson": 0.3, "density": 1000},
@@ -40,7 +40,7 @@ const char* kScene = R"({
 })";
 
 /// Two cameras: above and in front of the bar.
-const char* kCameras = R"({"format": "elastolearn-cameras/1", "cameras": [
+const char* kTwoCameras = R"({"format": "elastolearn-cameras/1", "cameras": [
   {"name": "top", "position": [0.1, 0.6, 0.025], "look_at": [0.1, 0, 0.025], "up": [0, 0, -1],
    "resolution": [64, 48], "fov_y": 30},
   {"name": "front", "position": [0.1, 0.0, 0.6], "look_at": [0.1, 0, 0], "resolution": [64, 48],
@@ -65,8 +65,8 @@ double distance_to_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 } // namespace
 
 TEST_F(CliCloudsTest, ScanPutsEveryPointOnTheSimulatedSurfaceAndRepeatsForASeed) {
-  write("bar.json", kScene);
-  write("cam.json", kCameras);
+  write("bar.json", kSwingingBar);
+  write("cam.json", kTwoCameras);
   const std::string d = quoted_folder();
   auto r = run("simulate " + d + "bar.json' -o " + d + "bar.h5' -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -55,7 +55,7 @@ const char* kMaterial = R"({"format": "elastolearn-material/1",
   "material": {"model": "corotated", "young": 1e5, "poisson": 0.3, "density": 1000}})";
 
 /// One camera looking at the bar of kScene from above.
-const char* kCameras = R"({"format": "elastolearn-cameras/1", "cameras": [{"name": "top",
+const char* kTopCamera = R"({"format": "elastolearn-cameras/1", "cameras": [{"name": "top",
   "position": [0.1, 0.5, 0.025], "look_at": [0.1, 0, 0.025], "up": [0, 0, -1],
   "resolution": [16, 12], "fov_y": 40}]})";
 
@@ -198,7 +198,7 @@ void write_base_inputs(const fs::path& dir) {
   write_text(dir / "springs.json", kSprings);
   write_text(dir / "ids.txt", "0 1\n");
   write_text(dir / "notadir", "a regular file: nothing can be created under it\n");
-  write_text(dir / "cam.json", kCameras);
+  write_text(dir / "cam.json", kTopCamera);
   write_text(dir / "frames/frame_1.xyz", "0 0 0\n0.1 0 0\n");
   write_text(dir / "frames/frame_2.xyz", "0 0 0.1\n");
   fs::create_directories(dir / "empty");
@@ -451,11 +451,11 @@ const std::vector<Case> kCases = {
   { "import_negative_dt", nothing(), "import-clouds frames --dt -0.01 -o out.h5", { "--dt" } },
   { "import_output_is_a_frame", nothing(), "import-clouds frames --dt 0.01 -o frames/frame_2.xyz", { "frame_2.xyz", kReplace } },
   { "camera_empty", text("c.json", ""), "scan traj.h5 --camera c.json -o out.h5", { "c.json", "invalid JSON" } },
-  { "camera_unknown_key", text("c.json", edit(kCameras, "\"up\"", "\"upp\"")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].upp" } },
-  { "camera_both_fov_and_intrinsics", text("c.json", edit(kCameras, "\"fov_y\": 40", "\"fov_y\": 40, \"intrinsics\": {\"fx\": 1, \"fy\": 1, \"cx\": 0, \"cy\": 0}")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0]", "exactly one" } },
-  { "camera_infinite_position", text("c.json", edit(kCameras, "0.5", "1e999")), "scan traj.h5 --camera c.json -o out.h5", { "c.json:2:", "1e999" } },
-  { "camera_huge_resolution", text("c.json", edit(kCameras, "[16, 12]", "[100000, 100000]")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].resolution" } },
-  { "camera_looks_at_itself", text("c.json", edit(kCameras, "[0.1, 0, 0.025]", "[0.1, 0.5, 0.025]")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].look_at" } },
+  { "camera_unknown_key", text("c.json", edit(kTopCamera, "\"up\"", "\"upp\"")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].upp" } },
+  { "camera_both_fov_and_intrinsics", text("c.json", edit(kTopCamera, "\"fov_y\": 40", "\"fov_y\": 40, \"intrinsics\": {\"fx\": 1, \"fy\": 1, \"cx\": 0, \"cy\": 0}")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0]", "exactly one" } },
+  { "camera_infinite_position", text("c.json", edit(kTopCamera, "0.5", "1e999")), "scan traj.h5 --camera c.json -o out.h5", { "c.json:2:", "1e999" } },
+  { "camera_huge_resolution", text("c.json", edit(kTopCamera, "[16, 12]", "[100000, 100000]")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].resolution" } },
+  { "camera_looks_at_itself", text("c.json", edit(kTopCamera, "[0.1, 0, 0.025]", "[0.1, 0.5, 0.025]")), "scan traj.h5 --camera c.json -o out.h5", { "c.json: cameras[0].look_at" } },
   { "scan_negative_noise", nothing(), "scan traj.h5 --camera cam.json --noise -1 -o out.h5", { "scan.noise" } },
   { "scan_outliers_above_one", nothing(), "scan traj.h5 --camera cam.json --outliers 2 -o out.h5", { "scan.outliers" } },
   { "scan_trajectory_without_surface", trajectory("t.h5", [](H5Spec& s) { s.i32.erase("/tets"); }), "scan t.h5 --camera cam.json -o out.h5", { "t.h5", "neither /tets nor /faces" } },

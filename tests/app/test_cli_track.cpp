@@ -38,7 +38,7 @@ std::string scene(int frames, const std::string& young = "1e5") {
 
 /// One camera above the front of the bar: it sees the top face, which the sag moves along its
 /// normal.
-const char* kCameras = R"({"format": "elastolearn-cameras/1", "cameras": [
+const char* kCameraAbove = R"({"format": "elastolearn-cameras/1", "cameras": [
   {"name": "above", "position": [0.1, 0.4, 0.4], "look_at": [0.1, 0, 0], "resolution": [160, 120],
    "fov_y": 30}]})";
 
@@ -47,7 +47,7 @@ const char* kCameras = R"({"format": "elastolearn-cameras/1", "cameras": [
 TEST_F(CliTrackTest, TracksScansOfASimulationAndWritesATrajectory) {
   write("bar.json", scene(10));
   write("stiff.json", scene(10, "2e5")); // the nominal: E 2× too stiff
-  write("cam.json", kCameras);
+  write("cam.json", kCameraAbove);
   const std::string d = quoted_prefix(m_dir);
   auto r = run("simulate " + d + "stiff.json' -o " + d + "stiff.h5' -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -91,7 +91,7 @@ TEST_F(CliTrackTest, TracksScansOfASimulationAndWritesATrajectory) {
 TEST_F(CliTrackTest, CloudsWithOtherFramesThanTheSceneAreOneError) {
   write("bar.json", scene(10));
   write("short.json", scene(6));
-  write("cam.json", kCameras);
+  write("cam.json", kCameraAbove);
   const std::string d = quoted_prefix(m_dir);
   ASSERT_EQ(run("simulate " + d + "bar.json' -o " + d + "bar.h5' -q").exit_code, 0);
   ASSERT_EQ(

@@ -18,21 +18,7 @@
 namespace elastolearn::learn {
 namespace {
 
-/// A 0.4 × 0.1 × 0.1 m bar (240 tets) clamped at x = 0, 60 frames of 4 ms, ν = 0.43, α₁ 0.01 s.
-sim::Scene bar(material::ElasticModelType type, double young, bool swing) {
-  sim::Scene s = test::bar_scene({ .cells = { 10, 2, 2 },
-      .model = type,
-      .young = young,
-      .poisson = 0.43,
-      .alpha1 = 0.01,
-      .dt = 4e-3,
-      .frames = 60 });
-  if (swing) {
-    s.initial.kind = sim::InitialCondition::Kind::Velocity;
-    s.initial.angular_velocity = Vec3(0, 0, 2.0);
-  }
-  return s;
-}
+using test::learning_bar;
 
 /// A third of the surface of `truth`'s motion, with noise σ [m].
 observe::Observation observe(const sim::Scene& truth, double sigma) {
@@ -70,10 +56,10 @@ double test_error(const fem::MaterialModel& material, const sim::Scene& truth_sw
       .max;
 }
 
-struct Case {
-  sim::Scene nominal = bar(material::ElasticModelType::Corotated, 1.75e6, false);
-  sim::Scene truth = bar(material::ElasticModelType::NeoHookean, 1e6, false);
-  sim::Scene truth_swing = bar(material::ElasticModelType::NeoHookean, 1e6, true);
+struct RecipeCase {
+  sim::Scene nominal = learning_bar(material::ElasticModelType::Corotated, 1.75e6, false);
+  sim::Scene truth = learning_bar(material::ElasticModelType::NeoHookean, 1e6, false);
+  sim::Scene truth_swing = learning_bar(material::ElasticModelType::NeoHookean, 1e6, true);
   std::vector<Motion> motions(double sigma) const {
     return { { "droop", nominal, observe(truth, sigma) } };
   }
@@ -276,7 +262,7 @@ TEST(LearningRecipe, ANetworkReplacesItsTeacherOnlyWhenItValidatesAsWell) {
 }
 
 TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTheFittedNominal) {
-  const Case c;
+  const RecipeCase c;
   const auto motions = c.motions(0);
   const RecipeResult r = learn_material(motions, small_recipe());
   ASSERT_FALSE(r.interrupted);
@@ -347,7 +333,7 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
 TEST(LearningRecipe, ATrainingSetHoldsOutTheTailOfEveryMotion) {
   // A droop and a swing: both are trained on (their first 48 frames) and both validate (their
   // last 12), so the choice sees both kinds of motion.
-  const Case c;
+  const RecipeCase c;
   sim::Scene swing = c.nominal;
   swing.initial = c.truth_swing.initial;
   const std::vector<Motion> motions { { "droop", c.nominal, observe(c.truth, 0) },
@@ -391,7 +377,7 @@ TEST(LearningRecipe, TheHeldOutFramesTakeNoPartInLearning) {
   // parameter fit and the loop, smoothed positions included (the smoother is global in time),
   // must learn exactly the same from both; only the validation errors differ. σ is given so
   // that its estimate, which reads every frame, is the same too.
-  const Case c;
+  const RecipeCase c;
   const double sigma = 1e-3 * c.nominal.mesh.bounding_box_diagonal();
   const auto motions = c.motions(sigma);
   auto moved = motions;
@@ -426,7 +412,7 @@ TEST(LearningRecipe, TheHeldOutFramesTakeNoPartInLearning) {
 
 TEST(LearningRecipe, NoisyCaptureLearnsWithoutDivergenceAndBeatsTheNominal) {
   // σ = 0.2 % of the size (0.85 mm on the 0.42 m bar), estimated from the data.
-  const Case c;
+  const RecipeCase c;
   const double size = c.nominal.mesh.bounding_box_diagonal(), sigma = 2e-3 * size;
   const auto motions = c.motions(sigma);
   const RecipeResult r = learn_material(motions, small_recipe());
@@ -443,7 +429,7 @@ TEST(LearningRecipe, NoisyCaptureLearnsWithoutDivergenceAndBeatsTheNominal) {
 }
 
 TEST(LearningRecipe, ResumedRunEqualsTheWholeRun) {
-  const Case c;
+  const RecipeCase c;
   const auto motions = c.motions(0);
   const RecipeOptions options = small_recipe();
   const RecipeResult whole = learn_material(motions, options);
@@ -472,7 +458,7 @@ TEST(LearningRecipe, ResumedRunEqualsTheWholeRun) {
 }
 
 TEST(LearningRecipe, RefusesWhatItCannotLearnFrom) {
-  const Case c;
+  const RecipeCase c;
   EXPECT_THROW(learn_material({}), InputError);
   auto motions = c.motions(0);
   motions[0].scene.frames = 3; // too few frames to hold some out (and observations disagree)

@@ -22,21 +22,7 @@
 namespace elastolearn::learn {
 namespace {
 
-/// A 0.4 × 0.1 × 0.1 m bar (240 tets) clamped at x = 0, 60 frames of 4 ms, ν = 0.43, α₁ 0.01 s.
-sim::Scene bar(material::ElasticModelType type, double young, bool swing) {
-  sim::Scene s = test::bar_scene({ .cells = { 10, 2, 2 },
-      .model = type,
-      .young = young,
-      .poisson = 0.43,
-      .alpha1 = 0.01,
-      .dt = 4e-3,
-      .frames = 60 });
-  if (swing) {
-    s.initial.kind = sim::InitialCondition::Kind::Velocity;
-    s.initial.angular_velocity = Vec3(0, 0, 2.0);
-  }
-  return s;
-}
+using test::learning_bar;
 
 /// A third of the surface of `truth`'s motion with a fifth of the marker-frames lost in bursts
 /// (NaN where lost).
@@ -62,21 +48,21 @@ observe::Observation with_garbage(observe::Observation o, double value) {
   return o;
 }
 
-struct Case {
-  sim::Scene nominal = bar(material::ElasticModelType::Corotated, 1.75e6, false);
-  sim::Scene truth = bar(material::ElasticModelType::NeoHookean, 1e6, false);
+struct DropoutCase {
+  sim::Scene nominal = learning_bar(material::ElasticModelType::Corotated, 1.75e6, false);
+  sim::Scene truth = learning_bar(material::ElasticModelType::NeoHookean, 1e6, false);
   observe::Observation observed = observe_with_dropout(truth); // NaN where lost
   observe::Observation huge = with_garbage(observed, 1e300);
   observe::Observation other = with_garbage(observed, -0.37);
 };
 
-const Case& the_case() {
-  static const Case c;
+const DropoutCase& the_case() {
+  static const DropoutCase c;
   return c;
 }
 
 TEST(LostMarkers, ObservationErrorCountsOnlySeenEntries) {
-  const Case& c = the_case();
+  const DropoutCase& c = the_case();
   const auto run = sim::simulate_positions(c.nominal);
   ASSERT_TRUE(run.completed);
   const ErrorSummary e = observation_error(run.positions, c.huge);
@@ -97,7 +83,7 @@ TEST(LostMarkers, ObservationErrorCountsOnlySeenEntries) {
 }
 
 TEST(LostMarkers, ParameterFitIgnoresLostEntries) {
-  const Case& c = the_case();
+  const DropoutCase& c = the_case();
   ParameterFitOptions options;
   options.max_iterations = 3;
   material::ElasticModelType type {};
@@ -128,7 +114,7 @@ TEST(LostMarkers, ParameterFitIgnoresLostEntries) {
 }
 
 TEST(LostMarkers, SpaceTimeAndForwardFitIgnoreLostEntries) {
-  const Case& c = the_case();
+  const DropoutCase& c = the_case();
   const auto run = sim::simulate_positions(c.nominal);
   ASSERT_TRUE(run.completed);
   // A basis of a few displacement snapshots (any basis with zero rows at the clamp will do).
@@ -179,7 +165,7 @@ TEST(LostMarkers, SpaceTimeAndForwardFitIgnoreLostEntries) {
 
 TEST(LostMarkers, LearningLoopResultDoesNotDependOnLostPositions) {
   // The raw loop (no smoothing before it): its constrained simulation follows filled gaps.
-  const Case& c = the_case();
+  const DropoutCase& c = the_case();
   LearningOptions options;
   options.max_iterations = 2;
   options.centres = 10;
@@ -202,7 +188,7 @@ TEST(LostMarkers, LearningLoopResultDoesNotDependOnLostPositions) {
 }
 
 TEST(LostMarkers, RecipeResultDoesNotDependOnLostPositionsAndBeatsTheNominal) {
-  const Case& c = the_case();
+  const DropoutCase& c = the_case();
   RecipeOptions options;
   options.parameter_fit.max_iterations = 4;
   options.loop.max_iterations = 2;
@@ -225,7 +211,7 @@ TEST(LostMarkers, RecipeResultDoesNotDependOnLostPositionsAndBeatsTheNominal) {
   EXPECT_EQ(b.chosen, a.chosen);
   // The result predicts a different motion (a swing) much better than the nominal (measured:
   // err_L 4.45 % nominal, 0.56 % learned with this small budget).
-  const sim::Scene swing = bar(material::ElasticModelType::NeoHookean, 1e6, true);
+  const sim::Scene swing = learning_bar(material::ElasticModelType::NeoHookean, 1e6, true);
   const auto test_error = [&](const fem::MaterialModel& material) {
     sim::Scene s = swing;
     s.material = material;

@@ -47,4 +47,21 @@ inline sim::Scene bar_scene(const BarOptions& o = {}) {
   return s;
 }
 
+/// The 240-tet bar the learning tests learn from (0.4 × 0.1 × 0.1 m, ν = 0.43, α₁ 0.01 s, 60
+/// frames of 4 ms): at rest (a droop), or with `swing` turning at 2 rad/s about z.
+inline sim::Scene learning_bar(material::ElasticModelType type, double young, bool swing) {
+  sim::Scene s = bar_scene({ .cells = { 10, 2, 2 },
+      .model = type,
+      .young = young,
+      .poisson = 0.43,
+      .alpha1 = 0.01,
+      .dt = 4e-3,
+      .frames = 60 });
+  if (swing) {
+    s.initial.kind = sim::InitialCondition::Kind::Velocity;
+    s.initial.angular_velocity = Vec3(0, 0, 2.0);
+  }
+  return s;
+}
+
 } // namespace elastolearn::test

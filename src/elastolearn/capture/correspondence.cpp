@@ -12,7 +12,7 @@ namespace elastolearn::capture {
 
 namespace {
 
-constexpr FieldErrors fail("correspondence");
+constexpr FieldErrors correspondence_error("correspondence");
 
 /// Samples per parallel block: each block's pairs are collected apart and joined in block order,
 /// so the result does not depend on how blocks are spread over threads.
@@ -22,10 +22,10 @@ constexpr int k_block = 256;
 
 void CorrespondenceOptions::validate() const {
   if (!(sigma > 0) || !std::isfinite(sigma))
-    fail("sigma",
+    correspondence_error("sigma",
         "must be positive and finite (the scanner's accuracy in metres), got " + to_text(sigma));
   if (!(truncation > 0 && truncation < 1))
-    fail("truncation", "must be in (0, 1), got " + to_text(truncation));
+    correspondence_error("truncation", "must be in (0, 1), got " + to_text(truncation));
 }
 
 double CorrespondenceOptions::radius() const {

@@ -15,7 +15,7 @@ namespace elastolearn::capture {
 
 namespace {
 
-constexpr FieldErrors fail("scan");
+constexpr FieldErrors scan_error("scan");
 
 std::uint64_t splitmix64(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
@@ -52,9 +52,9 @@ class PixelRandom {
 
 void ScanOptions::validate() const {
   if (!std::isfinite(noise) || noise < 0)
-    fail("noise", "must be finite and ≥ 0, got " + to_text(noise));
+    scan_error("noise", "must be finite and ≥ 0, got " + to_text(noise));
   if (!(outlier_fraction >= 0 && outlier_fraction <= 1))
-    fail("outliers", "must be a fraction in [0, 1], got " + to_text(outlier_fraction));
+    scan_error("outliers", "must be a fraction in [0, 1], got " + to_text(outlier_fraction));
 }
 
 VirtualScanner::VirtualScanner(const Faces& faces, int num_vertices,

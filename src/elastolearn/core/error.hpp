@@ -22,9 +22,10 @@ class InputError : public std::runtime_error {
 };
 
 /// Throws InputError for the fields of one group of inputs (an options struct, a file section):
-/// `where` is "<group>.<field>". A file that validates a group declares one, named for its use,
-///   constexpr FieldErrors fail("pod");
-/// and reports a bad field with `fail("max_modes", "must be at least 1, got 0")`.
+/// `where` is "<group>.<field>". A file that validates a group declares one, named for its group
+/// (unique within its library: a unity build compiles several files as one),
+///   constexpr FieldErrors pod_error("pod");
+/// and reports a bad field with `pod_error("max_modes", "must be at least 1, got 0")`.
 class FieldErrors {
   public:
   constexpr explicit FieldErrors(const char* group)

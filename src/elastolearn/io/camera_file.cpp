@@ -10,8 +10,8 @@ namespace elastolearn::io {
 
 namespace {
 
-constexpr const char* k_kind = "elastolearn-cameras";
-constexpr int k_version = 1;
+constexpr const char* k_cameras_kind = "elastolearn-cameras";
+constexpr int k_cameras_version = 1;
 
 capture::DepthCamera read_camera(const JsonObject& c, int index) {
   // A typo must not fall back to a default (an "upp" would leave "up" at +y).
@@ -67,7 +67,7 @@ capture::DepthCamera read_camera(const JsonObject& c, int index) {
 std::vector<capture::DepthCamera> read_camera_file(const std::filesystem::path& path) {
   const nlohmann::json json = read_json_file(path);
   const JsonObject root(json, path.string());
-  check_format(root, k_kind, k_version);
+  check_format(root, k_cameras_kind, k_cameras_version);
   const std::vector<JsonObject> list = root.objects("cameras");
   root.reject_unknown_keys({ "format", "cameras" });
   if (list.empty())
@@ -97,7 +97,7 @@ nlohmann::json cameras_to_json(const std::vector<capture::DepthCamera>& cameras)
       camera["far"] = c.far;
     list.push_back(camera);
   }
-  return { { "format", std::string(k_kind) + "/" + std::to_string(k_version) },
+  return { { "format", std::string(k_cameras_kind) + "/" + std::to_string(k_cameras_version) },
     { "cameras", list } };
 }
 

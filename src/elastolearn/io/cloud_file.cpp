@@ -12,8 +12,8 @@ namespace elastolearn::io {
 
 namespace {
 
-constexpr const char* k_kind = "elastolearn-clouds";
-constexpr int k_version = 1;
+constexpr const char* k_clouds_kind = "elastolearn-clouds";
+constexpr int k_clouds_version = 1;
 const std::string k_points = "/clouds/points";
 const std::string k_offsets = "/clouds/offsets";
 const std::string k_normals = "/clouds/normals";
@@ -133,7 +133,8 @@ void CloudWriter::finish(const std::map<std::string, std::string>& metadata) {
   for (hsize_t t = 0; t < T; ++t)
     time[t] = s.start_time + double(t) * s.dt;
   s.file.write(k_time, time.data(), { T });
-  s.file.set_attribute("format", std::string(k_kind) + "/" + std::to_string(k_version));
+  s.file.set_attribute(
+      "format", std::string(k_clouds_kind) + "/" + std::to_string(k_clouds_version));
   s.file.set_number_attribute("dt", s.dt);
   for (const auto& [key, value] : metadata)
     s.file.set_attribute(key, value);
@@ -153,7 +154,7 @@ void write_clouds_h5(const std::filesystem::path& path, const capture::PointClou
 
 capture::PointCloudSequence read_clouds_h5(const std::filesystem::path& path) {
   const h5::File file = h5::File::open(path);
-  file.check_format(k_kind, k_version, "point-cloud file");
+  file.check_format(k_clouds_kind, k_clouds_version, "point-cloud file");
   capture::PointCloudSequence clouds;
 
   const hsize_t N = shape_of(file, k_points, 2, true, "(N, 3)")[0];
@@ -207,7 +208,7 @@ capture::PointCloudSequence read_clouds_h5(const std::filesystem::path& path) {
 
 std::map<std::string, std::string> read_clouds_metadata(const std::filesystem::path& path) {
   const h5::File file = h5::File::open(path);
-  file.check_format(k_kind, k_version, "point-cloud file");
+  file.check_format(k_clouds_kind, k_clouds_version, "point-cloud file");
   std::map<std::string, std::string> metadata = file.attributes("/");
   metadata.erase("format");
   metadata.erase("dt");
@@ -232,7 +233,7 @@ double read_clouds_noise_sigma(const std::filesystem::path& path) {
 bool is_clouds_h5(const std::filesystem::path& path) {
   try {
     const std::optional<std::string> format = h5::File::open(path).attribute("format");
-    return format && format->rfind(std::string(k_kind) + "/", 0) == 0;
+    return format && format->rfind(std::string(k_clouds_kind) + "/", 0) == 0;
   } catch (const InputError&) {
     return false;
   }

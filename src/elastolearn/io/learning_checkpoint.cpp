@@ -11,7 +11,7 @@ namespace {
 constexpr const char* k_format = "elastolearn-learning-checkpoint";
 /// The version written. Version 3 writes one record per kind of step (iteration_record_to_json);
 /// versions 1 and 2 wrote flat records with flags, still read (read_flat_record).
-constexpr int k_version = 3;
+constexpr int k_checkpoint_version = 3;
 
 /// A checkpoint's options with the fields added since it was written set to the values every run
 /// had before (so that it still resumes under those options): rbf.smoothness 0,
@@ -312,22 +312,23 @@ void write_learning_checkpoint(const std::filesystem::path& path, const Learning
   nlohmann::json tried = nlohmann::json::array();
   for (const auto& [iteration, correction] : state.tried)
     tried.push_back({ { "iteration", iteration }, { "correction", correction_json(correction) } });
-  const nlohmann::json j = { { "format", std::string(k_format) + "/" + std::to_string(k_version) },
-    { "inputs",
-        { { "scene", inputs.scene }, { "observations", inputs.observations },
-            { "options", inputs.options } } },
-    { "parameter_fit", parameter_fit_json(resume.parameter_fit) },
-    { "state",
-        { { "next_iteration", state.next_iteration },
-            { "correction", correction_json(state.correction) },
-            { "best", correction_json(state.best) }, { "best_error", state.best_error },
-            { "best_iteration", state.best_iteration },
-            { "iterations_without_improvement", state.iterations_without_improvement },
-            { "failed_steps_in_a_row", state.failed_steps_in_a_row },
-            { "finished", state.finished }, { "forward_fit_steps", state.forward_fit_steps },
-            { "forward_fit_damping", state.forward_fit_damping },
-            { "forward_fit_converged", state.forward_fit_converged }, { "history", history },
-            { "tried", tried } } } };
+  const nlohmann::json j
+      = { { "format", std::string(k_format) + "/" + std::to_string(k_checkpoint_version) },
+          { "inputs",
+              { { "scene", inputs.scene }, { "observations", inputs.observations },
+                  { "options", inputs.options } } },
+          { "parameter_fit", parameter_fit_json(resume.parameter_fit) },
+          { "state",
+              { { "next_iteration", state.next_iteration },
+                  { "correction", correction_json(state.correction) },
+                  { "best", correction_json(state.best) }, { "best_error", state.best_error },
+                  { "best_iteration", state.best_iteration },
+                  { "iterations_without_improvement", state.iterations_without_improvement },
+                  { "failed_steps_in_a_row", state.failed_steps_in_a_row },
+                  { "finished", state.finished }, { "forward_fit_steps", state.forward_fit_steps },
+                  { "forward_fit_damping", state.forward_fit_damping },
+                  { "forward_fit_converged", state.forward_fit_converged }, { "history", history },
+                  { "tried", tried } } } };
   write_json_file(path, j);
 }
 
@@ -352,7 +353,7 @@ learn::RecipeResume read_learning_checkpoint(
     const std::filesystem::path& path, const LearningInputs& inputs) {
   const nlohmann::json j = read_json_file(path);
   const JsonObject root(j, path.string());
-  const int version = check_format(root, k_format, k_version);
+  const int version = check_format(root, k_format, k_checkpoint_version);
   const JsonObject in = root.object("inputs");
   if (in.string("scene") != inputs.scene)
     in.fail("scene",

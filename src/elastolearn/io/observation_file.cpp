@@ -11,18 +11,18 @@ namespace elastolearn::io {
 
 namespace {
 
-constexpr const char* k_kind = "elastolearn-observation";
+constexpr const char* k_observation_kind = "elastolearn-observation";
 /// Version 2 adds the optional /observed/valid; a file without it is written as version 1, which
 /// every reader reads. A file with it says 2, so that a reader that would ignore the mask (and
 /// take lost positions for data) refuses it instead.
-constexpr int k_version = 2;
+constexpr int k_observation_version = 2;
 const std::string k_ids = "/observed/vertex_ids";
 const std::string k_positions = "/observed/positions";
 const std::string k_valid = "/observed/valid";
 const std::string k_time = "/time";
 
 void check_format(const h5::File& file) {
-  file.check_format(k_kind, k_version, "observation");
+  file.check_format(k_observation_kind, k_observation_version, "observation");
 }
 
 /// The optional /observed/valid: T × k integers, each 0 (lost) or 1 (seen); empty if absent.
@@ -93,8 +93,9 @@ void write_observation_h5(const std::filesystem::path& path, const observe::Obse
   file.write(k_time, time.data(), { T });
   if (obs.valid.size() != 0)
     file.write(k_valid, obs.valid.data(), { T, k });
-  file.set_attribute(
-      "format", std::string(k_kind) + "/" + std::to_string(obs.valid.size() != 0 ? k_version : 1));
+  file.set_attribute("format",
+      std::string(k_observation_kind) + "/"
+          + std::to_string(obs.valid.size() != 0 ? k_observation_version : 1));
   file.set_number_attribute("dt", obs.dt);
   for (const auto& [key, value] : metadata)
     file.set_attribute(key, value);
@@ -150,7 +151,7 @@ std::map<std::string, std::string> read_observation_metadata(const std::filesyst
 bool is_observation_h5(const std::filesystem::path& path) {
   try {
     const std::optional<std::string> format = h5::File::open(path).attribute("format");
-    return format && format->rfind(std::string(k_kind) + "/", 0) == 0;
+    return format && format->rfind(std::string(k_observation_kind) + "/", 0) == 0;
   } catch (const InputError&) {
     return false;
   }

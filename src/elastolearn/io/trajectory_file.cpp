@@ -11,8 +11,8 @@ namespace elastolearn::io {
 
 namespace {
 
-constexpr const char* k_kind = "elastolearn-trajectory";
-constexpr int k_version = 1;
+constexpr const char* k_trajectory_kind = "elastolearn-trajectory";
+constexpr int k_trajectory_version = 1;
 constexpr hsize_t k_any = ~hsize_t(0);
 
 /// Throws InputError("<file>: <dataset>", "<frame prefix>non-finite value ...") if any of the
@@ -148,7 +148,8 @@ struct TrajectoryWriter::Impl {
       }
     }
     try {
-      file.set_attribute("format", std::string(k_kind) + "/" + std::to_string(k_version));
+      file.set_attribute(
+          "format", std::string(k_trajectory_kind) + "/" + std::to_string(k_trajectory_version));
       for (const auto& [key, value] : metadata)
         file.set_attribute(key, value);
       positions.close();
@@ -285,7 +286,7 @@ h5::Shape require_shape(const h5::File& file, const std::string& dataset, const 
 }
 
 void check_format(const h5::File& file) {
-  file.check_format(k_kind, k_version, "trajectory");
+  file.check_format(k_trajectory_kind, k_trajectory_version, "trajectory");
 }
 
 template <typename Table>

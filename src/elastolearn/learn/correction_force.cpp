@@ -14,7 +14,7 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("stress_reconstruction");
+constexpr FieldErrors correction_force_error("stress_reconstruction");
 
 /// Free index of each element's 12 local dofs (−1 for prescribed).
 std::vector<std::array<int, 12>> element_free_rows(
@@ -57,7 +57,8 @@ CorrectionForceJacobian::CorrectionForceJacobian(
     , m_batch(
           12 * std::min(k_jacobian_batch, std::max(1, mesh.num_tets())), design.num_unknowns()) {
   if (design.damping_unknowns() > 0 && mesh.nominal.elastic == nullptr)
-    fail("nominal", "fitting the damping correction needs the nominal elastic model");
+    correction_force_error(
+        "nominal", "fitting the damping correction needs the nominal elastic model");
 }
 
 void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
@@ -153,10 +154,10 @@ ForceMisfit correction_force_misfit(const ReconstructionMesh& mesh, const fem::D
     const material::Correction& correction, const std::vector<VecX>& positions,
     const std::vector<VecX>& velocities, const std::vector<VecX>& target_forces, int frame_stride) {
   if (frame_stride < 1)
-    fail("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
+    correction_force_error("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
   detail::check_frames(mesh, &dofs, positions, &velocities, &target_forces);
   if (dofs.num_free() == 0)
-    fail("dofs", "no free degree of freedom");
+    correction_force_error("dofs", "no free degree of freedom");
   const std::vector<int> frames = detail::selected_frames(int(positions.size()), frame_stride);
   double residual = 0, target = 0;
   VecX g, f;

@@ -11,7 +11,7 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("stress_reconstruction");
+constexpr FieldErrors element_state_error("stress_reconstruction");
 
 /// Element states of elements [begin, end) (serial; no allocation).
 void element_states_range(const ReconstructionMesh& mesh, const VecX& x, const VecX& v, int begin,
@@ -29,7 +29,7 @@ void element_states_range(const ReconstructionMesh& mesh, const VecX& x, const V
 /// A stiffness scale, if any, has one entry per tet (its values fem::ElasticForce checks).
 void check_stiffness_scale(const fem::MaterialModel& nominal, Eigen::Index tets) {
   if (nominal.stiffness_scale && Eigen::Index(nominal.stiffness_scale->size()) != tets)
-    fail("nominal.stiffness_scale",
+    element_state_error("nominal.stiffness_scale",
         to_text(nominal.stiffness_scale->size()) + " entries for " + to_text(tets) + " tets");
 }
 
@@ -50,9 +50,10 @@ ReconstructionMesh::ReconstructionMesh(std::vector<fem::TetRestData> rest_data, 
     , num_vertices(n)
     , nominal(std::move(nominal_model)) {
   if (rest.size() != static_cast<size_t>(tets.rows()))
-    fail("mesh", to_text(rest.size()) + " rest data for " + to_text(tets.rows()) + " tets");
+    element_state_error(
+        "mesh", to_text(rest.size()) + " rest data for " + to_text(tets.rows()) + " tets");
   if (tets.size() > 0 && (tets.minCoeff() < 0 || tets.maxCoeff() >= n))
-    fail("mesh", "a tet index is outside [0, " + to_text(n) + ")");
+    element_state_error("mesh", "a tet index is outside [0, " + to_text(n) + ")");
   check_stiffness_scale(nominal, tets.rows());
 }
 
@@ -106,9 +107,10 @@ void check_frames(const ReconstructionMesh& mesh, const fem::DofMap* dofs,
     const std::vector<VecX>* target_forces) {
   const Eigen::Index n3 = 3 * Eigen::Index(mesh.num_vertices);
   if (positions.empty())
-    fail("positions", "no frames");
+    element_state_error("positions", "no frames");
   if (dofs != nullptr && dofs->num_dofs() != n3)
-    fail("dofs", "the DofMap has " + to_text(dofs->num_dofs()) + " dofs, the mesh " + to_text(n3));
+    element_state_error(
+        "dofs", "the DofMap has " + to_text(dofs->num_dofs()) + " dofs, the mesh " + to_text(n3));
   const std::array<std::pair<const char*, const std::vector<VecX>*>, 3> lists {
     { { "positions", &positions }, { "velocities", velocities },
         { "target_forces", target_forces } }
@@ -117,14 +119,16 @@ void check_frames(const ReconstructionMesh& mesh, const fem::DofMap* dofs,
     if (list == nullptr)
       continue;
     if (list->size() != positions.size())
-      fail(name, to_text(list->size()) + " frames but " + to_text(positions.size()) + " positions");
+      element_state_error(
+          name, to_text(list->size()) + " frames but " + to_text(positions.size()) + " positions");
     for (size_t t = 0; t < list->size(); ++t) {
       const VecX& f = (*list)[t];
       if (f.size() != n3)
-        fail(std::string(name) + "[" + to_text(t) + "]",
+        element_state_error(std::string(name) + "[" + to_text(t) + "]",
             "length " + to_text(f.size()) + ", expected 3n = " + to_text(n3));
       if (!f.allFinite())
-        fail(std::string(name) + "[" + to_text(t) + "]", "contains a non-finite value");
+        element_state_error(
+            std::string(name) + "[" + to_text(t) + "]", "contains a non-finite value");
     }
   }
 }

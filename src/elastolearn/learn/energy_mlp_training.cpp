@@ -9,7 +9,7 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("mlp_training");
+constexpr FieldErrors energy_mlp_training_error("mlp_training");
 
 /// Forward buffers of one layer over a batch (B columns): pre-activation Z, f(Z), f'(Z), f''(Z),
 /// and per input c the pre-activation tangent U_c = ∂Z/∂x_c and the activation tangent
@@ -73,17 +73,17 @@ MatX stress_of(const std::vector<Forward>& f, ConstRef<MatX> maps, int d, int m)
 
 void check_set(const char* field, const GradientSamples& s, int d, int m) {
   if (s.inputs.cols() < 1)
-    fail(field, "is empty");
+    energy_mlp_training_error(field, "is empty");
   if (s.inputs.rows() != d || s.maps.rows() != d * m || s.targets.rows() != m
       || s.maps.cols() != s.inputs.cols() || s.targets.cols() != s.inputs.cols()) {
-    fail(field,
+    energy_mlp_training_error(field,
         "inputs " + to_text(s.inputs.rows()) + " × " + to_text(s.inputs.cols()) + ", maps "
             + to_text(s.maps.rows()) + " × " + to_text(s.maps.cols()) + " and targets "
             + to_text(s.targets.rows()) + " × " + to_text(s.targets.cols())
             + " do not match (d inputs, d·m map rows, m targets, one column per sample)");
   }
   if (!s.inputs.allFinite() || !s.maps.allFinite() || !s.targets.allFinite())
-    fail(field, "contains a non-finite value");
+    energy_mlp_training_error(field, "contains a non-finite value");
 }
 
 double loss_of(const BatchNormMlp& net, const GradientSamples& s) {
@@ -102,12 +102,13 @@ MlpTrainingResult train_gradient_mlp(
     const GradientSamples& train, const GradientSamples& valid, const MlpTrainingOptions& o) {
   o.validate();
   if (o.batch_norm)
-    fail("batch_norm", "is not supported when training a network by its gradient");
+    energy_mlp_training_error(
+        "batch_norm", "is not supported when training a network by its gradient");
   const auto start = Clock::now();
   const int d = static_cast<int>(train.inputs.rows());
   const int m = static_cast<int>(train.targets.rows());
   if (d < 1 || m < 1)
-    fail("training", "needs ≥ 1 input and target row");
+    energy_mlp_training_error("training", "needs ≥ 1 input and target row");
   check_set("training", train, d, m);
   check_set("validation", valid, d, m);
 
@@ -117,7 +118,7 @@ MlpTrainingResult train_gradient_mlp(
   const Eigen::Index n = train.inputs.cols();
   const Eigen::Index batch = std::min<Eigen::Index>(o.batch_size, n);
   if (batch < 2)
-    fail("training", "needs ≥ 2 samples, got " + to_text(n));
+    energy_mlp_training_error("training", "needs ≥ 2 samples, got " + to_text(n));
   const Eigen::Index batches = n / batch;
 
   std::vector<Forward> f(layers);
@@ -203,7 +204,7 @@ MlpTrainingResult train_gradient_mlp(
     }
     const double loss = loss_of(net, valid);
     if (!std::isfinite(loss)) {
-      fail("learning_rate",
+      energy_mlp_training_error("learning_rate",
           "training diverged at epoch " + to_text(epoch) + " (validation loss " + to_text(loss)
               + "); lower the learning rate");
     }

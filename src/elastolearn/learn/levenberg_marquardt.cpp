@@ -13,7 +13,7 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("levenberg_marquardt");
+constexpr FieldErrors levenberg_marquardt_error("levenberg_marquardt");
 
 /// Below this fraction of the largest diagonal entry an unknown counts as not moving the
 /// residuals (marquardt scaling holds it fixed).
@@ -85,26 +85,30 @@ class DampedSystem {
 
 void LevenbergMarquardtOptions::validate() const {
   if (max_iterations < 1)
-    fail("max_iterations", "must be ≥ 1, got " + to_text(max_iterations));
+    levenberg_marquardt_error("max_iterations", "must be ≥ 1, got " + to_text(max_iterations));
   if (max_steps < 0)
-    fail("max_steps", "must be ≥ 0, got " + to_text(max_steps));
+    levenberg_marquardt_error("max_steps", "must be ≥ 0, got " + to_text(max_steps));
   if (max_rejections < 1)
-    fail("max_rejections", "must be ≥ 1, got " + to_text(max_rejections));
+    levenberg_marquardt_error("max_rejections", "must be ≥ 1, got " + to_text(max_rejections));
   if (!(initial_damping > 0 && std::isfinite(initial_damping)))
-    fail("initial_damping", "must be finite and > 0, got " + to_text(initial_damping));
+    levenberg_marquardt_error(
+        "initial_damping", "must be finite and > 0, got " + to_text(initial_damping));
   if (!(damping_decrease >= 1 && std::isfinite(damping_decrease)))
-    fail("damping_decrease", "must be finite and ≥ 1, got " + to_text(damping_decrease));
+    levenberg_marquardt_error(
+        "damping_decrease", "must be finite and ≥ 1, got " + to_text(damping_decrease));
   if (!(min_damping >= 0 && std::isfinite(min_damping)))
-    fail("min_damping", "must be finite and ≥ 0, got " + to_text(min_damping));
+    levenberg_marquardt_error("min_damping", "must be finite and ≥ 0, got " + to_text(min_damping));
   if (!(damping_increase > 1 && std::isfinite(damping_increase)))
-    fail("damping_increase", "must be finite and > 1, got " + to_text(damping_increase));
+    levenberg_marquardt_error(
+        "damping_increase", "must be finite and > 1, got " + to_text(damping_increase));
   if (!(failed_damping_increase > 1 && std::isfinite(failed_damping_increase)))
-    fail("failed_damping_increase",
+    levenberg_marquardt_error("failed_damping_increase",
         "must be finite and > 1, got " + to_text(failed_damping_increase));
   if (!(max_step > 0))
-    fail("max_step", "must be > 0, got " + to_text(max_step));
+    levenberg_marquardt_error("max_step", "must be > 0, got " + to_text(max_step));
   if (!(function_tolerance >= 0 && std::isfinite(function_tolerance)))
-    fail("function_tolerance", "must be finite and ≥ 0, got " + to_text(function_tolerance));
+    levenberg_marquardt_error(
+        "function_tolerance", "must be finite and ≥ 0, got " + to_text(function_tolerance));
 }
 
 LevenbergMarquardtSummary levenberg_marquardt(

@@ -12,7 +12,7 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("mlp_training");
+constexpr FieldErrors mlp_training_error("mlp_training");
 
 /// Per-layer gradients, Adam state and batch buffers, allocated once per training run.
 struct LayerWork {
@@ -46,15 +46,15 @@ double mean_squared_error(const BatchNormMlp& net, ConstRef<MatX> x, ConstRef<Ma
 
 void check_set(const char* field, ConstRef<MatX> x, ConstRef<MatX> y, int inputs, int outputs) {
   if (x.cols() < 1)
-    fail(field, "is empty");
+    mlp_training_error(field, "is empty");
   if (x.rows() != inputs || y.rows() != outputs || y.cols() != x.cols()) {
-    fail(field,
+    mlp_training_error(field,
         "inputs " + to_text(x.rows()) + " × " + to_text(x.cols()) + " and targets "
             + to_text(y.rows()) + " × " + to_text(y.cols()) + " do not match (" + to_text(inputs)
             + " inputs, " + to_text(outputs) + " outputs, one column per sample)");
   }
   if (!x.allFinite() || !y.allFinite())
-    fail(field, "contains a non-finite value");
+    mlp_training_error(field, "contains a non-finite value");
 }
 
 } // namespace
@@ -100,50 +100,52 @@ bool EarlyStopping::update(
 
 void MlpTrainingOptions::validate() const {
   if (hidden_widths.empty())
-    fail("hidden_widths", "is empty; at least one hidden layer is required");
+    mlp_training_error("hidden_widths", "is empty; at least one hidden layer is required");
   if (hidden_widths.size() > std::size_t(material::NnCorrection::max_hidden_layers)) {
-    fail("hidden_widths",
+    mlp_training_error("hidden_widths",
         "has " + to_text(hidden_widths.size()) + " layers, at most "
             + to_text(material::NnCorrection::max_hidden_layers) + " are supported");
   }
   for (int w : hidden_widths) {
     if (w < 1 || w > material::NnCorrection::max_width) {
-      fail("hidden_widths",
+      mlp_training_error("hidden_widths",
           "width " + to_text(w) + " outside 1.." + to_text(material::NnCorrection::max_width));
     }
   }
   if (batch_size < 2)
-    fail("batch_size", "must be ≥ 2, got " + to_text(batch_size));
+    mlp_training_error("batch_size", "must be ≥ 2, got " + to_text(batch_size));
   if (max_epochs < 1)
-    fail("max_epochs", "must be ≥ 1, got " + to_text(max_epochs));
+    mlp_training_error("max_epochs", "must be ≥ 1, got " + to_text(max_epochs));
   if (!(learning_rate > 0) || !std::isfinite(learning_rate))
-    fail("learning_rate", "must be finite and > 0, got " + to_text(learning_rate));
+    mlp_training_error("learning_rate", "must be finite and > 0, got " + to_text(learning_rate));
   if (!(beta1 >= 0 && beta1 < 1))
-    fail("beta1", "must be in [0, 1), got " + to_text(beta1));
+    mlp_training_error("beta1", "must be in [0, 1), got " + to_text(beta1));
   if (!(beta2 >= 0 && beta2 < 1))
-    fail("beta2", "must be in [0, 1), got " + to_text(beta2));
+    mlp_training_error("beta2", "must be in [0, 1), got " + to_text(beta2));
   if (!(adam_epsilon > 0) || !std::isfinite(adam_epsilon))
-    fail("adam_epsilon", "must be finite and > 0, got " + to_text(adam_epsilon));
+    mlp_training_error("adam_epsilon", "must be finite and > 0, got " + to_text(adam_epsilon));
   if (plateau_epochs < 1)
-    fail("plateau_epochs", "must be ≥ 1, got " + to_text(plateau_epochs));
+    mlp_training_error("plateau_epochs", "must be ≥ 1, got " + to_text(plateau_epochs));
   if (patience < 1)
-    fail("patience", "must be ≥ 1, got " + to_text(patience));
+    mlp_training_error("patience", "must be ≥ 1, got " + to_text(patience));
   if (!(min_improvement >= 0 && min_improvement < 1))
-    fail("min_improvement", "must be in [0, 1), got " + to_text(min_improvement));
+    mlp_training_error("min_improvement", "must be in [0, 1), got " + to_text(min_improvement));
   if (!(batch_norm_momentum > 0 && batch_norm_momentum <= 1))
-    fail("batch_norm_momentum", "must be in (0, 1], got " + to_text(batch_norm_momentum));
+    mlp_training_error(
+        "batch_norm_momentum", "must be in (0, 1], got " + to_text(batch_norm_momentum));
   if (!(batch_norm_epsilon > 0) || !std::isfinite(batch_norm_epsilon))
-    fail("batch_norm_epsilon", "must be finite and > 0, got " + to_text(batch_norm_epsilon));
+    mlp_training_error(
+        "batch_norm_epsilon", "must be finite and > 0, got " + to_text(batch_norm_epsilon));
 }
 
 BatchNormMlp make_batch_norm_mlp(int inputs, const std::vector<int>& hidden_widths, int outputs,
     bool batch_norm, std::uint64_t seed) {
   if (inputs < 1 || outputs < 1)
-    fail("network",
+    mlp_training_error("network",
         "needs ≥ 1 input and output, got " + to_text(inputs) + " and " + to_text(outputs));
   for (int w : hidden_widths) {
     if (w < 1 || w > material::NnCorrection::max_width) {
-      fail("hidden_widths",
+      mlp_training_error("hidden_widths",
           "width " + to_text(w) + " outside 1.." + to_text(material::NnCorrection::max_width));
     }
   }
@@ -220,7 +222,7 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
   check_set("training", train_x, train_y, inputs, outputs);
   check_set("validation", valid_x, valid_y, inputs, outputs);
   if (inputs < 1 || outputs < 1)
-    fail("training", "needs ≥ 1 input and output row");
+    mlp_training_error("training", "needs ≥ 1 input and output row");
 
   BatchNormMlp net = make_batch_norm_mlp(inputs, o.hidden_widths, outputs, o.batch_norm, o.seed);
   net.batch_norm_epsilon = o.batch_norm_epsilon;
@@ -228,7 +230,7 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
   const Eigen::Index n = train_x.cols();
   const Eigen::Index batch = std::min<Eigen::Index>(o.batch_size, n);
   if (batch < 2)
-    fail("training", "needs ≥ 2 samples, got " + to_text(n));
+    mlp_training_error("training", "needs ≥ 2 samples, got " + to_text(n));
   const Eigen::Index batches = n / batch; // the remainder (< batch) sits out this epoch
   const std::size_t num_layers = net.layers.size();
 
@@ -326,7 +328,7 @@ MlpTrainingResult train_mlp(ConstRef<MatX> train_x, ConstRef<MatX> train_y, Cons
     }
     const double loss = mean_squared_error(net, valid_x, valid_y);
     if (!std::isfinite(loss)) {
-      fail("learning_rate",
+      mlp_training_error("learning_rate",
           "training diverged at epoch " + to_text(epoch) + " (validation loss " + to_text(loss)
               + "); lower the learning rate");
     }

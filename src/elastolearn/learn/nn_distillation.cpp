@@ -16,7 +16,7 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("distillation");
+constexpr FieldErrors distillation_error("distillation");
 
 using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
@@ -78,28 +78,31 @@ void direction_rows(
 
 void DistillationSampleOptions::validate() const {
   if (recorded_samples < 1)
-    fail("recorded_samples", "must be ≥ 1, got " + to_text(recorded_samples));
+    distillation_error("recorded_samples", "must be ≥ 1, got " + to_text(recorded_samples));
   if (frame_stride < 1)
-    fail("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
+    distillation_error("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
   if (jitter_copies < 0)
-    fail("jitter_copies", "must be ≥ 0, got " + to_text(jitter_copies));
+    distillation_error("jitter_copies", "must be ≥ 0, got " + to_text(jitter_copies));
   if (!std::isfinite(stretch_jitter) || stretch_jitter < 0)
-    fail("stretch_jitter", "must be finite and ≥ 0, got " + to_text(stretch_jitter));
+    distillation_error("stretch_jitter", "must be finite and ≥ 0, got " + to_text(stretch_jitter));
   if (!std::isfinite(rate_jitter) || rate_jitter < 0)
-    fail("rate_jitter", "must be finite and ≥ 0, got " + to_text(rate_jitter));
+    distillation_error("rate_jitter", "must be finite and ≥ 0, got " + to_text(rate_jitter));
   if (std::isnan(stretch_min) || std::isnan(stretch_max) || !(stretch_min <= stretch_max))
-    fail("stretch_min", "must be ≤ stretch_max");
+    distillation_error("stretch_min", "must be ≤ stretch_max");
 }
 
 void NnDistillationOptions::validate() const {
   training.validate();
   if (energy_polynomial_degree != 0 && energy_polynomial_degree != 2
       && energy_polynomial_degree != 3)
-    fail("energy_polynomial_degree", "must be 0, 2 or 3, got " + to_text(energy_polynomial_degree));
+    distillation_error(
+        "energy_polynomial_degree", "must be 0, 2 or 3, got " + to_text(energy_polynomial_degree));
   if (kind == material::NnKind::Energy && training.batch_norm)
-    fail("training.batch_norm", "must be off for an energy network (train_gradient_mlp)");
+    distillation_error(
+        "training.batch_norm", "must be off for an energy network (train_gradient_mlp)");
   if (!(validation_fraction > 0 && validation_fraction < 1))
-    fail("validation_fraction", "must be in (0, 1), got " + to_text(validation_fraction));
+    distillation_error(
+        "validation_fraction", "must be in (0, 1), got " + to_text(validation_fraction));
 }
 
 StressSamples distillation_samples(std::span<const sim::Scene> scenes,
@@ -107,7 +110,7 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
     DistillationSampleReport* report_out) {
   o.validate();
   if (scenes.empty())
-    fail("scenes", "no scene to simulate");
+    distillation_error("scenes", "no scene to simulate");
   DistillationSampleReport report;
   const Eigen::Index k = o.recorded_samples;
   Rows3 stretches(k, 3), rates(k, 3);
@@ -157,7 +160,7 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   report.states_seen = seen;
   const Eigen::Index recorded = std::min<Eigen::Index>(k, seen);
   if (recorded == 0)
-    fail("scenes", "the simulations recorded no element state");
+    distillation_error("scenes", "the simulations recorded no element state");
   report.recorded = static_cast<int>(recorded);
 
   // Jittered copies around the recorded states.
@@ -189,7 +192,7 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
     out.targets.row(j) = teacher.correction(s, f).transpose();
   }
   if (!out.targets.allFinite())
-    fail("teacher", "the teacher correction returned a non-finite value");
+    distillation_error("teacher", "the teacher correction returned a non-finite value");
   if (report_out)
     *report_out = std::move(report);
   return out;
@@ -205,7 +208,7 @@ material::NnCorrection with_teacher_damping(
   } else if (const auto* nn = dynamic_cast<const material::NnCorrection*>(&teacher)) {
     p.damping = nn->parameters().damping;
   } else if (teacher.stiffness_damping(Vec3::Ones()) != 0) {
-    fail("teacher",
+    distillation_error("teacher",
         "a \"" + teacher.name() + "\" correction's damping cannot be carried over (only an RBF's)");
   }
   return material::NnCorrection(std::move(p));
@@ -224,7 +227,7 @@ std::vector<sim::Scene> scaled_motions(const sim::Scene& scene, std::span<const 
   std::vector<sim::Scene> out;
   for (double a : scales) {
     if (!std::isfinite(a))
-      fail("motion_scales", "contains a non-finite factor " + to_text(a));
+      distillation_error("motion_scales", "contains a non-finite factor " + to_text(a));
     sim::Scene s = sim::amplified_scene(scene, a);
     s.name = scene.name + "_x" + to_text(a);
     out.push_back(std::move(s));
@@ -241,13 +244,13 @@ void split_states(const StressSamples& samples, const NnDistillationOptions& o,
   o.validate();
   const Eigen::Index n = samples.stretches.rows();
   if (samples.stretch_rates.rows() != n || samples.targets.rows() != n) {
-    fail("samples",
+    distillation_error("samples",
         to_text(n) + " stretch samples but " + to_text(samples.stretch_rates.rows())
             + " stretch rates and " + to_text(samples.targets.rows()) + " targets");
   }
   if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite()
       || !samples.targets.allFinite()) {
-    fail("samples", "contain a non-finite value");
+    distillation_error("samples", "contain a non-finite value");
   }
   // The split is over states, so that the three direction rows of a state are never on both
   // sides of it.
@@ -257,7 +260,7 @@ void split_states(const StressSamples& samples, const NnDistillationOptions& o,
   shuffle_in_place(order, rng);
   const auto n_valid = static_cast<std::size_t>(std::llround(o.validation_fraction * double(n)));
   if (n_valid < 2 || order.size() - n_valid < 2) {
-    fail("samples",
+    distillation_error("samples",
         to_text(n) + " samples leave fewer than 2 in the training or validation split "
             + "(validation_fraction " + to_text(o.validation_fraction) + ")");
   }
@@ -347,7 +350,8 @@ NnDistillationResult distill_stress_network(
 NnDistillationResult distill_energy_network(
     const StressSamples& samples, const NnDistillationOptions& o) {
   if (o.training.batch_norm)
-    fail("training.batch_norm", "must be off for an energy network (train_gradient_mlp)");
+    distillation_error(
+        "training.batch_norm", "must be off for an energy network (train_gradient_mlp)");
   std::vector<int> train, valid;
   split_states(samples, o, train, valid);
   const auto row = [&](int j) { return Vec3(samples.stretches.row(j).transpose()); };
@@ -448,11 +452,11 @@ std::optional<Eigen::Matrix<double, 6, 1>> rbf_energy_polynomial(
 
 void RbfDistillationOptions::validate() const {
   if (jitter_copies < 0)
-    fail("jitter_copies", "must be ≥ 0, got " + to_text(jitter_copies));
+    distillation_error("jitter_copies", "must be ≥ 0, got " + to_text(jitter_copies));
   if (!std::isfinite(stretch_jitter) || stretch_jitter < 0)
-    fail("stretch_jitter", "must be finite and ≥ 0, got " + to_text(stretch_jitter));
+    distillation_error("stretch_jitter", "must be finite and ≥ 0, got " + to_text(stretch_jitter));
   if (!std::isfinite(rate_sigma) || rate_sigma < 0)
-    fail("rate_sigma", "must be finite and ≥ 0, got " + to_text(rate_sigma));
+    distillation_error("rate_sigma", "must be finite and ≥ 0, got " + to_text(rate_sigma));
   stress.validate();
   energy.validate();
 }
@@ -461,11 +465,11 @@ NnDistillationResult distill_rbf(const material::RbfCorrection& teacher, ConstRe
     const RbfDistillationOptions& o) {
   o.validate();
   if (stretches.cols() != 3 || stretches.rows() < 2)
-    fail("stretches",
+    distillation_error("stretches",
         "expected n × 3 principal stretches with n ≥ 2, got " + to_text(stretches.rows()) + " × "
             + to_text(stretches.cols()));
   if (!stretches.allFinite())
-    fail("stretches", "contain a non-finite value");
+    distillation_error("stretches", "contain a non-finite value");
   const material::NnKind kind = o.kind.value_or(
       teacher.parameters().energy_kernels ? material::NnKind::Energy : material::NnKind::Stress);
   const Eigen::Index n = stretches.rows(), total = n * (1 + o.jitter_copies);
@@ -485,7 +489,7 @@ NnDistillationResult distill_rbf(const material::RbfCorrection& teacher, ConstRe
         = teacher.elastic_correction(samples.stretches.row(j).transpose()).transpose();
   }
   if (!samples.targets.allFinite())
-    fail("teacher", "the teacher correction returned a non-finite value");
+    distillation_error("teacher", "the teacher correction returned a non-finite value");
   NnDistillationOptions training = kind == material::NnKind::Energy ? o.energy : o.stress;
   if (kind == material::NnKind::Energy && o.teacher_polynomial && !training.energy_polynomial)
     training.energy_polynomial = rbf_energy_polynomial(teacher);

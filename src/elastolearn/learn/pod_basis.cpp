@@ -11,23 +11,23 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("pod");
+constexpr FieldErrors pod_error("pod");
 
 } // namespace
 
 void PodOptions::validate() const {
   if (max_modes < 1)
-    fail("max_modes", "must be at least 1, got " + to_text(max_modes));
+    pod_error("max_modes", "must be at least 1, got " + to_text(max_modes));
   if (!(energy_fraction > 0 && energy_fraction <= 1))
-    fail("energy_fraction", "must be in (0, 1], got " + to_text(energy_fraction));
+    pod_error("energy_fraction", "must be in (0, 1], got " + to_text(energy_fraction));
   if (first_frame < 0)
-    fail("first_frame", "must be ≥ 0, got " + to_text(first_frame));
+    pod_error("first_frame", "must be ≥ 0, got " + to_text(first_frame));
   if (frame_count < 0)
-    fail("frame_count", "must be ≥ 0 (0 = all), got " + to_text(frame_count));
+    pod_error("frame_count", "must be ≥ 0 (0 = all), got " + to_text(frame_count));
   if (frame_stride < 1)
-    fail("frame_stride", "must be at least 1, got " + to_text(frame_stride));
+    pod_error("frame_stride", "must be at least 1, got " + to_text(frame_stride));
   if (!(rank_tolerance >= 0 && rank_tolerance < 1))
-    fail("rank_tolerance", "must be in [0, 1), got " + to_text(rank_tolerance));
+    pod_error("rank_tolerance", "must be in [0, 1), got " + to_text(rank_tolerance));
 }
 
 PodBasis pod_basis(const std::vector<Positions>& frames, ConstRef<Positions> rest,
@@ -41,17 +41,17 @@ PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRe
   options.validate();
   const Eigen::Index n = rest.rows();
   if (trajectories.empty())
-    fail("frames", "no trajectory");
+    pod_error("frames", "no trajectory");
   const std::vector<Positions>& frames = trajectories.front();
   for (std::size_t k = 0; k < trajectories.size(); ++k) {
     if (trajectories[k].size() != frames.size()) {
-      fail("frames",
+      pod_error("frames",
           "trajectory " + to_text(k) + " has " + to_text(trajectories[k].size())
               + " frames, the first " + "has " + to_text(frames.size()));
     }
     for (std::size_t t = 0; t < trajectories[k].size(); ++t) {
       if (trajectories[k][t].rows() != n) {
-        fail("frames",
+        pod_error("frames",
             "frame " + to_text(t) + " has " + to_text(trajectories[k][t].rows())
                 + " vertices, the rest " + "shape has " + to_text(n));
       }
@@ -59,25 +59,26 @@ PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRe
   }
   for (int v : free_vertices) {
     if (v < 0 || v >= n)
-      fail("free_vertices", "vertex " + to_text(v) + " is out of range [0, " + to_text(n) + ")");
+      pod_error(
+          "free_vertices", "vertex " + to_text(v) + " is out of range [0, " + to_text(n) + ")");
   }
   if (free_vertices.empty())
-    fail("free_vertices", "no free vertex: nothing to reduce");
+    pod_error("free_vertices", "no free vertex: nothing to reduce");
   {
     std::vector<int> sorted = free_vertices;
     std::sort(sorted.begin(), sorted.end());
     const auto repeated = std::adjacent_find(sorted.begin(), sorted.end());
     if (repeated != sorted.end())
-      fail("free_vertices", "vertex " + to_text(*repeated) + " is listed twice");
+      pod_error("free_vertices", "vertex " + to_text(*repeated) + " is listed twice");
   }
   if (options.mass_orthonormal) {
     if (dof_masses.size() != 3 * n)
-      fail("dof_masses",
+      pod_error("dof_masses",
           "need 3n = " + to_text(3 * n) + " masses, got " + to_text(dof_masses.size()));
     for (int v : free_vertices) {
       for (int c = 0; c < 3; ++c) {
         if (!(dof_masses[3 * v + c] > 0))
-          fail("dof_masses", "mass of vertex " + to_text(v) + " is not positive");
+          pod_error("dof_masses", "mass of vertex " + to_text(v) + " is not positive");
       }
     }
   }
@@ -90,7 +91,7 @@ PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRe
   for (int t = options.first_frame; t < end; t += options.frame_stride)
     basis.frames.push_back(t);
   if (basis.frames.empty()) {
-    fail("first_frame",
+    pod_error("first_frame",
         "selects no frame of " + to_text(total) + " (first_frame " + to_text(options.first_frame)
             + ")");
   }
@@ -116,14 +117,14 @@ PodBasis pod_basis(std::span<const std::vector<Positions>> trajectories, ConstRe
     }
   }
   if (!snapshots.allFinite())
-    fail("frames", "non-finite displacement in the snapshots");
+    pod_error("frames", "non-finite displacement in the snapshots");
 
   const Eigen::BDCSVD<MatX> svd(snapshots, Eigen::ComputeThinU);
   basis.singular_values = svd.singularValues();
   const VecX& sv = basis.singular_values;
   const double total_energy = sv.squaredNorm();
   if (sv.size() == 0 || !(sv[0] > 0))
-    fail("frames", "the selected frames do not move (all displacements are zero): no mode");
+    pod_error("frames", "the selected frames do not move (all displacements are zero): no mode");
   int rank = 0;
   while (rank < sv.size() && sv[rank] > options.rank_tolerance * sv[0])
     ++rank;

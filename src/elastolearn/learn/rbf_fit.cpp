@@ -13,7 +13,7 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("rbf_fit");
+constexpr FieldErrors rbf_fit_error("rbf_fit");
 
 constexpr Eigen::Index k_chunk = 2048;
 
@@ -35,20 +35,20 @@ template <typename Kernel> MatX unit_trace_seminorm(int m, const Kernel& kernel)
 
 void RbfFitOptions::validate() const {
   if (continuation == material::Continuation::edge_hessian)
-    fail("continuation", "learning continues with bounded_softening or smooth_clamp");
+    rbf_fit_error("continuation", "learning continues with bounded_softening or smooth_clamp");
   if (!std::isfinite(epsilon) || epsilon < 0)
-    fail("epsilon", "must be finite and ≥ 0, got " + to_text(epsilon));
+    rbf_fit_error("epsilon", "must be finite and ≥ 0, got " + to_text(epsilon));
   if (!std::isfinite(regularization) || regularization < 0)
-    fail("regularization", "must be finite and ≥ 0, got " + to_text(regularization));
+    rbf_fit_error("regularization", "must be finite and ≥ 0, got " + to_text(regularization));
   if (!std::isfinite(damping_regularization) || damping_regularization < 0)
-    fail(
+    rbf_fit_error(
         "damping_regularization", "must be finite and ≥ 0, got " + to_text(damping_regularization));
   if (!std::isfinite(smoothness) || smoothness < 0)
-    fail("smoothness", "must be finite and ≥ 0, got " + to_text(smoothness));
+    rbf_fit_error("smoothness", "must be finite and ≥ 0, got " + to_text(smoothness));
   if (std::isnan(damping_floor) || damping_floor > 0)
-    fail("damping_floor", "must be ≤ 0 (or −infinity), got " + to_text(damping_floor));
+    rbf_fit_error("damping_floor", "must be ≤ 0 (or −infinity), got " + to_text(damping_floor));
   if (damping_quadratic_tail && !damping_polynomial)
-    fail("damping_quadratic_tail", "needs damping_polynomial (the linear tail)");
+    rbf_fit_error("damping_quadratic_tail", "needs damping_polynomial (the linear tail)");
 }
 
 RbfDesign::RbfDesign(
@@ -58,13 +58,14 @@ RbfDesign::RbfDesign(
   options.validate();
   trusted.validate("rbf_fit.trusted_stretches");
   if (!options.energy_kernels && trusted.bounded())
-    fail("trusted_stretches", "needs energy kernels (stress kernels have no energy to continue)");
+    rbf_fit_error(
+        "trusted_stretches", "needs energy kernels (stress kernels have no energy to continue)");
   if (centres.rows() < 1 || centres.cols() != 3)
-    fail("centres",
+    rbf_fit_error("centres",
         "expected m × 3 with m ≥ 1, got " + to_text(centres.rows()) + " × "
             + to_text(centres.cols()));
   if (!centres.allFinite())
-    fail("centres", "contains a non-finite value");
+    rbf_fit_error("centres", "contains a non-finite value");
   m_centres = centres;
   const int m = static_cast<int>(centres.rows());
   m_rest_kernels = VecX::Zero(m);
@@ -348,7 +349,7 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   if (p.centres.rows() != m || p.centres != m_centres || p.epsilon != m_options.epsilon
       || p.energy_kernels != m_options.energy_kernels || p.trusted.min != m_trusted.min
       || p.trusted.max != m_trusted.max)
-    fail("correction",
+    rbf_fit_error("correction",
         "its centres, kernel smoothing, kernel kind or trusted stretches differ from the design's");
   const bool has_tail = p.own_slope != 0 || p.other_slope != 0 || !p.quadratic.isZero();
   const bool has_damping_tail
@@ -356,7 +357,7 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   const bool has_damping = p.damping_weights.size() > 0 || has_damping_tail;
   if ((has_tail && !m_options.elastic_polynomial) || (!p.quadratic.isZero() && m_quadratic < 0)
       || (!p.neo_hookean.isZero() && m_neo_hookean < 0) || (has_damping && m_damping == 0))
-    fail("correction", "it has a term the design does not fit");
+    rbf_fit_error("correction", "it has a term the design does not fit");
   VecX x = VecX::Zero(num_unknowns());
   x.head(m) = p.weights;
   if (m_options.elastic_polynomial) {
@@ -379,7 +380,8 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
   if (m_constant < 0
       && std::abs(prestress)
           > 1e-9 * (std::abs(p.constant) + p.weights.cwiseAbs().dot(m_rest_kernels.cwiseAbs()) + 1))
-    fail("correction", "it is not stress-free at rest (N(1) = " + to_text(prestress) + " Pa)");
+    rbf_fit_error(
+        "correction", "it is not stress-free at rest (N(1) = " + to_text(prestress) + " Pa)");
   if (m_damping > 0) {
     if (p.damping_weights.size() == m)
       x.segment(m_elastic, m) = p.damping_weights;
@@ -389,9 +391,9 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
       if (m_options.damping_quadratic_tail)
         x.segment<3>(m_elastic + m + 4) = p.damping_quadratic;
       else if (!p.damping_quadratic.isZero(0))
-        fail("correction", "it has a quadratic damping tail the design does not fit");
+        rbf_fit_error("correction", "it has a quadratic damping tail the design does not fit");
     } else if (has_damping_tail)
-      fail("correction", "it has a damping tail the design does not fit");
+      rbf_fit_error("correction", "it has a damping tail the design does not fit");
   }
   return x;
 }
@@ -440,26 +442,27 @@ VecX solve_regularised_normal_equations(
   normal.diagonal() += regularization;
   const Eigen::LLT<MatX> llt(normal);
   if (llt.info() != Eigen::Success)
-    fail("regularization",
+    rbf_fit_error("regularization",
         "the normal equations are singular (" + to_text(samples) + " samples, " + to_text(u)
             + " unknowns); increase the regularisation or give more varied samples");
   const VecX x = (llt.solve(rhs.cwiseQuotient(scale))).cwiseQuotient(scale);
   if (!x.allFinite())
-    fail("regularization", "the fit produced non-finite weights; increase the regularisation");
+    rbf_fit_error(
+        "regularization", "the fit produced non-finite weights; increase the regularisation");
   return x;
 }
 
 RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& samples) {
   const Eigen::Index n = samples.stretches.rows();
   if (n == 0)
-    fail("samples", "no samples to fit");
+    rbf_fit_error("samples", "no samples to fit");
   if (samples.stretch_rates.rows() != n || samples.targets.rows() != n)
-    fail("samples",
+    rbf_fit_error("samples",
         to_text(n) + " stretch samples but " + to_text(samples.stretch_rates.rows())
             + " stretch rates and " + to_text(samples.targets.rows()) + " targets");
   if (!samples.stretches.allFinite() || !samples.stretch_rates.allFinite()
       || !samples.targets.allFinite())
-    fail("samples", "contain a non-finite value");
+    rbf_fit_error("samples", "contain a non-finite value");
   const int u = design.elastic_unknowns();
   MatX normal = MatX::Zero(u, u);
   VecX rhs = VecX::Zero(u);

@@ -15,7 +15,7 @@ namespace elastolearn::learn {
 
 namespace {
 
-constexpr FieldErrors fail("stress_reconstruction");
+constexpr FieldErrors stress_reconstruction_error("stress_reconstruction");
 
 /// Per-thread work space of the normal-equation assembly.
 struct AssemblyScratch {
@@ -50,13 +50,16 @@ ReconstructionMethod reconstruction_method_from_name(
 
 void StressReconstructionOptions::validate() const {
   if (frame_stride < 1)
-    fail("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
+    stress_reconstruction_error("frame_stride", "must be ≥ 1, got " + to_text(frame_stride));
   if (!std::isfinite(lsqr_tolerance) || lsqr_tolerance <= 0)
-    fail("lsqr_tolerance", "must be finite and > 0, got " + to_text(lsqr_tolerance));
+    stress_reconstruction_error(
+        "lsqr_tolerance", "must be finite and > 0, got " + to_text(lsqr_tolerance));
   if (lsqr_max_iterations < 0)
-    fail("lsqr_max_iterations", "must be ≥ 0, got " + to_text(lsqr_max_iterations));
+    stress_reconstruction_error(
+        "lsqr_max_iterations", "must be ≥ 0, got " + to_text(lsqr_max_iterations));
   if (!std::isfinite(full_space_weight) || full_space_weight < 0)
-    fail("full_space_weight", "must be finite and ≥ 0, got " + to_text(full_space_weight));
+    stress_reconstruction_error(
+        "full_space_weight", "must be finite and ≥ 0, got " + to_text(full_space_weight));
 }
 
 namespace {
@@ -67,14 +70,15 @@ void check_motion(const ReconstructionMotion& motion, const RbfDesign& design) {
       motion.mesh, &motion.dofs, motion.positions, &motion.velocities, &motion.target_forces);
   const int rows = motion.dofs.num_free();
   if (rows == 0)
-    fail("dofs", "no free degree of freedom");
+    stress_reconstruction_error("dofs", "no free degree of freedom");
   const Eigen::Ref<const MatX>& projection = motion.projection;
   if (projection.size() > 0 && (projection.rows() != rows || !projection.allFinite()))
-    fail("projection",
+    stress_reconstruction_error("projection",
         "must have one finite row per free dof (" + to_text(rows) + "), got "
             + to_text(projection.rows()));
   if (design.damping_unknowns() > 0 && motion.mesh.nominal.elastic == nullptr)
-    fail("nominal", "fitting the damping correction needs the nominal elastic model");
+    stress_reconstruction_error(
+        "nominal", "fitting the damping correction needs the nominal elastic model");
 }
 
 /// Adds one motion's lower-triangular Σ JᵀJ and Σ Jᵀ g (each projected and/or μ-weighted) at
@@ -138,11 +142,12 @@ StressReconstructionResult reconstruct_rbf_correction(std::span<const Reconstruc
     const RbfDesign& design, const StressReconstructionOptions& options) {
   options.validate();
   if (motions.empty())
-    fail("motions", "no motion to reconstruct from");
+    stress_reconstruction_error("motions", "no motion to reconstruct from");
   if (options.method == ReconstructionMethod::lsqr) {
     for (const ReconstructionMotion& motion : motions)
       if (motion.projection.size() > 0)
-        fail("method", "the lsqr method has no force projection: use normal_equations");
+        stress_reconstruction_error(
+            "method", "the lsqr method has no force projection: use normal_equations");
     return reconstruct_rbf_correction_via_lsqr(motions, design, options);
   }
   for (const ReconstructionMotion& motion : motions)

@@ -7,7 +7,7 @@
 namespace elastolearn::material {
 
 namespace {
-constexpr FieldErrors fail("analytic_correction");
+constexpr FieldErrors analytic_correction_error("analytic_correction");
 } // namespace
 
 AnalyticCorrection::AnalyticCorrection(const Parameters& p)
@@ -16,7 +16,7 @@ AnalyticCorrection::AnalyticCorrection(const Parameters& p)
   const char* names[3] = { "a", "b", "c" };
   for (int k = 0; k < 3; ++k) {
     if (!std::isfinite(values[k]))
-      fail(names[k], "must be finite, got " + to_text(values[k]));
+      analytic_correction_error(names[k], "must be finite, got " + to_text(values[k]));
   }
 }
 

@@ -10,7 +10,7 @@ namespace elastolearn::material {
 
 namespace {
 
-constexpr FieldErrors fail("nn_correction");
+constexpr FieldErrors nn_correction_error("nn_correction");
 
 std::string layer_field(std::size_t k, const char* member) {
   return "layers[" + std::to_string(k) + "]." + member;
@@ -20,7 +20,7 @@ template <typename Derived>
 void check_scale(const char* field, const Eigen::MatrixBase<Derived>& scale) {
   for (Eigen::Index i = 0; i < scale.size(); ++i) {
     if (!std::isfinite(scale[i]) || scale[i] <= 0)
-      fail(field,
+      nn_correction_error(field,
           "entry " + std::to_string(i) + " must be finite and > 0, got " + to_text(scale[i]));
   }
 }
@@ -304,31 +304,33 @@ NnCorrection::NnCorrection(Parameters p)
     : m_p(std::move(p)) {
   const int inputs = num_inputs();
   if (m_p.input_mean.size() != inputs)
-    fail("input_mean",
+    nn_correction_error("input_mean",
         "has " + std::to_string(m_p.input_mean.size()) + " entries, expected "
             + std::to_string(inputs) + " (the " + to_string(m_p.kind) + " network's inputs)");
   if (m_p.input_scale.size() != inputs)
-    fail("input_scale",
+    nn_correction_error("input_scale",
         "has " + std::to_string(m_p.input_scale.size()) + " entries, expected "
             + std::to_string(inputs) + " (the " + to_string(m_p.kind) + " network's inputs)");
   if (!m_p.input_mean.allFinite())
-    fail("input_mean", "contains a non-finite value");
+    nn_correction_error("input_mean", "contains a non-finite value");
   if (!std::isfinite(m_p.output_mean))
-    fail("output_mean", "is not finite");
+    nn_correction_error("output_mean", "is not finite");
   check_scale("input_scale", m_p.input_scale);
   check_scale("output_scale", Eigen::Matrix<double, 1, 1>(m_p.output_scale));
   if (!m_p.polynomial.allFinite())
-    fail("polynomial", "contains a non-finite value");
+    nn_correction_error("polynomial", "contains a non-finite value");
   if (m_p.kind == NnKind::Stress && !m_p.polynomial.isZero(0))
-    fail("polynomial", "is only for an energy network; a stress network's must be zero");
+    nn_correction_error(
+        "polynomial", "is only for an energy network; a stress network's must be zero");
   m_p.trusted.validate("nn_correction.trusted_stretches");
   if (m_p.kind == NnKind::Stress && m_p.trusted.bounded())
-    fail("trusted_stretches", "is only for an energy network (a stress network has no energy)");
+    nn_correction_error(
+        "trusted_stretches", "is only for an energy network (a stress network has no energy)");
   if (m_p.layers.empty())
-    fail("layers",
+    nn_correction_error("layers",
         "is empty; at least the output layer (1 × " + std::to_string(inputs) + ") is required");
   if (m_p.layers.size() > std::size_t(k_max_hidden) + 1) {
-    fail("layers",
+    nn_correction_error("layers",
         "has " + std::to_string(m_p.layers.size() - 1) + " hidden layers, at most "
             + std::to_string(k_max_hidden) + " are supported");
   }
@@ -337,33 +339,34 @@ NnCorrection::NnCorrection(Parameters p)
     const Layer& l = m_p.layers[k];
     const bool last = k + 1 == m_p.layers.size();
     if (l.weight.cols() != in) {
-      fail(layer_field(k, "weight"),
+      nn_correction_error(layer_field(k, "weight"),
           "has " + std::to_string(l.weight.cols()) + " columns, expected " + std::to_string(in)
               + (k == 0 ? " (the network's inputs)" : " (the previous layer's outputs)"));
     }
     if (last && l.weight.rows() != 1) {
-      fail(layer_field(k, "weight"),
+      nn_correction_error(layer_field(k, "weight"),
           "is the output layer and has " + std::to_string(l.weight.rows())
               + " rows, expected 1 (one scalar network)");
     }
     if (!last && (l.weight.rows() < 1 || l.weight.rows() > k_max)) {
-      fail(layer_field(k, "weight"),
+      nn_correction_error(layer_field(k, "weight"),
           "has " + std::to_string(l.weight.rows()) + " rows, expected a hidden width in 1.."
               + std::to_string(k_max));
     }
     if (l.bias.size() != l.weight.rows()) {
-      fail(layer_field(k, "bias"),
+      nn_correction_error(layer_field(k, "bias"),
           "has " + std::to_string(l.bias.size()) + " entries, expected "
               + std::to_string(l.weight.rows()));
     }
     if (!l.weight.allFinite())
-      fail(layer_field(k, "weight"), "contains a non-finite value");
+      nn_correction_error(layer_field(k, "weight"), "contains a non-finite value");
     if (!l.bias.allFinite())
-      fail(layer_field(k, "bias"), "contains a non-finite value");
+      nn_correction_error(layer_field(k, "bias"), "contains a non-finite value");
     in = l.weight.rows();
   }
   if (m_p.damping && m_p.damping->has_elastic_part())
-    fail("damping", "must carry only a damping correction (its elastic part must be zero)");
+    nn_correction_error(
+        "damping", "must carry only a damping correction (its elastic part must be zero)");
 
   // Fold the standardisation: L₁((x − μ) ⊘ s) = (W₁ diag(1/s)) x + (b₁ − W₁ (μ ⊘ s)), and
   // μ_y + s_y L_K(a) = (s_y W_K) a + (s_y b_K + μ_y).
@@ -476,7 +479,8 @@ Lanes NnCorrection::stress_lanes(const Lanes* x, Lanes* d_x) const {
 
 double NnCorrection::evaluate(const NnInput& x, NnInput* d_input) const {
   if (m_p.kind != NnKind::Stress)
-    fail("kind", "evaluate() takes a stress network's input; this is an energy network");
+    nn_correction_error(
+        "kind", "evaluate() takes a stress network's input; this is an energy network");
   std::array<Lanes, 6> lanes, d;
   for (int i = 0; i < 6; ++i)
     lanes[std::size_t(i)] = Lanes::Constant(x[i]);
@@ -685,7 +689,7 @@ Vec3 NnCorrection::energy_chain(
 
 double NnCorrection::elastic_energy(const Vec3& stretches) const {
   if (m_p.kind != NnKind::Energy)
-    fail("kind", "a stress network has no energy");
+    nn_correction_error("kind", "a stress network has no energy");
   return continued_energy(
       m_p.trusted, m_ends, stretches, [&](const Vec3& s) { return formula_energy(s); },
       [&](const Vec3& s, Mat3* h) { return energy_correction(s, h); });

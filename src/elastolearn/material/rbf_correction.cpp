@@ -9,7 +9,7 @@ namespace elastolearn::material {
 
 namespace {
 
-constexpr FieldErrors fail("rbf_correction");
+constexpr FieldErrors rbf_correction_error("rbf_correction");
 
 /// Stable descending order of three values: order[i] = index of the i-th largest.
 std::array<int, 3> descending_order(const Vec3& v) {
@@ -108,16 +108,16 @@ RbfCorrection::RbfCorrection(Parameters p)
     : m_p(std::move(p)) {
   const Eigen::Index m = m_p.centres.rows();
   if (m_p.weights.size() != m)
-    fail("weights",
+    rbf_correction_error("weights",
         "has " + std::to_string(m_p.weights.size()) + " entries, one per centre ("
             + std::to_string(m) + ") expected");
   if (m_p.damping_weights.size() != 0 && m_p.damping_weights.size() != m)
-    fail("damping_weights",
+    rbf_correction_error("damping_weights",
         "has " + std::to_string(m_p.damping_weights.size())
             + " entries, expected none or one per centre (" + std::to_string(m) + ")");
   const auto finite = [](const char* field, bool ok) {
     if (!ok)
-      fail(field, "contains a non-finite value");
+      rbf_correction_error(field, "contains a non-finite value");
   };
   finite("centres", m_p.centres.allFinite());
   finite("weights", m_p.weights.allFinite());
@@ -131,15 +131,16 @@ RbfCorrection::RbfCorrection(Parameters p)
   finite("damping_constant", std::isfinite(m_p.damping_constant));
   finite("damping_quadratic", m_p.damping_quadratic.allFinite());
   if (std::isnan(m_p.damping_floor) || m_p.damping_floor == std::numeric_limits<double>::infinity())
-    fail("damping_floor", "must be a number or −infinity");
+    rbf_correction_error("damping_floor", "must be a number or −infinity");
   if (!std::isfinite(m_p.epsilon) || m_p.epsilon < 0) {
-    fail("epsilon", "must be finite and ≥ 0, got " + to_text(m_p.epsilon));
+    rbf_correction_error("epsilon", "must be finite and ≥ 0, got " + to_text(m_p.epsilon));
   }
   m_p.trusted.validate("rbf_correction.trusted_stretches");
   if (!m_p.energy_kernels && m_p.trusted.bounded())
-    fail("trusted_stretches", "needs energy kernels (stress kernels have no energy to continue)");
+    rbf_correction_error(
+        "trusted_stretches", "needs energy kernels (stress kernels have no energy to continue)");
   if (m_p.energy_kernels && !is_energy_quadratic_tail(m_p.quadratic))
-    fail("quadratic",
+    rbf_correction_error("quadratic",
         "is not the gradient of an energy (energy kernels need quadratic[1] = 2 quadratic[2])");
   if (m_p.energy_kernels) {
     const Eigen::Index n = 6 * m, padded = (n + 3) / 4 * 4;
@@ -216,7 +217,7 @@ Vec3 RbfCorrection::energy_kernels_sum(const Vec3& stretches, Mat3* hessian) con
 
 double RbfCorrection::elastic_energy(const Vec3& stretches) const {
   if (!m_p.energy_kernels)
-    fail("energy_kernels", "the correction is not an energy (stress kernels)");
+    rbf_correction_error("energy_kernels", "the correction is not an energy (stress kernels)");
   return continued_energy(
       m_p.trusted, m_ends, stretches, [&](const Vec3& s) { return formula_energy(s); },
       [&](const Vec3& s, Mat3* h) { return formula(s, h); });
@@ -400,9 +401,9 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   zero.centres.resize(0, 3);
   const RbfCorrection::Parameters& q = b ? b->parameters() : zero;
   if (b && q.epsilon != p.epsilon)
-    fail("epsilon", "cannot blend corrections with different kernel smoothing");
+    rbf_correction_error("epsilon", "cannot blend corrections with different kernel smoothing");
   if (b && q.energy_kernels != p.energy_kernels)
-    fail("energy_kernels", "cannot blend energy kernels with stress kernels");
+    rbf_correction_error("energy_kernels", "cannot blend energy kernels with stress kernels");
   const auto damping_weights = [](const RbfCorrection::Parameters& x) {
     return x.damping_weights.size() > 0 ? x.damping_weights : VecX(VecX::Zero(x.centres.rows()));
   };

@@ -12,17 +12,18 @@ namespace elastolearn::observe {
 
 namespace {
 
-constexpr FieldErrors fail("cloud observation");
+constexpr FieldErrors cloud_observation_error("cloud observation");
 
 } // namespace
 
 void CloudObservationOptions::validate() const {
   if (!(sigma > 0) || !std::isfinite(sigma))
-    fail("sigma", "must be positive and finite [m], got " + to_text(sigma));
+    cloud_observation_error("sigma", "must be positive and finite [m], got " + to_text(sigma));
   if (!(truncation > 0 && truncation < 1))
-    fail("truncation", "must be in (0, 1), got " + to_text(truncation));
+    cloud_observation_error("truncation", "must be in (0, 1), got " + to_text(truncation));
   if (!(min_relative_weight > 0 && min_relative_weight <= 1))
-    fail("min_relative_weight", "must be in (0, 1], got " + to_text(min_relative_weight));
+    cloud_observation_error(
+        "min_relative_weight", "must be in (0, 1], got " + to_text(min_relative_weight));
 }
 
 Observation observe_clouds(const std::vector<int>& vertex_ids,

@@ -29,7 +29,7 @@ class HoldingForce final : public fem::ForceTerm {
   }
 };
 
-constexpr FieldErrors fail("tracking");
+constexpr FieldErrors tracking_error("tracking");
 
 /// Surface samples are spaced at most 3σ (a cloud point on the surface is then within
 /// 3σ/√3 ≈ 1.7σ of a sample, well inside the 3.72σ reach of the default truncation) ...
@@ -70,21 +70,21 @@ double longitudinal_modulus(const fem::MaterialModel& material) {
 
 void TrackingOptions::validate() const {
   if (!(sigma > 0) || !std::isfinite(sigma))
-    fail("sigma",
+    tracking_error("sigma",
         "must be positive and finite (the scanner's accuracy in metres), got " + to_text(sigma));
   if (!(weight > 0) || !std::isfinite(weight))
-    fail("weight", "must be positive and finite, got " + to_text(weight));
+    tracking_error("weight", "must be positive and finite, got " + to_text(weight));
   if (!(tangential_weight >= 0 && tangential_weight <= 1))
-    fail("tangential_weight", "must be in [0, 1], got " + to_text(tangential_weight));
+    tracking_error("tangential_weight", "must be in [0, 1], got " + to_text(tangential_weight));
   if (!(truncation > 0 && truncation < 1))
-    fail("truncation", "must be in (0, 1), got " + to_text(truncation));
+    tracking_error("truncation", "must be in (0, 1), got " + to_text(truncation));
   if (em_iterations < 1)
-    fail("em_iterations", "must be at least 1, got " + std::to_string(em_iterations));
+    tracking_error("em_iterations", "must be at least 1, got " + std::to_string(em_iterations));
   if (initial_em_iterations < 1)
-    fail("initial_em_iterations",
+    tracking_error("initial_em_iterations",
         "must be at least 1, got " + std::to_string(initial_em_iterations));
   if (!(em_tolerance >= 0) || !std::isfinite(em_tolerance))
-    fail("em_tolerance", "must be non-negative and finite, got " + to_text(em_tolerance));
+    tracking_error("em_tolerance", "must be non-negative and finite, got " + to_text(em_tolerance));
 }
 
 double default_tracking_sigma(
