@@ -91,8 +91,8 @@ double g_damping_regularization = -1, g_regularization = -1, g_position_weight =
        g_kernel_smoothing = -1, g_full_space_weight = -1, g_damping_prior = -1,
        g_elastic_prior = -1, g_smoothness = -1, g_forward_fit_tolerance = -1;
 bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
-     g_full_space = false, g_no_damping = false, g_smooth_clamp = false, g_pod_forward_only = false,
-     g_unprojected = false, g_no_backtrack = false;
+     g_full_space = false, g_no_damping = false, g_smooth_clamp = false, g_smooth_expansion = false,
+     g_pod_forward_only = false, g_unprojected = false, g_no_backtrack = false;
 
 void apply_overrides(learn::LearningOptions& o) {
   if (g_modes > 0)
@@ -123,6 +123,8 @@ void apply_overrides(learn::LearningOptions& o) {
     o.rbf.smoothness = g_smoothness;
   if (g_smooth_clamp)
     o.rbf.continuation = material::Continuation::smooth_clamp;
+  if (g_smooth_expansion)
+    o.rbf.continuation = material::Continuation::smooth_expansion;
   if (g_linear_tail)
     o.rbf.quadratic_tail = false;
   if (g_neo_hookean_tail)
@@ -494,6 +496,8 @@ int main(int argc, char** argv) {
       g_no_damping = true;
     else if (a == "--smooth-clamp")
       g_smooth_clamp = true;
+    else if (a == "--smooth-expansion")
+      g_smooth_expansion = true;
     else if (a == "--position-weight" && i + 1 < argc)
       g_position_weight = std::stod(argv[++i]);
     else if (a == "--unprojected-reconstruction")
@@ -520,7 +524,8 @@ int main(int argc, char** argv) {
                   "[--smoothness L] "
                   "[--stress-kernels] [--linear-tail] [--neo-hookean-tail] "
                   "[--damping-quadratic-tail] [--full-space] "
-                  "[--pod-forward-only] [--no-damping] [--smooth-clamp] [--position-weight W] "
+                  "[--pod-forward-only] [--no-damping] [--smooth-clamp] [--smooth-expansion] "
+                  "[--position-weight W] "
                   "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\n"
                   "       bench_learning --random N [--seed S] [--random-case I] [--draw-only] "
                   "[--noise PCT] [--data DIR]\n       (either form) [--test-candidates]\ncases:");

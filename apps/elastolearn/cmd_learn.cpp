@@ -340,9 +340,10 @@ void add_learn_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--continuation", o->continuation,
          "how a correction continues beyond the stretches it was learned from: "
-         "bounded_softening (the edge's stiffness, keeping half the nominal's) | smooth_clamp "
-         "(exact: the ends' uniaxial stress and stiffness; docs/learning_recipe.md)")
-      ->check(CLI::IsMember({ "bounded_softening", "smooth_clamp" }))
+         "bounded_softening (the edge's stiffness, keeping half the nominal's) | "
+         "smooth_expansion (exact: a second-order expansion at the ends) | smooth_clamp (exact: "
+         "the ends' uniaxial stress and stiffness); docs/learning_recipe.md")
+      ->check(CLI::IsMember({ "bounded_softening", "smooth_expansion", "smooth_clamp" }))
       ->capture_default_str();
   cmd->add_option("--smoothness", l.rbf.smoothness,
          "weight of the RBF's smoothness penalty (native-space seminorm of the kernel weights, "

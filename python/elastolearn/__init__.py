@@ -101,8 +101,8 @@ def learn(scene, observations=None, *, clouds=None, output=None, checkpoint=None
     pod_stride, full_space, pod_forward_only, kernels, position_weight, space_time_iterations,
     regularization, reconstruction ("normal_equations" | "lsqr"), frame_stride,
     unprojected_reconstruction, full_space_weight, no_damping, linear_tail,
-    damping_regularization, continuation ("bounded_softening" | "smooth_clamp"), smoothness,
-    seed, forward_fit, forward_fit_tolerance, damping_prior,
+    damping_regularization, continuation ("bounded_softening" | "smooth_expansion" |
+    "smooth_clamp"), smoothness, seed, forward_fit, forward_fit_tolerance, damping_prior,
     elastic_prior, kernel_smoothing, stress_kernels, neo_hookean_tail, damping_quadratic_tail,
     allow_rest_stress, no_network (stage 5 off: keep the RBF), network_kind,
     network_motion_scales, network_samples, network_rate_jitter.

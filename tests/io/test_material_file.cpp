@@ -583,32 +583,37 @@ TEST(MaterialFile, RbfContinuationRoundTripsAndOlderFilesKeepTheEdgeHessian) {
   expect_bad(bad, { "bad.json: correction", "kept_stiffness" });
 }
 
-TEST(MaterialFile, TheSmoothClampRoundTripsWithItsWidth) {
-  // "continuation": "smooth_clamp" with its "clamp_width": what learning writes; read back it
-  // continues the correction exactly as written, beyond the interval too.
-  auto p = rbf_parameters(3, 9);
-  p.energy_kernels = true;
-  p.quadratic[1] = 2 * p.quadratic[2];
-  p.trusted = { 0.85, 1.3, material::Continuation::smooth_clamp };
-  p.trusted.clamp_width = 0.07;
-  p.trusted.nominal_stiffness = 1e4 * (Mat3::Identity() + Mat3::Ones());
-  MaterialFile f;
-  f.material = k_nominal;
-  f.correction = std::make_shared<material::RbfCorrection>(p);
-  const Json j = material_file_to_json(f);
-  EXPECT_EQ(j["correction"]["continuation"], "smooth_clamp");
-  EXPECT_EQ(j["correction"]["clamp_width"], 0.07);
-  const auto read = parse_material_file(Json::parse(j.dump()), "f.json").correction;
-  const auto& q = dynamic_cast<const material::RbfCorrection&>(*read).parameters().trusted;
-  EXPECT_EQ(q.continuation, material::Continuation::smooth_clamp);
-  EXPECT_EQ(q.clamp_width, 0.07);
-  EXPECT_EQ(q.nominal_stiffness, p.trusted.nominal_stiffness);
-  for (const Vec3& s : { Vec3(1.0, 0.9, 0.5), Vec3(1.33, 1.0, 0.95), Vec3(2.0, 1.4, 0.6) })
-    EXPECT_EQ(f.correction->correction(s, Vec3::Zero()), read->correction(s, Vec3::Zero()));
-  Json bad = j;
-  bad["correction"].erase("clamp_width");
-  expect_bad(bad, { "bad.json: correction.clamp_width" });
-  bad = j;
-  bad["correction"]["clamp_width"] = -1;
-  expect_bad(bad, { "bad.json: correction", "clamp_width" });
+TEST(MaterialFile, TheSmoothFormsRoundTripWithTheirWidth) {
+  // "continuation": "smooth_expansion" or "smooth_clamp" with its "clamp_width": what learning
+  // writes; read back it continues the correction exactly as written, beyond the interval too.
+  for (const auto continuation :
+      { material::Continuation::smooth_clamp, material::Continuation::smooth_expansion }) {
+    const std::string name = material::continuation_name(continuation);
+    SCOPED_TRACE(name);
+    auto p = rbf_parameters(3, 9);
+    p.energy_kernels = true;
+    p.quadratic[1] = 2 * p.quadratic[2];
+    p.trusted = { 0.85, 1.3, continuation };
+    p.trusted.clamp_width = 0.07;
+    p.trusted.nominal_stiffness = 1e4 * (Mat3::Identity() + Mat3::Ones());
+    MaterialFile f;
+    f.material = k_nominal;
+    f.correction = std::make_shared<material::RbfCorrection>(p);
+    const Json j = material_file_to_json(f);
+    EXPECT_EQ(j["correction"]["continuation"], name);
+    EXPECT_EQ(j["correction"]["clamp_width"], 0.07);
+    const auto read = parse_material_file(Json::parse(j.dump()), "f.json").correction;
+    const auto& q = dynamic_cast<const material::RbfCorrection&>(*read).parameters().trusted;
+    EXPECT_EQ(q.continuation, continuation);
+    EXPECT_EQ(q.clamp_width, 0.07);
+    EXPECT_EQ(q.nominal_stiffness, p.trusted.nominal_stiffness);
+    for (const Vec3& s : { Vec3(1.0, 0.9, 0.5), Vec3(1.33, 1.0, 0.95), Vec3(2.0, 1.4, 0.6) })
+      EXPECT_EQ(f.correction->correction(s, Vec3::Zero()), read->correction(s, Vec3::Zero()));
+    Json bad = j;
+    bad["correction"].erase("clamp_width");
+    expect_bad(bad, { "bad.json: correction.clamp_width" });
+    bad = j;
+    bad["correction"]["clamp_width"] = -1;
+    expect_bad(bad, { "bad.json: correction", "clamp_width" });
+  }
 }

@@ -537,9 +537,9 @@ TEST(LearningLoop, RefusesAnEmptyTrainingSetAndNamesTheMotion) {
 }
 
 } // namespace
-TEST(LearningLoop, TheSmoothClampLearnsAndItsCorrectionsCarryIt) {
-  // `learn --continuation smooth_clamp`: every correction the loop writes is continued by the
-  // exact smooth clamp (with the nominal's rest stiffness for its floor), and the learned
+TEST(LearningLoop, TheSmoothExpansionLearnsAndItsCorrectionsCarryIt) {
+  // `learn --continuation smooth_expansion`: every correction the loop writes is continued by the
+  // exact smooth expansion (with the nominal's rest stiffness for its floor), and the learned
   // material simulates the unseen swing, which goes beyond the droop's stretches, well below the
   // nominal's error (the 5× of the tests above).
   const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
@@ -547,21 +547,21 @@ TEST(LearningLoop, TheSmoothClampLearnsAndItsCorrectionsCarryIt) {
   const auto observed = observe_surface(bar_scene(truth, false));
   LearningOptions options = small_options();
   options.rbf.energy_kernels = true;
-  options.rbf.continuation = material::Continuation::smooth_clamp;
+  options.rbf.continuation = material::Continuation::smooth_expansion;
   LearningState state;
   ASSERT_TRUE(run_learning(bar_scene(nominal, false), observed, options, state));
   const auto* rbf = dynamic_cast<const material::RbfCorrection*>(state.best.get());
   ASSERT_NE(rbf, nullptr);
   const material::TrustedStretches& t = rbf->parameters().trusted;
-  EXPECT_EQ(t.continuation, material::Continuation::smooth_clamp);
+  EXPECT_EQ(t.continuation, material::Continuation::smooth_expansion);
   EXPECT_TRUE(t.bounded());
   EXPECT_EQ(t.nominal_stiffness,
       bar_scene(nominal, false).material.elastic->principal_stress_derivative(Vec3::Ones()));
   const double nominal_error = swing_error(bar_scene(truth, true), bar_scene(nominal, true));
   const double learned_error = swing_error(
       bar_scene(truth, true), sim::with_correction(bar_scene(nominal, true), state.best));
-  std::printf("[ measured ] smooth clamp: err_L nominal %.4f %%, learned %.4f %%\n", nominal_error,
-      learned_error);
+  std::printf("[ measured ] smooth expansion: err_L nominal %.4f %%, learned %.4f %%\n",
+      nominal_error, learned_error);
   EXPECT_LT(learned_error, nominal_error / 5);
 }
 

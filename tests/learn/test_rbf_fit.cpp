@@ -444,20 +444,24 @@ TEST(RbfDesign, BeyondTheTrustedStretchesTheDesignContinuesAsTheCorrection) {
   expect_design_is_the_correction(
       design, x, { Vec3(1.5, 0.93, 0.97), Vec3(0.6, 1.3, 1.0), Vec3(1.05, 1.0, 0.95) });
   EXPECT_THROW(RbfDesign(centres, options).unknowns(n), InputError) << "another interval";
-  // The smooth clamp is linear in x where its end stiffness is above its floor (here
+  // The smooth forms are linear in x where their end stiffness is above its floor (here
   // everywhere), so A x = N and the derivatives agree exactly, in the transition and far
   // beyond, one end or both; Δα₁ is read at φ(σ) too.
-  material::TrustedStretches clamp { 0.9, 1.15, material::Continuation::smooth_clamp };
-  clamp.clamp_width = 0.1;
-  clamp.nominal_stiffness = 1e12 * (Mat3::Identity() + Mat3::Ones()); // the floor is inactive
-  clamp.kept_stiffness = 0;
-  RbfFitOptions damped = options;
-  damped.fit_damping = true;
-  const RbfDesign clamped(centres, damped, clamp);
-  ASSERT_GT(clamped.damping_unknowns(), 0);
-  expect_design_is_the_correction(clamped, random_unknowns(clamped, 6),
-      { Vec3(1.5, 0.93, 0.97), Vec3(0.6, 1.3, 1.0), Vec3(1.2, 1.0, 0.95), Vec3(1.18, 1.17, 0.86),
-          Vec3(1.05, 1.0, 0.95) });
+  for (const auto continuation :
+      { material::Continuation::smooth_clamp, material::Continuation::smooth_expansion }) {
+    SCOPED_TRACE(material::continuation_name(continuation));
+    material::TrustedStretches clamp { 0.9, 1.15, continuation };
+    clamp.clamp_width = 0.1;
+    clamp.nominal_stiffness = 1e12 * (Mat3::Identity() + Mat3::Ones()); // the floor is inactive
+    clamp.kept_stiffness = 0;
+    RbfFitOptions damped = options;
+    damped.fit_damping = true;
+    const RbfDesign clamped(centres, damped, clamp);
+    ASSERT_GT(clamped.damping_unknowns(), 0);
+    expect_design_is_the_correction(clamped, random_unknowns(clamped, 6),
+        { Vec3(1.5, 0.93, 0.97), Vec3(0.6, 1.3, 1.0), Vec3(1.2, 1.0, 0.95), Vec3(1.18, 1.17, 0.86),
+            Vec3(1.35, 0.83, 1.21), Vec3(1.05, 1.0, 0.95) });
+  }
   RbfFitOptions stress = options;
   stress.energy_kernels = false;
   EXPECT_THROW(RbfDesign(centres, stress, { 0.9, 1.15 }), InputError);

@@ -589,31 +589,34 @@ TEST(NnCorrectionEnergy, BeyondItsTrustedStretchesItKeepsTheStiffnessOfTheEdge) 
   EXPECT_THROW(NnCorrection { stress_network }, InputError);
 }
 
-TEST(NnCorrectionEnergy, TheSmoothClampIsAnExactEnergyBeyondItsTrustedStretches) {
-  // An energy network continued by the smooth clamp: in mixed, transition and saturated states
-  // its stress is the energy's gradient and its tangent the stress's derivative (central
-  // differences), symmetric; inside it is the network itself.
+TEST(NnCorrectionEnergy, TheSmoothFormsAreExactEnergiesBeyondTheirTrustedStretches) {
+  // An energy network continued by the smooth clamp or the smooth expansion: in mixed, transition
+  // and saturated states its stress is the energy's gradient and its tangent the stress's
+  // derivative (central differences), symmetric; inside it is the network itself.
   const NnCorrection unbounded(energy_parameters({ 8, 8 }));
-  NnCorrection::Parameters p = energy_parameters({ 8, 8 });
-  p.trusted = { 0.9, 1.2, Continuation::smooth_clamp };
-  p.trusted.nominal_stiffness = 1e4 * (Mat3::Identity() + Mat3::Ones());
-  const NnCorrection n(p);
-  EXPECT_EQ(n.correction(Vec3(1.1, 1.0, 0.95), Vec3::Zero()),
-      unbounded.correction(Vec3(1.1, 1.0, 0.95), Vec3::Zero()));
-  for (const Vec3& s : { Vec3(1.6, 1.0, 0.95), Vec3(1.25, 1.02, 0.95), Vec3(0.85, 1.1, 1.6) }) {
-    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
-    Eigen::MatrixXd stress(1, 3);
-    stress.row(0) = n.correction(s, Vec3::Zero()).transpose();
-    const FdFunction energy = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-      return Eigen::VectorXd::Constant(1, n.elastic_energy(y.head<3>()));
-    };
-    expect_jacobian_matches(stress, energy, Eigen::VectorXd(s), 1e-7, 1e-4);
-    Mat3 ds, unused;
-    n.correction_with_gradient(s, Vec3::Zero(), ds, unused);
-    const FdFunction field = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-      return n.correction(y.head<3>(), Vec3::Zero());
-    };
-    expect_jacobian_matches(ds, field, Eigen::VectorXd(s), 1e-6, 1e-5);
-    EXPECT_LE((ds - ds.transpose()).norm(), 1e-10 * ds.norm());
-  }
+  for (const auto continuation : { Continuation::smooth_clamp, Continuation::smooth_expansion })
+    for (const Vec3& s : { Vec3(1.6, 1.0, 0.95), Vec3(1.25, 1.02, 0.95), Vec3(0.85, 1.1, 1.6),
+             Vec3(1.35, 0.83, 1.21) }) {
+      SCOPED_TRACE(
+          testing::Message() << continuation_name(continuation) << ", stretches " << s.transpose());
+      NnCorrection::Parameters p = energy_parameters({ 8, 8 });
+      p.trusted = { 0.9, 1.2, continuation };
+      p.trusted.nominal_stiffness = 1e4 * (Mat3::Identity() + Mat3::Ones());
+      const NnCorrection n(p);
+      EXPECT_EQ(n.correction(Vec3(1.1, 1.0, 0.95), Vec3::Zero()),
+          unbounded.correction(Vec3(1.1, 1.0, 0.95), Vec3::Zero()));
+      Eigen::MatrixXd stress(1, 3);
+      stress.row(0) = n.correction(s, Vec3::Zero()).transpose();
+      const FdFunction energy = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+        return Eigen::VectorXd::Constant(1, n.elastic_energy(y.head<3>()));
+      };
+      expect_jacobian_matches(stress, energy, Eigen::VectorXd(s), 1e-7, 1e-4);
+      Mat3 ds, unused;
+      n.correction_with_gradient(s, Vec3::Zero(), ds, unused);
+      const FdFunction field = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+        return n.correction(y.head<3>(), Vec3::Zero());
+      };
+      expect_jacobian_matches(ds, field, Eigen::VectorXd(s), 1e-6, 1e-5);
+      EXPECT_LE((ds - ds.transpose()).norm(), 1e-10 * ds.norm());
+    }
 }

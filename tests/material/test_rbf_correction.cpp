@@ -578,10 +578,10 @@ TEST(RbfCorrectionEnergy, RejectsAnInvalidTrustedInterval) {
 
 namespace {
 
-/// energy_correction() trusted in [0.9, 1.2], continued by the smooth clamp (w = 0.1).
-RbfCorrection clamped_correction() {
+/// energy_correction() trusted in [0.9, 1.2], continued by a smooth form (w = 0.1).
+RbfCorrection clamped_correction(Continuation continuation) {
   RbfCorrection::Parameters p = energy_correction().parameters();
-  p.trusted = trusted_interval(Continuation::smooth_clamp);
+  p.trusted = trusted_interval(continuation);
   p.trusted.clamp_width = 0.1;
   return RbfCorrection(std::move(p));
 }
@@ -590,25 +590,67 @@ RbfCorrection clamped_correction() {
 /// transition's far end max + w, where the third derivative of φ jumps and central differences
 /// lose their order.
 const std::vector<Vec3> k_clamped_states { Vec3(1.6, 1.0, 0.95), Vec3(1.25, 1.02, 0.95),
-  Vec3(1.24, 1.24, 0.92), Vec3(1.4, 1.33, 0.6), Vec3(0.85, 1.1, 1.6), Vec3(1.8, 1.01, 0.99) };
+  Vec3(1.24, 1.24, 0.92), Vec3(1.4, 1.33, 0.6), Vec3(0.85, 1.1, 1.6), Vec3(1.8, 1.01, 0.99),
+  Vec3(1.28, 0.88, 1.05) };
+
+const Continuation k_smooth_forms[] { Continuation::smooth_clamp, Continuation::smooth_expansion };
 
 } // namespace
 
-TEST(RbfCorrectionEnergy, TheSmoothClampIsAnExactEnergyEverywhere) {
-  // ΔΨ(φ(σ)) + Σ gᵢ(σᵢ − φᵢ): N is its gradient and the tangent N's derivative, symmetric, at
-  // every state beyond the interval, mixed ones included (stretches inside and outside at once).
-  const RbfCorrection n = clamped_correction();
-  for (const Vec3& s : k_clamped_states) {
+TEST(RbfCorrectionEnergy, TheSmoothFormsAreExactEnergiesEverywhere) {
+  // ΔΨ(φ(σ)) plus the terms in the distances beyond: N is its gradient and the tangent N's
+  // derivative, symmetric, at every state beyond the interval, mixed ones included (stretches
+  // inside and outside at once), beyond both ends.
+  for (const Continuation continuation : k_smooth_forms)
+    for (const Vec3& s : k_clamped_states) {
+      SCOPED_TRACE(
+          testing::Message() << continuation_name(continuation) << ", stretches " << s.transpose());
+      const RbfCorrection n = clamped_correction(continuation);
+      expect_stress_is_energy_gradient(n, s);
+      // Beyond both ends every stretch is saturated and the tangent is zero: its differences are
+      // round-off, ~1e-16 |N| / h ≈ 1e-8 Pa: the floor 1e7 Pa allows 1 Pa of error wherever the
+      // tangent is smaller (elsewhere it is ~1e4–1e6 Pa).
+      expect_gradient_matches_fd(n, s, Vec3::Zero(), 1e-7, 1e7);
+      Mat3 ds, dr;
+      n.correction_gradient(s, Vec3::Zero(), ds, dr);
+      EXPECT_LE((ds - ds.transpose()).norm(), 1e-10 * ds.norm()) << ds;
+    }
+}
+
+TEST(RbfCorrectionEnergy, TheSmoothExpansionContinuesAQuadraticEnergyExactly) {
+  // ΔΨ = a/2 Σ(σᵢ − 1)² + b Σ_{i<j}(σᵢ − 1)(σⱼ − 1) (the linear tail alone, no kernel): its
+  // second-order expansion is itself, so beyond the trusted stretches the smooth expansion must
+  // give the formula's stress and stiffness in the transition, far beyond, in mixed states and
+  // beyond both ends. The smooth clamp (expanded at the end point, uncoupled) does not.
+  RbfCorrection::Parameters p = energy_correction().parameters();
+  p.weights.setZero();
+  p.quadratic.setZero();
+  p.neo_hookean.setZero();
+  p.constant = 0;
+  p.own_slope = 3e4;
+  p.other_slope = 1e4;
+  const RbfCorrection formula(p);
+  p.trusted = trusted_interval(Continuation::smooth_expansion);
+  const RbfCorrection n(std::move(p));
+  std::vector<Vec3> states = k_clamped_states;
+  states.insert(
+      states.end(), { Vec3(1.23, 1.0, 0.95), Vec3(1.28, 0.88, 1.05), Vec3(0.82, 0.85, 1.1) });
+  for (const Vec3& s : states) {
     SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
-    expect_stress_is_energy_gradient(n, s);
-    // Beyond both ends every stretch is saturated and the tangent is zero: its differences are
-    // round-off, ~1e-16 |N| / h ≈ 1e-8 Pa: the floor 1e7 Pa allows 1 Pa of error wherever the
-    // tangent is smaller (elsewhere it is ~1e4–1e6 Pa).
-    expect_gradient_matches_fd(n, s, Vec3::Zero(), 1e-7, 1e7);
-    Mat3 ds, dr;
-    n.correction_gradient(s, Vec3::Zero(), ds, dr);
-    EXPECT_LE((ds - ds.transpose()).norm(), 1e-10 * ds.norm()) << ds;
+    Mat3 ds, dr, h;
+    const Vec3 stress = n.correction_with_gradient(s, Vec3::Zero(), ds, dr);
+    const Vec3 expected = formula.correction_with_gradient(s, Vec3::Zero(), h, dr);
+    EXPECT_LE((stress - expected).norm(), 1e-9 * expected.norm() + 1e-9);
+    EXPECT_LE((ds - h).norm(), 1e-9 * h.norm());
+    EXPECT_NEAR(n.elastic_energy(s), formula.elastic_energy(s), 1e-9 * 3e4);
   }
+  RbfCorrection::Parameters q = formula.parameters();
+  q.trusted = trusted_interval(Continuation::smooth_clamp);
+  const RbfCorrection clamp(std::move(q));
+  Mat3 ds, dr;
+  clamp.correction_with_gradient(Vec3(1.25, 1.0, 1.0), Vec3::Zero(), ds, dr); // x = ½
+  // Its φ''-term and its expansion at the end point leave 0.78 a there (0.78–1.16 a across it).
+  EXPECT_LT(ds(0, 0), 0.85 * 3e4) << "the smooth clamp keeps the stiffness in the transition";
 }
 
 TEST(RbfCorrectionEnergy, TheEdgeExpansionsTangentIsNotTheirStressDerivativeInMixedStates) {
@@ -631,76 +673,101 @@ TEST(RbfCorrectionEnergy, TheEdgeExpansionsTangentIsNotTheirStressDerivativeInMi
   EXPECT_GT((fd - ds).norm(), 0.1 * ds.norm()) << "tangent\n" << ds << "\nN's derivative\n" << fd;
 }
 
-TEST(RbfCorrectionEnergy, FarBeyondTheSmoothClampContinuesTheEndsUniaxialStressAndStiffness) {
+TEST(RbfCorrectionEnergy, FarBeyondTheSmoothFormsContinueTheEndsStressAndStiffness) {
   const RbfCorrection unbounded = energy_correction();
-  const RbfCorrection n = clamped_correction();
-  const TrustedStretches& t = n.parameters().trusted;
-  // Inside: the formula itself.
-  const Vec3 inside(1.1, 1.0, 0.95);
-  EXPECT_EQ(n.elastic_correction(inside), unbounded.elastic_correction(inside));
-  // Beyond max + w along σ₁: N₁ is the end's stress and stiffness continued from
-  // (max + w/2, 1, 1), the formula's N₁ and ∂N₁/∂σ₁ there (above the floor for this correction);
-  // the other stretches see the formula at (max + w/2, σ₂, σ₃).
+  // Beyond max + w along σ₁: N₁ is the end's stress g, stiffness k and (smooth_expansion)
+  // coupling l continued from e = (max + w/2, 1, 1), the formula's N₁, ∂N₁/∂σ₁ and ∂N₁/∂σ₂ there
+  // (k above the floor for this correction): N₁ = g + l (σ₂ − 1 + σ₃ − 1) + k (σ₁ − 1.25). The
+  // other stretches see the formula at (max + w/2, σ₂, σ₃) plus l (σ₁ − 1.25). smooth_clamp
+  // keeps the uniaxial part (l = 0).
   Mat3 end_hessian, unused;
-  const double g
-      = unbounded.correction_with_gradient(t.end_point(true), Vec3::Zero(), end_hessian, unused)[0];
+  const double g = unbounded.correction_with_gradient(
+      trusted_interval(Continuation::smooth_clamp).end_point(true), Vec3::Zero(), end_hessian,
+      unused)[0];
   const double k = end_hessian(0, 0);
+  ASSERT_GT(std::abs(end_hessian(0, 1)), 1e-3 * std::abs(k)) << "the test needs a coupling";
   const Mat3 k0 = bounded_nominal().principal_stress_derivative(Vec3::Ones());
   ASSERT_GT(k, -0.5 * (k0(0, 0) - k0(0, 1))) << "the test needs an end above the floor";
-  for (const double s1 : { 1.31, 1.6, 3.0 }) {
-    SCOPED_TRACE(testing::Message() << "σ₁ " << s1);
-    const Vec3 s(s1, 1.01, 0.99);
-    Mat3 ds;
-    const Vec3 stress = n.correction_with_gradient(s, Vec3::Zero(), ds, unused);
-    const Vec3 at_phi = unbounded.elastic_correction(Vec3(1.25, 1.01, 0.99));
-    EXPECT_NEAR(stress[0], g + k * (s1 - 1.25), 1e-12 * (std::abs(g) + std::abs(k)));
-    EXPECT_NEAR(stress[1], at_phi[1], 1e-12 * at_phi.norm());
-    EXPECT_NEAR(stress[2], at_phi[2], 1e-12 * at_phi.norm());
-    EXPECT_NEAR(ds(0, 0), k, 1e-12 * std::abs(k));
-    EXPECT_EQ(ds.row(0).tail<2>().norm(), 0);
-    EXPECT_EQ(ds.col(0).tail<2>().norm(), 0);
-    // So the twist of the two stretches inside stays the formula's there, however far σ₁ goes
-    // (an expansion at the edge adds third derivatives of ΔΨ times the distance to it).
-    Mat3 h;
-    unbounded.correction_gradient(Vec3(1.25, 1.01, 0.99), Vec3::Zero(), h, unused);
-    EXPECT_LE((ds.bottomRightCorner<2, 2>() - h.bottomRightCorner<2, 2>()).norm(), 1e-9 * h.norm());
-    // Δα₁ is the data's near the edge too, not its tails' far beyond.
-    EXPECT_EQ(n.stiffness_damping(s), unbounded.stiffness_damping(Vec3(1.25, 1.01, 0.99)));
-  }
-  // C² at both ends of the transition: the tangent is continuous at max and at max + w.
-  for (const double edge : { 1.2, 1.3 }) {
-    SCOPED_TRACE(testing::Message() << "edge " << edge);
-    Mat3 below, above;
-    const double step = 1e-7;
-    n.correction_gradient(Vec3(edge - step, 1.0, 0.95), Vec3::Zero(), below, unused);
-    n.correction_gradient(Vec3(edge + step, 1.0, 0.95), Vec3::Zero(), above, unused);
-    EXPECT_LE((above - below).norm(), 1e-4 * below.norm());
+  for (const Continuation continuation : k_smooth_forms) {
+    const RbfCorrection n = clamped_correction(continuation);
+    // Inside: the formula itself.
+    const Vec3 inside(1.1, 1.0, 0.95);
+    EXPECT_EQ(n.elastic_correction(inside), unbounded.elastic_correction(inside));
+    const double l = continuation == Continuation::smooth_expansion ? end_hessian(0, 1) : 0;
+    for (const double s1 : { 1.31, 1.6, 3.0 }) {
+      SCOPED_TRACE(testing::Message() << continuation_name(continuation) << ", σ₁ " << s1);
+      const Vec3 s(s1, 1.02, 0.97);
+      const double d = s1 - 1.25;
+      Mat3 ds;
+      const Vec3 stress = n.correction_with_gradient(s, Vec3::Zero(), ds, unused);
+      const Vec3 at_phi = unbounded.elastic_correction(Vec3(1.25, 1.02, 0.97));
+      const double scale = std::abs(g) + std::abs(k) + std::abs(end_hessian(0, 1)) + at_phi.norm();
+      EXPECT_NEAR(stress[0], g + l * (0.02 - 0.03) + k * d, 1e-12 * scale);
+      EXPECT_NEAR(stress[1], at_phi[1] + l * d, 1e-12 * scale);
+      EXPECT_NEAR(stress[2], at_phi[2] + l * d, 1e-12 * scale);
+      EXPECT_NEAR(ds(0, 0), k, 1e-12 * std::abs(k));
+      for (int j = 1; j < 3; ++j) {
+        EXPECT_NEAR(ds(0, j), l, 1e-12 * scale);
+        EXPECT_NEAR(ds(j, 0), l, 1e-12 * scale);
+      }
+      // So the twist of the two stretches inside stays the formula's there, however far σ₁ goes
+      // (an expansion at the moving edge point c adds third derivatives of ΔΨ times the
+      // distance).
+      Mat3 h;
+      unbounded.correction_gradient(Vec3(1.25, 1.02, 0.97), Vec3::Zero(), h, unused);
+      EXPECT_LE(
+          (ds.bottomRightCorner<2, 2>() - h.bottomRightCorner<2, 2>()).norm(), 1e-9 * h.norm());
+      // Δα₁ is the data's near the edge too, not its tails' far beyond.
+      EXPECT_EQ(n.stiffness_damping(s), unbounded.stiffness_damping(Vec3(1.25, 1.02, 0.97)));
+    }
+    // C² at both ends of the transition: the tangent is continuous at max and at max + w.
+    for (const double edge : { 1.2, 1.3 }) {
+      SCOPED_TRACE(testing::Message() << continuation_name(continuation) << ", edge " << edge);
+      Mat3 below, above;
+      const double step = 1e-7;
+      n.correction_gradient(Vec3(edge - step, 1.0, 0.95), Vec3::Zero(), below, unused);
+      n.correction_gradient(Vec3(edge + step, 1.0, 0.95), Vec3::Zero(), above, unused);
+      EXPECT_LE((above - below).norm(), 1e-4 * below.norm());
+    }
   }
 }
 
-TEST(RbfCorrectionEnergy, FarBeyondTheSmoothClampTheCorrectedModelKeepsItsShearStiffness) {
+TEST(RbfCorrectionEnergy, FarBeyondTheSmoothFormsTheCorrectedModelKeepsItsShearStiffness) {
   // A correction that removes more than the nominal's stiffness near the interval's lower end:
   // far beyond it, along the stretch beyond, the corrected corotated model keeps β of its rest
-  // shear stiffness 2μ (the end stiffness at its floor), where the edge Hessian's expansion is
-  // unstable.
-  RbfCorrection::Parameters p = softening_correction(Continuation::edge_hessian).parameters();
-  p.trusted = trusted_interval(Continuation::smooth_clamp);
-  const RbfCorrection n(std::move(p));
-  const RbfCorrection hessian = softening_correction(Continuation::edge_hessian);
-  const Mat3 k0 = bounded_nominal().principal_stress_derivative(Vec3::Ones());
-  const double floor = -(1 - kKeptStiffness) * (k0(0, 0) - k0(0, 1));
-  Mat3 end_hessian, unused;
-  hessian.correction_gradient(
-      n.parameters().trusted.end_point(false), Vec3::Zero(), end_hessian, unused);
-  ASSERT_LT(end_hessian(0, 0), floor) << "the test needs an end below the floor";
-  for (const Vec3& s : { Vec3(1.0, 0.95, 0.6), Vec3(1.0, 0.95, 0.4) }) {
-    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
-    const CorrectedStress c = corrected_principal_stress(bounded_nominal(), &n, s, Vec3::Zero());
-    const Mat3 k = bounded_nominal().principal_stress_derivative(s);
-    EXPECT_NEAR(c.d_stretches(2, 2), k(2, 2) + floor, 1e-9 * k.norm());
-    EXPECT_GT(c.d_stretches(2, 2), 0);
-    const CorrectedStress e
-        = corrected_principal_stress(bounded_nominal(), &hessian, s, Vec3::Zero());
-    EXPECT_LT(e.d_stretches(2, 2), 0) << "the edge Hessian's expansion";
+  // shear stiffness 2μ (the end stiffness at its floor; the smooth expansion's end Hessian is
+  // bounded first as bounded_softening bounds it, which may leave it above), where the edge
+  // Hessian's expansion is unstable.
+  for (const Continuation continuation : k_smooth_forms) {
+    SCOPED_TRACE(continuation_name(continuation));
+    RbfCorrection::Parameters p = softening_correction(Continuation::edge_hessian).parameters();
+    p.trusted = trusted_interval(continuation);
+    const RbfCorrection n(std::move(p));
+    const RbfCorrection hessian = softening_correction(Continuation::edge_hessian);
+    const Mat3 k0 = bounded_nominal().principal_stress_derivative(Vec3::Ones());
+    const double floor = -(1 - kKeptStiffness) * (k0(0, 0) - k0(0, 1));
+    Mat3 end_hessian, unused;
+    hessian.correction_gradient(
+        n.parameters().trusted.end_point(false), Vec3::Zero(), end_hessian, unused);
+    ASSERT_LT(end_hessian(0, 0), floor) << "the test needs an end below the floor";
+    RbfCorrection::Parameters untrusted = n.parameters();
+    untrusted.trusted = {};
+    Mat3 formula_hessian; // at the end point, the formula's own
+    RbfCorrection(std::move(untrusted))
+        .correction_gradient(
+            n.parameters().trusted.end_point(false), Vec3::Zero(), formula_hessian, unused);
+    const double kept = continuation == Continuation::smooth_expansion
+        ? std::max(n.parameters().trusted.continued_hessian(formula_hessian)(0, 0), floor)
+        : floor;
+    for (const Vec3& s : { Vec3(1.0, 0.95, 0.6), Vec3(1.0, 0.95, 0.4) }) {
+      SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+      const CorrectedStress c = corrected_principal_stress(bounded_nominal(), &n, s, Vec3::Zero());
+      const Mat3 k = bounded_nominal().principal_stress_derivative(s);
+      EXPECT_NEAR(c.d_stretches(2, 2), k(2, 2) + kept, 1e-9 * k.norm());
+      EXPECT_GT(c.d_stretches(2, 2), 0);
+      const CorrectedStress e
+          = corrected_principal_stress(bounded_nominal(), &hessian, s, Vec3::Zero());
+      EXPECT_LT(e.d_stretches(2, 2), 0) << "the edge Hessian's expansion";
+    }
   }
 }

@@ -53,7 +53,7 @@ void continuation_to_json(const material::TrustedStretches& t, Json& out) {
     out["nominal_stiffness"] = rows_to_json(t.nominal_stiffness);
     out["kept_stiffness"] = t.kept_stiffness;
   }
-  if (t.continuation == material::Continuation::smooth_clamp)
+  if (t.smooth())
     out["clamp_width"] = t.clamp_width;
 }
 
@@ -140,20 +140,19 @@ MatX read_rows(const JsonObject& o, const std::string& key, Eigen::Index rows, E
 }
 
 /// A correction's "trusted_stretches" and how it is continued beyond them ("continuation", with
-/// "nominal_stiffness" and "kept_stiffness" for bounded_softening and smooth_clamp,
-/// "clamp_width" for smooth_clamp); absent (older files):
+/// "nominal_stiffness" and "kept_stiffness" for all but edge_hessian, "clamp_width" for
+/// smooth_clamp and smooth_expansion); absent (older files):
 /// unbounded, and continued with the edge's Hessian as those files were.
 material::TrustedStretches trusted_from_json(const JsonObject& o) {
   material::TrustedStretches t;
-  const std::string continuation = o.choice(
-      "continuation", { "edge_hessian", "bounded_softening", "smooth_clamp" }, "edge_hessian");
+  const std::string continuation = o.choice("continuation",
+      { "edge_hessian", "bounded_softening", "smooth_clamp", "smooth_expansion" }, "edge_hessian");
+  t.continuation = material::continuation_from_name(continuation, "continuation");
   if (continuation != "edge_hessian") {
-    t.continuation = continuation == "smooth_clamp" ? material::Continuation::smooth_clamp
-                                                    : material::Continuation::bounded_softening;
     t.nominal_stiffness = read_rows(o, "nominal_stiffness", 3, 3);
     t.kept_stiffness = o.number("kept_stiffness");
   }
-  if (t.continuation == material::Continuation::smooth_clamp)
+  if (t.smooth())
     t.clamp_width = o.number("clamp_width");
   if (!o.has("trusted_stretches"))
     return t;

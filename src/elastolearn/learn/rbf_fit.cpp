@@ -35,7 +35,8 @@ template <typename Kernel> MatX unit_trace_seminorm(int m, const Kernel& kernel)
 
 void RbfFitOptions::validate() const {
   if (continuation == material::Continuation::edge_hessian)
-    rbf_fit_error("continuation", "learning continues with bounded_softening or smooth_clamp");
+    rbf_fit_error("continuation",
+        "learning continues with bounded_softening, smooth_expansion or smooth_clamp");
   if (!std::isfinite(epsilon) || epsilon < 0)
     rbf_fit_error("epsilon", "must be finite and ≥ 0, got " + to_text(epsilon));
   if (!std::isfinite(regularization) || regularization < 0)
@@ -107,17 +108,33 @@ RbfDesign::RbfDesign(
     if (m_damping > 0)
       m_damping_seminorm = unit_trace_seminorm(m, plain_kernel);
   }
-  if (m_trusted.continuation == material::Continuation::smooth_clamp) {
+  if (m_trusted.smooth()) {
     m_end_stress.setZero(2, m_elastic);
     m_end_stiffness.setZero(2, m_elastic);
+    m_end_coupling.setZero(2, m_elastic);
+    m_pair_coupling.setZero(3, m_elastic);
     OutputMatrix a(3, m_elastic);
     OutputGradient d(9, m_elastic);
+    const auto bounded
+        = [&](int end) { return std::isfinite(end == 0 ? m_trusted.max : m_trusted.min); };
     for (int end = 0; end < 2; ++end)
-      if (std::isfinite(end == 0 ? m_trusted.max : m_trusted.min)) {
+      if (bounded(end)) {
         formula_matrix(m_trusted.end_point(end == 0), a, d);
         m_end_stress.row(end) = a.row(0);
         m_end_stiffness.row(end) = d.row(0);
+        if (m_trusted.continuation == material::Continuation::smooth_expansion)
+          m_end_coupling.row(end) = d.row(3); // ∂A(0, ·)/∂σ₁
       }
+    if (m_trusted.continuation == material::Continuation::smooth_expansion)
+      m_follow = 1;
+    for (int e = 0; e < 2 && m_follow == 1; ++e)
+      for (int f = e; f < 2; ++f)
+        if (bounded(e) && bounded(f)) {
+          Vec3 point = m_trusted.end_point(e == 0);
+          point[1] = m_trusted.end_point(f == 0)[0];
+          formula_matrix(point, a, d);
+          m_pair_coupling.row(pair_row(e, f)) = d.row(3);
+        }
   }
 }
 
@@ -135,7 +152,7 @@ const Eigen::Matrix<double, 4, 3>& energy_tail_map() {
 
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
   if (m_trusted.nearest(stretches) != stretches) {
-    if (m_trusted.continuation == material::Continuation::smooth_clamp) {
+    if (m_trusted.smooth()) {
       formula_columns(m_trusted.formula_stretches(stretches), out);
       clamp_rows(stretches, out);
       return;
@@ -150,35 +167,84 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
   formula_columns(stretches, out);
 }
 
-void RbfDesign::clamp_rows(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
+RbfDesign::ClampState RbfDesign::clamp_state(const Vec3& stretches) const {
+  ClampState c;
+  const double one = std::clamp(1.0, m_trusted.min, m_trusted.max);
   for (int k = 0; k < 3; ++k) {
-    const material::ClampedStretch c = m_trusted.smooth_clamp(stretches[k]);
-    if (c.slope == 1 && c.curvature == 0)
+    c.stretch[k] = m_trusted.smooth_clamp(stretches[k]);
+    c.beyond[k] = stretches[k] > m_trusted.max || stretches[k] < m_trusted.min;
+    c.end[k] = end_row(stretches[k]);
+    c.distance[k] = stretches[k] - c.stretch[k].value;
+    c.offset[k] = c.stretch[k].value - one;
+  }
+  return c;
+}
+
+void RbfDesign::clamp_inner_rows(const ClampState& c, int q, Eigen::Ref<Eigen::RowVectorXd> a,
+    Eigen::Ref<Eigen::RowVectorXd> b) const {
+  a.setZero();
+  b.setZero();
+  for (int i = 0; i < 3; ++i) {
+    if (i == q || !c.beyond[i])
       continue;
-    const int end = end_row(stretches[k]);
-    out.row(k) = c.slope * out.row(k)
-        + (1 - c.slope)
-            * (m_end_stress.row(end) + (stretches[k] - c.value) * m_end_stiffness.row(end));
+    b += c.distance[i] * m_end_coupling.row(c.end[i]);
+    if (c.beyond[q])
+      a += c.distance[i] * m_pair_coupling.row(pair_row(c.end[q], c.end[i]));
+  }
+  if (c.beyond[q]) {
+    const double from_end = c.stretch[q].value - m_trusted.end_point(c.end[q] == 0)[0];
+    a += m_end_stress.row(c.end[q])
+        + (m_follow * from_end + c.distance[q]) * m_end_stiffness.row(c.end[q])
+        + (c.offset.sum() - c.offset[q]) * m_end_coupling.row(c.end[q]);
+    b += m_follow * c.distance[q] * m_end_stiffness.row(c.end[q]);
+  }
+}
+
+void RbfDesign::clamp_rows(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
+  // Row q: φ'_q (A_q(φ) + b_q) + (1 − φ'_q) a_q (material::smoothly_clamped_correction).
+  const ClampState c = clamp_state(stretches);
+  thread_local Eigen::RowVectorXd a, b;
+  a.resize(out.cols());
+  b.resize(out.cols());
+  for (int q = 0; q < 3; ++q) {
+    clamp_inner_rows(c, q, a, b);
+    out.row(q) = c.stretch[q].slope * (out.row(q) + b) + (1 - c.stretch[q].slope) * a;
   }
 }
 
 void RbfDesign::clamp_gradient(const Vec3& stretches, Eigen::Ref<const OutputMatrix> out,
     Eigen::Ref<OutputGradient> gradient) const {
-  // Row 3j + k is ∂A(k, ·)/∂σ_j: φ'_k φ'_j ∂A(k, ·)/∂φ_j, plus, for j = k,
-  // φ''_k (A_k(φ) − G_k − d_k K_k) + (1 − φ'_k)² K_k.
-  for (int k = 0; k < 3; ++k) {
-    const material::ClampedStretch c = m_trusted.smooth_clamp(stretches[k]);
-    if (c.slope == 1 && c.curvature == 0)
+  // Row 3r + q is ∂A(q, ·)/∂σ_r: φ'_q φ'_r ∂A(q, ·)/∂φ_r, plus, for r = q,
+  // φ''_q (A_q(φ) − a_q + b_q) + (1 − φ'_q)(1 − φ'_q + 2 f φ'_q) K_q, and for r ≠ q
+  // (1 − φ'_q) L_q φ'_r + φ'_q (1 − φ'_r) L_r + (1 − φ'_q)(1 − φ'_r) M_qr.
+  const ClampState c = clamp_state(stretches);
+  thread_local Eigen::RowVectorXd a, b;
+  a.resize(out.cols());
+  b.resize(out.cols());
+  for (int q = 0; q < 3; ++q)
+    for (int r = 0; r < 3; ++r)
+      gradient.row(3 * r + q) *= c.stretch[q].slope * c.stretch[r].slope;
+  for (int q = 0; q < 3; ++q) {
+    if (!c.beyond[q] && !c.beyond[(q + 1) % 3] && !c.beyond[(q + 2) % 3])
       continue;
-    for (int j = 0; j < 3; ++j) {
-      gradient.row(3 * j + k) *= c.slope;
-      gradient.row(3 * k + j) *= c.slope;
+    const double sq = c.stretch[q].slope;
+    if (c.beyond[q]) {
+      clamp_inner_rows(c, q, a, b);
+      gradient.row(3 * q + q) += c.stretch[q].curvature * (out.row(q) - a + b)
+          + (1 - sq) * (1 - sq + 2 * m_follow * sq) * m_end_stiffness.row(c.end[q]);
     }
-    const int end = end_row(stretches[k]);
-    const double d = stretches[k] - c.value;
-    gradient.row(3 * k + k)
-        += c.curvature * (out.row(k) - m_end_stress.row(end) - d * m_end_stiffness.row(end))
-        + (1 - c.slope) * (1 - c.slope) * m_end_stiffness.row(end);
+    for (int r = 0; r < 3; ++r) {
+      if (r == q)
+        continue;
+      const double sr = c.stretch[r].slope;
+      if (c.beyond[q])
+        gradient.row(3 * r + q) += (1 - sq) * sr * m_end_coupling.row(c.end[q]);
+      if (c.beyond[r])
+        gradient.row(3 * r + q) += sq * (1 - sr) * m_end_coupling.row(c.end[r]);
+      if (c.beyond[q] && c.beyond[r])
+        gradient.row(3 * r + q)
+            += (1 - sq) * (1 - sr) * m_pair_coupling.row(pair_row(c.end[q], c.end[r]));
+    }
   }
 }
 
@@ -221,7 +287,7 @@ void RbfDesign::view_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out
 void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
     Eigen::Ref<OutputGradient> gradient) const {
   const Vec3 c = m_trusted.nearest(stretches);
-  if (c != stretches && m_trusted.continuation == material::Continuation::smooth_clamp) {
+  if (c != stretches && m_trusted.smooth()) {
     formula_matrix(m_trusted.formula_stretches(stretches), out, gradient);
     clamp_gradient(stretches, out, gradient);
     clamp_rows(stretches, out);

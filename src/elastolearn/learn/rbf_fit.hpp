@@ -18,7 +18,8 @@ struct RbfFitOptions {
   bool energy_kernels = false;
   /// How learning continues an energy correction beyond its trusted stretches
   /// (material/trusted_stretches.hpp): the edge's bounded Hessian (the recipe), or the exact
-  /// smooth clamp (`learn --continuation smooth_clamp`).
+  /// smooth expansion (`learn --continuation smooth_expansion`; smooth_clamp, its uncoupled
+  /// form, for comparison).
   material::Continuation continuation = material::Continuation::bounded_softening;
   bool elastic_polynomial
       = true; ///< fit the linear tail a, b (and c, see below) of the elastic part
@@ -75,10 +76,10 @@ class RbfDesign {
   using OutputMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic>;
   /// `centres` m × 3 (m ≥ 1, finite). With energy kernels, `trusted` is the corrections' trusted
   /// stretches (material/trusted_stretches.hpp), and A(σ) continues beyond them as the
-  /// correction does. Continuation::smooth_clamp is linear in x, so N = A x everywhere (and
-  /// Δα₁ = d x, read at φ(σ) too), except beyond an end whose stiffness is at its floor (the
-  /// forward fit's steps are accepted on simulated errors). The expansions continue A with the
-  /// edge's Hessian, A(c) + ∂A/∂σ(c)(σ − c): N = A x everywhere for edge_hessian, and for
+  /// correction does. The smooth forms (smooth_clamp, smooth_expansion) are linear in x, so N = A x
+  /// everywhere (and Δα₁ = d x, read at φ(σ) too), except beyond an end whose stiffness is at its
+  /// floor (the forward fit's steps are accepted on simulated errors). The expansions continue A
+  /// with the edge's Hessian, A(c) + ∂A/∂σ(c)(σ − c): N = A x everywhere for edge_hessian, and for
   /// bounded_softening wherever the edge's Hessian is within the bound (elsewhere A x is its
   /// continuation with that Hessian unbounded). Throws InputError for invalid options, centres
   /// or interval.
@@ -124,10 +125,21 @@ class RbfDesign {
   private:
   /// A(σ) without the continuation.
   void formula_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const;
-  /// smooth_clamp beyond the trusted stretches: `out` holds A at φ(σ) and becomes the
-  /// continuation's, row k φ'_k A_k(φ) + (1 − φ'_k)(G_k + d_k K_k) with G_k, K_k the end rows of
-  /// the end σ_k is beyond and d_k = σ_k − φ_k (material::smoothly_clamped_correction; linear in
-  /// x where the end stiffness is above its floor).
+  /// The smooth forms beyond the trusted stretches, per stretch: φ, whether it is beyond an end,
+  /// that end's row, d = σ − φ and u = φ − 1'.
+  struct ClampState {
+    material::ClampedStretch stretch[3];
+    bool beyond[3] = { false, false, false };
+    int end[3] = { 0, 0, 0 };
+    Vec3 distance, offset;
+  };
+  ClampState clamp_state(const Vec3& stretches) const;
+  /// The rows a_q (zero unless stretch q is beyond an end) and b_q of
+  /// material::smoothly_clamped_correction, linear in x where the end stiffness is above its floor.
+  void clamp_inner_rows(const ClampState& c, int q, Eigen::Ref<Eigen::RowVectorXd> a,
+      Eigen::Ref<Eigen::RowVectorXd> b) const;
+  /// `out` holds A at φ(σ) and becomes the continuation's, row q φ'_q (A_q(φ) + b_q) +
+  /// (1 − φ'_q) a_q.
   void clamp_rows(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const;
   /// Its derivative: `gradient` holds ∂A/∂φ at φ(σ) and `out` A there (before clamp_rows).
   void clamp_gradient(const Vec3& stretches, Eigen::Ref<const OutputMatrix> out,
@@ -150,9 +162,15 @@ class RbfDesign {
   int m_elastic = 0;
   int m_damping = 0;
   material::TrustedStretches m_trusted;
-  /// smooth_clamp: at TrustedStretches::end_point above (row 0) and below (row 1), row 0 of A
-  /// (G, the end stress) and of ∂A/∂σ₀ (K, the end stiffness, without its floor).
-  Eigen::Matrix<double, 2, Eigen::Dynamic> m_end_stress, m_end_stiffness;
+  /// The smooth forms: at TrustedStretches::end_point above (row 0) and below (row 1), row 0 of A
+  /// (G, the end stress) and of ∂A/∂σ₀ (K, the end stiffness, without its floor) and ∂A/∂σ₁
+  /// (L, the coupling); and ∂A(0, ·)/∂σ₁ where two stretches are beyond ends (M; rows pair_row).
+  Eigen::Matrix<double, 2, Eigen::Dynamic> m_end_stress, m_end_stiffness, m_end_coupling;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> m_pair_coupling;
+  /// f of material::ClampEnds: 1 for smooth_expansion (with L and M), 0 for smooth_clamp.
+  double m_follow = 0;
+  /// The row of m_pair_coupling for two stretches beyond ends e and f (0 above, 1 below).
+  static int pair_row(int e, int f) { return e + f; }
   /// The row of m_end_stress and m_end_stiffness for a stretch beyond an end.
   int end_row(double stretch) const { return stretch > m_trusted.max ? 0 : 1; }
 };

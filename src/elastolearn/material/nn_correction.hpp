@@ -175,7 +175,7 @@ class NnCorrection final : public Correction {
       const Vec3& e, const Vec3& p, Vec3 grad_p, const Mat3* hessian_p, Mat3* hessian) const;
 
   Parameters m_p;
-  ClampEnds m_ends; ///< what smooth_clamp keeps beyond the trusted stretches
+  ClampEnds m_ends; ///< what the smooth forms keep beyond the trusted stretches
   /// The layers with the standardisation folded in: layer k's weights (row-major, out × in) at
   /// m_flat[m_offset[k]], its biases right after. m_width[k] = layer k's input count,
   /// m_width[num_layers] = 1.

@@ -170,7 +170,7 @@ class RbfCorrection final : public Correction {
   /// The damping kernels likewise: centres and damping weights, padded to a multiple of 4 (zero
   /// weight); empty without damping weights.
   Eigen::ArrayXd m_damping_x, m_damping_y, m_damping_z, m_damping_w;
-  ClampEnds m_ends; ///< what smooth_clamp keeps beyond the trusted stretches
+  ClampEnds m_ends; ///< what the smooth forms keep beyond the trusted stretches
 };
 
 /// (1 − t) a + t b: one correction whose N and Δα₁ (above its floor) are that blend of a's and
