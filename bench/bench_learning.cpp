@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <thread>
 
 namespace {
@@ -91,8 +92,10 @@ double g_damping_regularization = -1, g_regularization = -1, g_position_weight =
        g_kernel_smoothing = -1, g_full_space_weight = -1, g_damping_prior = -1,
        g_elastic_prior = -1, g_smoothness = -1, g_forward_fit_tolerance = -1;
 bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
-     g_full_space = false, g_no_damping = false, g_smooth_clamp = false, g_smooth_expansion = false,
-     g_pod_forward_only = false, g_unprojected = false, g_no_backtrack = false;
+     g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false,
+     g_no_backtrack = false;
+/// --smooth-clamp, --smooth-expansion: the continuation beyond the trusted stretches.
+std::optional<material::Continuation> g_continuation;
 
 void apply_overrides(learn::LearningOptions& o) {
   if (g_modes > 0)
@@ -121,10 +124,8 @@ void apply_overrides(learn::LearningOptions& o) {
     o.rbf.damping_regularization = g_damping_regularization;
   if (g_smoothness >= 0)
     o.rbf.smoothness = g_smoothness;
-  if (g_smooth_clamp)
-    o.rbf.continuation = material::Continuation::smooth_clamp;
-  if (g_smooth_expansion)
-    o.rbf.continuation = material::Continuation::smooth_expansion;
+  if (g_continuation)
+    o.rbf.continuation = *g_continuation;
   if (g_linear_tail)
     o.rbf.quadratic_tail = false;
   if (g_neo_hookean_tail)
@@ -495,9 +496,9 @@ int main(int argc, char** argv) {
     else if (a == "--no-damping")
       g_no_damping = true;
     else if (a == "--smooth-clamp")
-      g_smooth_clamp = true;
+      g_continuation = material::Continuation::smooth_clamp;
     else if (a == "--smooth-expansion")
-      g_smooth_expansion = true;
+      g_continuation = material::Continuation::smooth_expansion;
     else if (a == "--position-weight" && i + 1 < argc)
       g_position_weight = std::stod(argv[++i]);
     else if (a == "--unprojected-reconstruction")

@@ -115,10 +115,8 @@ RbfDesign::RbfDesign(
     m_pair_coupling.setZero(3, m_elastic);
     OutputMatrix a(3, m_elastic);
     OutputGradient d(9, m_elastic);
-    const auto bounded
-        = [&](int end) { return std::isfinite(end == 0 ? m_trusted.max : m_trusted.min); };
     for (int end = 0; end < 2; ++end)
-      if (bounded(end)) {
+      if (m_trusted.has_end(end == 0)) {
         formula_matrix(m_trusted.end_point(end == 0), a, d);
         m_end_stress.row(end) = a.row(0);
         m_end_stiffness.row(end) = d.row(0);
@@ -129,10 +127,8 @@ RbfDesign::RbfDesign(
       m_follow = 1;
     for (int e = 0; e < 2 && m_follow == 1; ++e)
       for (int f = e; f < 2; ++f)
-        if (bounded(e) && bounded(f)) {
-          Vec3 point = m_trusted.end_point(e == 0);
-          point[1] = m_trusted.end_point(f == 0)[0];
-          formula_matrix(point, a, d);
+        if (m_trusted.has_end(e == 0) && m_trusted.has_end(f == 0)) {
+          formula_matrix(m_trusted.pair_point(e == 0, f == 0), a, d);
           m_pair_coupling.row(pair_row(e, f)) = d.row(3);
         }
   }
@@ -154,7 +150,9 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
   if (m_trusted.nearest(stretches) != stretches) {
     if (m_trusted.smooth()) {
       formula_columns(m_trusted.formula_stretches(stretches), out);
-      clamp_rows(stretches, out);
+      thread_local OutputMatrix a, b; // per thread, sized once per design size
+      const ClampState c = clamp_state(stretches, a, b);
+      clamp_rows(c, a, b, out);
       return;
     }
     // Outside the trusted interval (energy kernels only): the expansion needs ∂A/∂σ. Per
@@ -167,72 +165,57 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
   formula_columns(stretches, out);
 }
 
-RbfDesign::ClampState RbfDesign::clamp_state(const Vec3& stretches) const {
+RbfDesign::ClampState RbfDesign::clamp_state(
+    const Vec3& stretches, OutputMatrix& a, OutputMatrix& b) const {
   ClampState c;
-  const double one = std::clamp(1.0, m_trusted.min, m_trusted.max);
   for (int k = 0; k < 3; ++k) {
     c.stretch[k] = m_trusted.smooth_clamp(stretches[k]);
     c.beyond[k] = stretches[k] > m_trusted.max || stretches[k] < m_trusted.min;
     c.end[k] = end_row(stretches[k]);
     c.distance[k] = stretches[k] - c.stretch[k].value;
-    c.offset[k] = c.stretch[k].value - one;
+    c.offset[k] = c.stretch[k].value - m_trusted.one();
+  }
+  a.setZero(3, m_elastic);
+  b.setZero(3, m_elastic);
+  for (int q = 0; q < 3; ++q) {
+    for (int i = 0; i < 3; ++i) {
+      if (i == q || !c.beyond[i])
+        continue;
+      b.row(q) += c.distance[i] * m_end_coupling.row(c.end[i]);
+      if (c.beyond[q])
+        a.row(q) += c.distance[i] * m_pair_coupling.row(pair_row(c.end[q], c.end[i]));
+    }
+    if (c.beyond[q]) {
+      const double from_end = c.stretch[q].value - m_trusted.end_point(c.end[q] == 0)[0];
+      a.row(q) += m_end_stress.row(c.end[q])
+          + (m_follow * from_end + c.distance[q]) * m_end_stiffness.row(c.end[q])
+          + (c.offset.sum() - c.offset[q]) * m_end_coupling.row(c.end[q]);
+      b.row(q) += m_follow * c.distance[q] * m_end_stiffness.row(c.end[q]);
+    }
   }
   return c;
 }
 
-void RbfDesign::clamp_inner_rows(const ClampState& c, int q, Eigen::Ref<Eigen::RowVectorXd> a,
-    Eigen::Ref<Eigen::RowVectorXd> b) const {
-  a.setZero();
-  b.setZero();
-  for (int i = 0; i < 3; ++i) {
-    if (i == q || !c.beyond[i])
-      continue;
-    b += c.distance[i] * m_end_coupling.row(c.end[i]);
-    if (c.beyond[q])
-      a += c.distance[i] * m_pair_coupling.row(pair_row(c.end[q], c.end[i]));
-  }
-  if (c.beyond[q]) {
-    const double from_end = c.stretch[q].value - m_trusted.end_point(c.end[q] == 0)[0];
-    a += m_end_stress.row(c.end[q])
-        + (m_follow * from_end + c.distance[q]) * m_end_stiffness.row(c.end[q])
-        + (c.offset.sum() - c.offset[q]) * m_end_coupling.row(c.end[q]);
-    b += m_follow * c.distance[q] * m_end_stiffness.row(c.end[q]);
-  }
-}
-
-void RbfDesign::clamp_rows(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
+void RbfDesign::clamp_rows(const ClampState& c, const OutputMatrix& a, const OutputMatrix& b,
+    Eigen::Ref<OutputMatrix> out) const {
   // Row q: φ'_q (A_q(φ) + b_q) + (1 − φ'_q) a_q (material::smoothly_clamped_correction).
-  const ClampState c = clamp_state(stretches);
-  thread_local Eigen::RowVectorXd a, b;
-  a.resize(out.cols());
-  b.resize(out.cols());
-  for (int q = 0; q < 3; ++q) {
-    clamp_inner_rows(c, q, a, b);
-    out.row(q) = c.stretch[q].slope * (out.row(q) + b) + (1 - c.stretch[q].slope) * a;
-  }
+  for (int q = 0; q < 3; ++q)
+    out.row(q) = c.stretch[q].slope * (out.row(q) + b.row(q)) + (1 - c.stretch[q].slope) * a.row(q);
 }
 
-void RbfDesign::clamp_gradient(const Vec3& stretches, Eigen::Ref<const OutputMatrix> out,
-    Eigen::Ref<OutputGradient> gradient) const {
+void RbfDesign::clamp_gradient(const ClampState& c, const OutputMatrix& a, const OutputMatrix& b,
+    Eigen::Ref<const OutputMatrix> out, Eigen::Ref<OutputGradient> gradient) const {
   // Row 3r + q is ∂A(q, ·)/∂σ_r: φ'_q φ'_r ∂A(q, ·)/∂φ_r, plus, for r = q,
   // φ''_q (A_q(φ) − a_q + b_q) + (1 − φ'_q)(1 − φ'_q + 2 f φ'_q) K_q, and for r ≠ q
   // (1 − φ'_q) L_q φ'_r + φ'_q (1 − φ'_r) L_r + (1 − φ'_q)(1 − φ'_r) M_qr.
-  const ClampState c = clamp_state(stretches);
-  thread_local Eigen::RowVectorXd a, b;
-  a.resize(out.cols());
-  b.resize(out.cols());
   for (int q = 0; q < 3; ++q)
     for (int r = 0; r < 3; ++r)
       gradient.row(3 * r + q) *= c.stretch[q].slope * c.stretch[r].slope;
   for (int q = 0; q < 3; ++q) {
-    if (!c.beyond[q] && !c.beyond[(q + 1) % 3] && !c.beyond[(q + 2) % 3])
-      continue;
     const double sq = c.stretch[q].slope;
-    if (c.beyond[q]) {
-      clamp_inner_rows(c, q, a, b);
-      gradient.row(3 * q + q) += c.stretch[q].curvature * (out.row(q) - a + b)
+    if (c.beyond[q])
+      gradient.row(3 * q + q) += c.stretch[q].curvature * (out.row(q) - a.row(q) + b.row(q))
           + (1 - sq) * (1 - sq + 2 * m_follow * sq) * m_end_stiffness.row(c.end[q]);
-    }
     for (int r = 0; r < 3; ++r) {
       if (r == q)
         continue;
@@ -289,8 +272,10 @@ void RbfDesign::output_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> ou
   const Vec3 c = m_trusted.nearest(stretches);
   if (c != stretches && m_trusted.smooth()) {
     formula_matrix(m_trusted.formula_stretches(stretches), out, gradient);
-    clamp_gradient(stretches, out, gradient);
-    clamp_rows(stretches, out);
+    thread_local OutputMatrix a, b; // per thread, sized once per design size
+    const ClampState state = clamp_state(stretches, a, b);
+    clamp_gradient(state, a, b, out, gradient);
+    clamp_rows(state, a, b, out);
     return;
   }
   formula_matrix(c, out, gradient);

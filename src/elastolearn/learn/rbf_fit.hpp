@@ -78,7 +78,8 @@ class RbfDesign {
   /// stretches (material/trusted_stretches.hpp), and A(σ) continues beyond them as the
   /// correction does. The smooth forms (smooth_clamp, smooth_expansion) are linear in x, so N = A x
   /// everywhere (and Δα₁ = d x, read at φ(σ) too), except beyond an end whose stiffness is at its
-  /// floor (the forward fit's steps are accepted on simulated errors). The expansions continue A
+  /// floor or, for smooth_expansion, whose Hessians are bounded (the forward fit's steps are
+  /// accepted on simulated errors). The expansions continue A
   /// with the edge's Hessian, A(c) + ∂A/∂σ(c)(σ − c): N = A x everywhere for edge_hessian, and for
   /// bounded_softening wherever the edge's Hessian is within the bound (elsewhere A x is its
   /// continuation with that Hessian unbounded). Throws InputError for invalid options, centres
@@ -133,17 +134,16 @@ class RbfDesign {
     int end[3] = { 0, 0, 0 };
     Vec3 distance, offset;
   };
-  ClampState clamp_state(const Vec3& stretches) const;
-  /// The rows a_q (zero unless stretch q is beyond an end) and b_q of
-  /// material::smoothly_clamped_correction, linear in x where the end stiffness is above its floor.
-  void clamp_inner_rows(const ClampState& c, int q, Eigen::Ref<Eigen::RowVectorXd> a,
-      Eigen::Ref<Eigen::RowVectorXd> b) const;
+  /// σ's ClampState, and into `a` and `b` (3 × elastic unknowns) the rows a_q (zero unless
+  /// stretch q is beyond an end) and b_q of material::smoothly_clamped_correction.
+  ClampState clamp_state(const Vec3& stretches, OutputMatrix& a, OutputMatrix& b) const;
   /// `out` holds A at φ(σ) and becomes the continuation's, row q φ'_q (A_q(φ) + b_q) +
   /// (1 − φ'_q) a_q.
-  void clamp_rows(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const;
+  void clamp_rows(const ClampState& c, const OutputMatrix& a, const OutputMatrix& b,
+      Eigen::Ref<OutputMatrix> out) const;
   /// Its derivative: `gradient` holds ∂A/∂φ at φ(σ) and `out` A there (before clamp_rows).
-  void clamp_gradient(const Vec3& stretches, Eigen::Ref<const OutputMatrix> out,
-      Eigen::Ref<OutputGradient> gradient) const;
+  void clamp_gradient(const ClampState& c, const OutputMatrix& a, const OutputMatrix& b,
+      Eigen::Ref<const OutputMatrix> out, Eigen::Ref<OutputGradient> gradient) const;
   /// A(σ) and its derivative, without the continuation.
   void formula_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> out,
       Eigen::Ref<OutputGradient> gradient) const;
@@ -164,7 +164,8 @@ class RbfDesign {
   material::TrustedStretches m_trusted;
   /// The smooth forms: at TrustedStretches::end_point above (row 0) and below (row 1), row 0 of A
   /// (G, the end stress) and of ∂A/∂σ₀ (K, the end stiffness, without its floor) and ∂A/∂σ₁
-  /// (L, the coupling); and ∂A(0, ·)/∂σ₁ where two stretches are beyond ends (M; rows pair_row).
+  /// (L, the coupling); and ∂A(0, ·)/∂σ₁ where two stretches are beyond ends (M; rows pair_row),
+  /// all without their bounds.
   Eigen::Matrix<double, 2, Eigen::Dynamic> m_end_stress, m_end_stiffness, m_end_coupling;
   Eigen::Matrix<double, 3, Eigen::Dynamic> m_pair_coupling;
   /// f of material::ClampEnds: 1 for smooth_expansion (with L and M), 0 for smooth_clamp.

@@ -138,9 +138,19 @@ struct TrustedStretches {
   /// upper (`above`) or lower end, where φ saturates: (end ± w/2, 1, 1), the 1s clamped into the
   /// interval.
   Vec3 end_point(bool above) const {
-    const double one = std::clamp(1.0, min, max);
-    return { above ? max + 0.5 * clamp_width : min - 0.5 * clamp_width, one, one };
+    return { above ? max + 0.5 * clamp_width : min - 0.5 * clamp_width, one(), one() };
   }
+  /// smooth_expansion: the point of two stretches beyond ends, the first beyond the upper
+  /// (`above0`) or lower end, the second beyond `above1`'s: (end₀ ± w/2, end₁ ± w/2, 1').
+  Vec3 pair_point(bool above0, bool above1) const {
+    Vec3 p = end_point(above0);
+    p[1] = end_point(above1)[0];
+    return p;
+  }
+  /// 1 clamped into [min, max] (1'): the end points' other stretches.
+  double one() const { return std::clamp(1.0, min, max); }
+  /// Whether the upper (`above`) or lower end is finite.
+  bool has_end(bool above) const { return std::isfinite(above ? max : min); }
   /// The Hessian the continuation uses beyond the edge, from the edge's Hessian ∇²ΔΨ(c). With
   /// bounded_softening: in K₀'s metric, M = K₀^(−½) H K₀^(−½) with its eigenvalues raised to at
   /// least β − 1, mapped back. 3 × 3 symmetric: closed-form eigensolvers, no allocation. Any
@@ -219,7 +229,7 @@ ClampEnds clamp_ends(const TrustedStretches& trusted, const Formula& formula) {
   const bool expansion = trusted.continuation == Continuation::smooth_expansion;
   Mat3 h;
   for (const bool above : { true, false })
-    if (std::isfinite(above ? trusted.max : trusted.min)) {
+    if (trusted.has_end(above)) {
       ClampEnd& end = above ? out.above : out.below;
       end.stress = formula(trusted.end_point(above), &h)[0];
       if (expansion) // the end's whole stiffness, bounded as bounded_softening bounds it
@@ -227,16 +237,13 @@ ClampEnds clamp_ends(const TrustedStretches& trusted, const Formula& formula) {
       end.stiffness = std::max(h(0, 0), floor);
       end.coupling = expansion ? h(0, 1) : 0;
     }
-  if (trusted.continuation != Continuation::smooth_expansion)
+  if (!expansion)
     return out;
   out.follow = 1;
   for (int a = 0; a < 2; ++a)
     for (int b = a; b < 2; ++b)
-      if (std::isfinite(a == 0 ? trusted.max : trusted.min)
-          && std::isfinite(b == 0 ? trusted.max : trusted.min)) {
-        Vec3 point = trusted.end_point(a == 0);
-        point[1] = trusted.end_point(b == 0)[0];
-        formula(point, &h);
+      if (trusted.has_end(a == 0) && trusted.has_end(b == 0)) {
+        formula(trusted.pair_point(a == 0, b == 0), &h);
         out.pair[a][b] = out.pair[b][a] = trusted.continued_hessian(h)(0, 1);
       }
   return out;
@@ -265,14 +272,13 @@ Vec3 smoothly_clamped_correction(const TrustedStretches& trusted, const ClampEnd
   const ClampEnd* end[3];
   int side[3];
   Vec3 phi, d, u;
-  const double one = std::clamp(1.0, trusted.min, trusted.max);
   for (int i = 0; i < 3; ++i) {
     c[i] = trusted.smooth_clamp(stretches[i]);
     phi[i] = c[i].value;
     end[i] = ends.of(trusted, stretches[i]);
     side[i] = end[i] != nullptr ? ClampEnds::side(trusted, stretches[i]) : -1;
     d[i] = stretches[i] - phi[i];
-    u[i] = phi[i] - one;
+    u[i] = phi[i] - trusted.one();
   }
   Mat3 h;
   const Vec3 n = formula(phi, tangent != nullptr ? &h : nullptr);
@@ -317,8 +323,8 @@ Vec3 smoothly_clamped_correction(const TrustedStretches& trusted, const ClampEnd
 
 /// N at σ, continued beyond `trusted`: `formula(c, hessian)` gives N at c and, if `hessian` is
 /// non-null, ∇²ΔΨ(c) there. `tangent` (if non-null) receives ∂N/∂σ (outside: the continued
-/// Hessian, TrustedStretches::continued_hessian; for smooth_clamp the exact derivative,
-/// smoothly_clamped_correction). `ends` is used by smooth_clamp only.
+/// Hessian, TrustedStretches::continued_hessian; for the smooth forms the exact derivative,
+/// smoothly_clamped_correction). `ends` is used by the smooth forms only.
 template <typename Formula>
 Vec3 continued_correction(const TrustedStretches& trusted, const ClampEnds& ends,
     const Vec3& stretches, Mat3* tangent, const Formula& formula) {
@@ -345,11 +351,11 @@ double continued_energy(const TrustedStretches& trusted, const ClampEnds& ends,
     return energy(stretches);
   if (trusted.smooth()) {
     const Vec3 phi = trusted.formula_stretches(stretches), d = stretches - phi;
-    const double u_sum = (phi.array() - std::clamp(1.0, trusted.min, trusted.max)).sum();
+    const double u_sum = (phi.array() - trusted.one()).sum();
     double psi = energy(phi);
     for (int i = 0; i < 3; ++i)
       if (const ClampEnd* end = ends.of(trusted, stretches[i])) {
-        const double u_others = u_sum - (phi[i] - std::clamp(1.0, trusted.min, trusted.max));
+        const double u_others = u_sum - (phi[i] - trusted.one());
         const double from_end = phi[i] - trusted.end_point(stretches[i] > trusted.max)[0];
         psi += d[i]
             * (end->stress + end->stiffness * (ends.follow * from_end + 0.5 * d[i])
