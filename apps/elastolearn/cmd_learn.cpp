@@ -227,9 +227,8 @@ void run_learn(const LearnOptions& o) {
           + (std::isnan(c.training_significance)
                   ? std::string("not compared")
                   : "better by " + elastolearn::to_text(c.training_significance)
-                      + " noise deviations after its unknowns' share"
-                      + (c.beats_reference ? "" : ": not significant"))
-          + ")";
+                      + " noise deviations after its unknowns' share")
+          + ": hold out frames that still move, e.g. a second motion, to let them decide)";
     else if (c.completed && !reference && c.significance <= 0)
       note = "   (no better than the fitted nominal)";
     else if (c.completed && !reference && c.significance < learn::kSignificance)

@@ -136,14 +136,17 @@ TEST(LearningRecipe, ACandidateReplacesTheFittedNominalOnlyBeyondNoise) {
   }
 }
 
-TEST(LearningRecipe, WhereTheHeldOutDataCannotResolveACandidateTheChargedTrainingDataDecide) {
+TEST(LearningRecipe, WhereTheHeldOutDataCannotResolveACandidateTheFittedNominalStays) {
   // A motion that has died out by its held-out tail: there every prediction is the truth to
   // within 2 µm, far below what σ = 1 mm over 300 coordinates can resolve (‖c − r‖ / 2σ ≪ 2).
+  // The training data are compared and reported, not used: fitting the training frames better
+  // says nothing of how a candidate forecasts (random cases whose tiny training motion it
+  // passed tested at 1.2× their fit, or diverged, on a larger motion).
   // On the training data (3000 coordinates) the fitted nominal r is off by a 0.5 mm bias in x.
   // Candidate C removes it (gain 1000 · (0.5 mm)² = 250 mm², less a charge of k σ² = 50 mm²,
   // against a spread 2σ‖C − r‖ ≈ 32 mm²: z ≈ 6); candidate F only fits the noise of 50
   // coordinates, as 50 unknowns fitted to noise would: its gain is k σ² in expectation, and
-  // uncharged it would pass (z ≈ √k / 2 ≈ 3.5).
+  // uncharged it would seem significant (z ≈ √k / 2 ≈ 3.5).
   const double sigma = 1e-3;
   const int k = 50;
   const Eigen::Index n_held = 300, n_train = 3000;
@@ -189,30 +192,31 @@ TEST(LearningRecipe, WhereTheHeldOutDataCannotResolveACandidateTheChargedTrainin
     const ComparedData trained { { r_train, c_train, f_train }, train_observed };
     for (size_t i = 0; i < 3; ++i)
       c[i].validation.rms = rms(held.predictions[i], held_observed);
-    EXPECT_EQ(choose_candidate(c, held, trained, 0, sigma), 1);
+    EXPECT_EQ(choose_candidate(c, held, trained, 0, sigma), 0);
     std::printf("[ measured ] C: resolution %.3g, training z %.2f; F: resolution %.3g, training z "
                 "%.2f\n",
         c[1].resolution, c[1].training_significance, c[2].resolution, c[2].training_significance);
     EXPECT_LT(c[1].resolution, 0.1);
     EXPECT_LT(c[2].resolution, 0.1);
-    EXPECT_TRUE(c[1].beats_reference);
+    EXPECT_FALSE(c[1].beats_reference);
     EXPECT_GE(c[1].training_significance, kSignificance);
     EXPECT_FALSE(c[2].beats_reference);
     EXPECT_LT(c[2].training_significance, kSignificance);
-    // The charge is what stops F: uncharged, its gain over the noise would pass.
+    // The charge is what keeps F's reported z low: uncharged, its gain over the noise would
+    // seem significant.
     const double f_gain
         = (r_train - train_observed).squaredNorm() - (f_train - train_observed).squaredNorm();
     EXPECT_GT(f_gain / (2 * sigma * (f_train - r_train).norm()), kSignificance);
-    // Without training predictions the held-out data alone decide: the fitted nominal stays.
+    // Without training predictions nothing is reported for them.
     auto d = candidates(3);
     for (size_t i = 0; i < 3; ++i)
       d[i].validation.rms = c[i].validation.rms;
     EXPECT_EQ(choose_candidate(d, held, {}, 0, sigma), 0);
-    EXPECT_FALSE(d[1].beats_reference);
+    EXPECT_TRUE(std::isnan(d[1].training_significance));
   }
   {
-    // A candidate that beats the reference on the held-out data wins over one that beats it
-    // only on the training data, whatever their training errors.
+    // A candidate that beats the reference on the held-out data is chosen, whatever the
+    // training errors say.
     auto c = candidates(3);
     const VecX resolved_held = held_observed; // an overfit extreme: z ≫ 2 there
     const ComparedData held { { r_held, c_held, resolved_held }, held_observed };
@@ -221,7 +225,7 @@ TEST(LearningRecipe, WhereTheHeldOutDataCannotResolveACandidateTheChargedTrainin
       c[i].validation.rms = rms(held.predictions[i], held_observed);
     EXPECT_EQ(choose_candidate(c, held, trained, 0, sigma), 2);
     EXPECT_GE(c[2].resolution, kSignificance);
-    EXPECT_TRUE(c[1].beats_reference); // on the training data, but not chosen
+    EXPECT_FALSE(c[1].beats_reference); // better on the training data only
   }
 }
 

@@ -329,9 +329,8 @@ void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int re
     c.training_significance = in_noise_deviations(
         (rt - o).squaredNorm() - (ct - o).squaredNorm() - charge, rt, ct, sigma);
   }
-  // NaN (not measured) compares false: such a candidate passes on the held-out data or not at all.
-  c.beats_reference = c.resolution >= kSignificance ? c.significance >= kSignificance
-                                                    : c.training_significance >= kSignificance;
+  // The held-out data alone decide: the training frames cannot see how a candidate forecasts.
+  c.beats_reference = c.resolution >= kSignificance && c.significance >= kSignificance;
 }
 
 bool network_replaces_teacher(
@@ -344,8 +343,7 @@ bool network_replaces_teacher(
 
 int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
     const ComparedData& training, int reference, double sigma) {
-  int chosen = -1, by_training = -1;
-  double lowest_training = std::numeric_limits<double>::infinity();
+  int chosen = -1;
   const Candidate* ref = reference >= 0 ? &candidates[static_cast<size_t>(reference)] : nullptr;
   if (ref && !ref->completed)
     ref = nullptr;
@@ -358,23 +356,11 @@ int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& val
       compare_with_reference(candidates, i, reference, validation, training, sigma);
     if (!c.eligible())
       continue;
-    const bool on_held_out = is_reference || (c.beats_reference && c.resolution >= kSignificance);
-    if (on_held_out
+    if ((is_reference || c.beats_reference)
         && (chosen < 0
             || c.validation.rms < candidates[static_cast<size_t>(chosen)].validation.rms))
       chosen = static_cast<int>(i);
-    if (!is_reference && c.beats_reference && c.resolution < kSignificance) {
-      const double error = (training.predictions[i] - training.observed).squaredNorm();
-      if (error < lowest_training) {
-        lowest_training = error;
-        by_training = static_cast<int>(i);
-      }
-    }
   }
-  // The training data decide only where the held-out data could not: no candidate beat the
-  // reference there.
-  if (by_training >= 0 && (chosen < 0 || chosen == reference))
-    return by_training;
   return chosen;
 }
 

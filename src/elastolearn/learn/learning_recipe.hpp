@@ -17,9 +17,10 @@
 ///      simulates the held-out data; among those
 ///      whose material survives a larger motion (kLargerMotion) and that beat the fitted nominal
 ///      by more than noise could (z ≥ kSignificance), the one with the smallest RMS error there
-///      is the result; the fitted nominal if none. Where the held-out data cannot resolve a
-///      candidate from the fitted nominal (a motion that has died out under noise), the training
-///      data decide, charged for the unknowns fitted to them (choose_candidate);
+///      is the result; the fitted nominal if none, also where the held-out data cannot resolve
+///      a candidate from it (a motion that has died out under noise: the training data, which
+///      cannot see how a candidate forecasts, are compared and reported, not used;
+///      choose_candidate);
 ///   5. network: a chosen correction is distilled into the network correction
 ///      (network_distillation.hpp), validated the same way, and replaces its teacher when it is
 ///      eligible, beats the fitted nominal by kSignificance, and is as good as its teacher
@@ -119,11 +120,13 @@ struct Candidate {
   int unknowns = 0;
   /// Its improvement on the reference over the training observations, charged for what fitting
   /// its unknowns to their noise gains by itself (k σ² in expectation, k = unknowns):
-  /// z = (‖r − o‖² − ‖c − o‖² − k σ²) / (2σ‖c − r‖). NaN where not measured.
+  /// z = (‖r − o‖² − ‖c − o‖² − k σ²) / (2σ‖c − r‖). NaN where not measured. Reported (what the
+  /// training data say where the held-out data cannot resolve a candidate), not used by the
+  /// choice: fitting the training frames better says nothing of how a candidate forecasts.
   double training_significance = std::numeric_limits<double>::quiet_NaN();
-  /// It beats the reference beyond noise: on the held-out data where they resolve it
-  /// (resolution ≥ kSignificance: significance ≥ kSignificance), else on the training data
-  /// (training_significance ≥ kSignificance). False for the reference itself.
+  /// It beats the reference beyond noise on the held-out data: they resolve it (resolution ≥
+  /// kSignificance) and it gains there (significance ≥ kSignificance). False for the reference
+  /// itself.
   bool beats_reference = false;
   /// Eligible for the choice: its validation completed, it survives a larger motion and it is
   /// stable where a motion of another kind may go.
@@ -214,9 +217,9 @@ void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int re
 /// Stage 4's choice, `reference` the index of the fitted nominal (or −1: no reference), σ the
 /// noise per coordinate. Compares every other completed candidate with the reference
 /// (compare_with_reference) and returns the index of the eligible candidate with the lowest
-/// validation RMS among the reference and the candidates that beat it on the held-out data. If
-/// none does, but some that the held-out data cannot resolve beat it on the training data, the
-/// one of those with the lowest training error. −1 if no candidate is eligible.
+/// validation RMS among the reference and the candidates that beat it on the held-out data
+/// (`training`, if it holds predictions, only sets their training_significance). −1 if no
+/// candidate is eligible.
 int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
     const ComparedData& training, int reference, double sigma);
 
