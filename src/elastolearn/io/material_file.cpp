@@ -145,10 +145,9 @@ MatX read_rows(const JsonObject& o, const std::string& key, Eigen::Index rows, E
 /// unbounded, and continued with the edge's Hessian as those files were.
 material::TrustedStretches trusted_from_json(const JsonObject& o) {
   material::TrustedStretches t;
-  const std::string continuation = o.choice("continuation",
-      { "edge_hessian", "bounded_softening", "smooth_clamp", "smooth_expansion" }, "edge_hessian");
-  t.continuation = material::continuation_from_name(continuation, "continuation");
-  if (continuation != "edge_hessian") {
+  t.continuation = material::continuation_from_name(
+      o.choice("continuation", material::continuation_names(), "edge_hessian"), "continuation");
+  if (t.continuation != material::Continuation::edge_hessian) {
     t.nominal_stiffness = read_rows(o, "nominal_stiffness", 3, 3);
     t.kept_stiffness = o.number("kept_stiffness");
   }

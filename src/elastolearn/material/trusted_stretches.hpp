@@ -38,7 +38,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <string>
+#include <vector>
 
 namespace elastolearn::material {
 
@@ -51,6 +54,10 @@ enum class Continuation {
   /// (exact)
   smooth_expansion,
 };
+
+/// Every continuation, in the order their names are listed.
+inline constexpr Continuation kContinuations[] = { Continuation::edge_hessian,
+  Continuation::bounded_softening, Continuation::smooth_clamp, Continuation::smooth_expansion };
 
 /// The continuation's name in files and options ("edge_hessian", "bounded_softening",
 /// "smooth_clamp", "smooth_expansion").
@@ -68,15 +75,24 @@ inline const char* continuation_name(Continuation c) {
   return "edge_hessian";
 }
 
+/// Every continuation's name (kContinuations' order).
+inline std::vector<std::string> continuation_names() {
+  std::vector<std::string> names;
+  for (const Continuation c : kContinuations)
+    names.emplace_back(continuation_name(c));
+  return names;
+}
+
 /// The continuation named `name`; throws InputError(`field`, ...) naming the choices otherwise.
 inline Continuation continuation_from_name(const std::string& name, const std::string& field) {
-  for (const Continuation c : { Continuation::edge_hessian, Continuation::bounded_softening,
-           Continuation::smooth_clamp, Continuation::smooth_expansion })
+  std::string expected;
+  for (const Continuation c : kContinuations) {
     if (name == continuation_name(c))
       return c;
-  throw InputError(field,
-      "unknown continuation \"" + name
-          + "\" (expected edge_hessian, bounded_softening, smooth_clamp or smooth_expansion)");
+    const char* separator = c == kContinuations[std::size(kContinuations) - 1] ? " or " : ", ";
+    expected.append(expected.empty() ? "" : separator).append(continuation_name(c));
+  }
+  throw InputError(field, "unknown continuation \"" + name + "\" (expected " + expected + ")");
 }
 
 /// The fraction β of the nominal's rest stiffness a continued correction keeps (learning's).
