@@ -91,7 +91,7 @@ long g_seed = -1;
 double g_damping_regularization = -1, g_regularization = -1, g_position_weight = -1,
        g_kernel_smoothing = -1, g_full_space_weight = -1, g_damping_prior = -1,
        g_elastic_prior = -1, g_smoothness = -1, g_forward_fit_tolerance = -1;
-bool g_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
+bool g_no_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
      g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false,
      g_no_backtrack = false;
 /// --smooth-clamp, --smooth-expansion: the continuation beyond the trusted stretches.
@@ -128,8 +128,8 @@ void apply_overrides(learn::LearningOptions& o) {
     o.rbf.continuation = *g_continuation;
   if (g_linear_tail)
     o.rbf.quadratic_tail = false;
-  if (g_neo_hookean_tail)
-    o.rbf.neo_hookean_tail = true;
+  if (g_no_neo_hookean_tail)
+    o.rbf.neo_hookean_tail = false;
   if (g_damping_quadratic)
     o.rbf.damping_quadratic_tail = true;
   if (g_full_space)
@@ -447,6 +447,10 @@ int main(int argc, char** argv) {
       g_outliers = std::stod(argv[++i]);
     else if (a == "--truth-only")
       g_truth_only = true;
+    else if (a == "--no-mass-damping")
+      g_recipe.loop.rbf.mass_damping = false;
+    else if (a == "--fit" && i + 1 < argc)
+      g_recipe.parameter_fit.parameters = learn::fit_parameters_from_string(argv[++i]);
     else if (a == "--test-candidates")
       g_test_candidates = true;
     else if (a == "--no-fit")
@@ -481,8 +485,8 @@ int main(int argc, char** argv) {
       g_recipe.loop.rbf.energy_kernels = false;
     else if (a == "--linear-tail")
       g_linear_tail = true;
-    else if (a == "--neo-hookean-tail")
-      g_neo_hookean_tail = true;
+    else if (a == "--no-neo-hookean-tail")
+      g_no_neo_hookean_tail = true;
     else if (a == "--damping-quadratic-tail")
       g_damping_quadratic = true;
     else if (a == "--full-space")
@@ -523,7 +527,7 @@ int main(int argc, char** argv) {
                   "RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
                   "[--smoothness L] "
-                  "[--stress-kernels] [--linear-tail] [--neo-hookean-tail] "
+                  "[--stress-kernels] [--linear-tail] [--no-neo-hookean-tail] [--no-mass-damping] "
                   "[--damping-quadratic-tail] [--full-space] "
                   "[--pod-forward-only] [--no-damping] [--smooth-clamp] [--smooth-expansion] "
                   "[--position-weight W] "

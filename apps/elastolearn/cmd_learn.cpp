@@ -213,7 +213,11 @@ void run_learn(const LearnOptions& o) {
         || (c.kind == learn::CandidateKind::Nominal && !options.fit_parameters);
     std::string note;
     if (static_cast<int>(i) == result.chosen)
-      note = "   <- chosen";
+      note = "   <- chosen"
+          + (c.correction && c.correction->mass_damping() != 0
+                  ? " (with Δα₀ " + elastolearn::to_text(c.correction->mass_damping())
+                      + " 1/s on the nominal's mass damping)"
+                  : std::string());
     else if (c.completed && !c.eligible())
       note = "   (diverged in a motion driven " + elastolearn::to_text(learn::kLargerMotion)
           + "× as hard: not eligible)";
@@ -366,8 +370,10 @@ void add_learn_command(CLI::App& root) {
       ->capture_default_str();
   cmd->add_flag("!--stress-kernels", l.rbf.energy_kernels,
       "RBF kernels of the principal stress (paper Eq. 10) instead of an energy's (default)");
-  cmd->add_flag("--neo-hookean-tail", l.rbf.neo_hookean_tail,
-      "RBF with a neo-Hookean tail too (barrier terms that extrapolate strong compression)");
+  cmd->add_flag("!--no-neo-hookean-tail", l.rbf.neo_hookean_tail,
+      "RBF without the neo-Hookean tail (barrier terms that extrapolate strong compression)");
+  cmd->add_flag("!--no-mass-damping", l.rbf.mass_damping,
+      "do not learn Δα₀, the change of the fitted nominal's mass damping, with the correction");
   cmd->add_flag("--damping-quadratic-tail", l.rbf.damping_quadratic_tail,
       "RBF damping Δα₁ with a quadratic tail too (carries its curvature beyond the training's "
       "stretches)");

@@ -103,7 +103,8 @@ def learn(scene, observations=None, *, clouds=None, output=None, checkpoint=None
     unprojected_reconstruction, full_space_weight, no_damping, linear_tail,
     damping_regularization, continuation ("bounded_softening" | "smooth_expansion" |
     "smooth_clamp"), smoothness, seed, forward_fit, forward_fit_tolerance, damping_prior,
-    elastic_prior, kernel_smoothing, stress_kernels, neo_hookean_tail, damping_quadratic_tail,
+    elastic_prior, kernel_smoothing, stress_kernels, no_neo_hookean_tail, no_mass_damping,
+    damping_quadratic_tail,
     allow_rest_stress, no_network (stage 5 off: keep the RBF), network_kind,
     network_motion_scales, network_samples, network_rate_jitter.
 

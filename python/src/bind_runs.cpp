@@ -246,10 +246,12 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
         [](S& s, H v) { s.recipe.loop.rbf.epsilon = value<double>(v, "kernel_smoothing"); } },
     { "stress_kernels",
         [](S& s, H v) { s.recipe.loop.rbf.energy_kernels = !value<bool>(v, "stress_kernels"); } },
-    { "neo_hookean_tail",
+    { "no_neo_hookean_tail",
         [](S& s, H v) {
-          s.recipe.loop.rbf.neo_hookean_tail = value<bool>(v, "neo_hookean_tail");
+          s.recipe.loop.rbf.neo_hookean_tail = !value<bool>(v, "no_neo_hookean_tail");
         } },
+    { "no_mass_damping",
+        [](S& s, H v) { s.recipe.loop.rbf.mass_damping = !value<bool>(v, "no_mass_damping"); } },
     { "damping_quadratic_tail",
         [](S& s, H v) {
           s.recipe.loop.rbf.damping_quadratic_tail = value<bool>(v, "damping_quadratic_tail");

@@ -151,6 +151,23 @@ TEST(MaterialFile, RbfRoundTripIsBitExact) {
   expect_same_function(*original, *back);
 }
 
+TEST(MaterialFile, MassDampingRoundTripsAndIsWrittenOnlyWhenLearned) {
+  auto p = rbf_parameters(3, 8);
+  MaterialFile f;
+  f.material = k_nominal;
+  f.correction = std::make_shared<material::RbfCorrection>(p);
+  EXPECT_FALSE(material_file_to_json(f)["correction"].contains("mass_damping"))
+      << "a file without Δα₀ keeps the form it had before the field";
+  p.mass_damping = -0.1234567890123;
+  f.correction = std::make_shared<material::RbfCorrection>(p);
+  const Json j = material_file_to_json(f);
+  const MaterialFile g = parse_material_file(Json::parse(j.dump()), "f.json");
+  EXPECT_EQ(g.correction->mass_damping(), p.mass_damping);
+  Json bad = j;
+  bad["correction"]["mass_damping"] = "much";
+  expect_bad(bad, { "bad.json: correction.mass_damping" });
+}
+
 TEST(MaterialFile, TrainingStretchesRoundTripAndAreOptional) {
   MaterialFile f = parse_material_file(valid_rbf_file(), "old.json");
   EXPECT_FALSE(f.training_stretches.has_value()) << "files before the field read without it";

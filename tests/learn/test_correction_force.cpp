@@ -158,6 +158,41 @@ TEST(CorrectionForce, IsTheElasticForceWithTheCorrectionMinusWithout) {
   EXPECT_LT(clamped, m);
 }
 
+TEST(CorrectionForce, AMassDampingChangeDampsTheLumpedMassAsTheSimulatorDoes) {
+  // Δα₀ adds −Δα₀ (ρ V_e / 4) v_a per element, kept α₀ + Δα₀ ≥ 0 (the nominal's α₀ is 0.3):
+  // with a Δα₀ that leaves α₀ positive and with one that the clamp cuts to −α₀.
+  const mesh::TetMesh mesh = small_mesh();
+  const State s = random_state(mesh, 6);
+  const auto scales = random_scales(mesh.num_tets());
+  const material::RbfCorrection plain = rbf_correction();
+  const fem::MaterialModel material = nominal(material::DampingTangent::FlipFree, scales);
+  const ReconstructionMesh geometry(mesh, material);
+  const VecX f_plain = correction_force(geometry, plain, s.x, s.v);
+  for (const double change : { 0.2, -0.1, -0.5 }) {
+    SCOPED_TRACE(change);
+    auto p = plain.parameters();
+    p.mass_damping = change;
+    const material::RbfCorrection damped(p);
+    const VecX f = correction_force(geometry, damped, s.x, s.v);
+    const VecX expected = elastic_force_difference(mesh, material, damped, s);
+    EXPECT_LE((f - expected).lpNorm<Eigen::Infinity>(), 1e-10 * expected.lpNorm<Eigen::Infinity>());
+    // The mass term itself: the applied change times −M v (lumped), M from ρ = 1000.
+    const double applied = std::max(change, -0.3);
+    VecX mass_force = VecX::Zero(s.x.size());
+    for (int e = 0; e < mesh.num_tets(); ++e)
+      for (int a = 0; a < 4; ++a) {
+        const int i = mesh.tets()(e, a);
+        mass_force.segment<3>(3 * i)
+            -= applied * 1000 * geometry.rest[e].volume / 4 * s.v.segment<3>(3 * i);
+      }
+    EXPECT_LE(
+        (f - f_plain - mass_force).lpNorm<Eigen::Infinity>(), 1e-10 * f.lpNorm<Eigen::Infinity>());
+    // Small next to the elastic force (ρ = 1000, v ~ 0.1 m/s: measured 3e-5–1e-4 of it), but far
+    // above the tolerances above, so a wrong mass, sign or clamp fails them.
+    EXPECT_GT(mass_force.lpNorm<Eigen::Infinity>(), 1e-6 * f.lpNorm<Eigen::Infinity>());
+  }
+}
+
 TEST(CorrectionForce, WithoutANominalElasticModelIsTheCorrectionStressAlone) {
   // No nominal model: B N(σ, ḟ) only (no damping, no Δα₁), i.e. ElasticForce's difference with
   // the nominal and the Rayleigh damping switched off.
@@ -182,25 +217,30 @@ TEST(CorrectionForceJacobian, TimesTheUnknownsIsTheCorrectionForce) {
     if (mesh.rest_positions()(i, 0) == 0.0)
       fixed.push_back(i);
   const fem::DofMap dofs(mesh.num_vertices(), fixed);
-  const RbfDesign design(rbf_correction().parameters().centres, RbfFitOptions {});
-  ASSERT_GT(design.damping_unknowns(), 0);
-  std::mt19937 rng(8);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  VecX unknowns(design.num_unknowns());
-  for (int i = 0; i < unknowns.size(); ++i)
-    unknowns[i] = (i < design.elastic_unknowns() ? 2e3 : 1e-3) * u(rng);
-  const material::RbfCorrection correction = design.correction(unknowns);
   const State s = random_state(mesh, 5);
   const auto scales = random_scales(mesh.num_tets());
-  for (const material::DampingTangent kind : material::all_damping_tangents) {
-    SCOPED_TRACE(material::to_string(kind));
-    const ReconstructionMesh geometry(mesh, nominal(kind, scales));
-    ASSERT_EQ(clamped_elements(geometry, correction, s), 0);
-    CorrectionForceJacobian jacobian(geometry, dofs, design);
-    const VecX Jx = jacobian.transposed(s.x, s.v).transpose() * unknowns;
-    const VecX f = dofs.restrict(correction_force(geometry, correction, s.x, s.v));
-    // Linear in the unknowns up to round-off of the operator columns (measured 1e-15).
-    EXPECT_LE((Jx - f).lpNorm<Eigen::Infinity>(), 1e-9 * f.lpNorm<Eigen::Infinity>());
-    EXPECT_GT(f.norm(), 0.0);
-  }
+  for (const bool mass_damping : { false, true })
+    for (const material::DampingTangent kind : material::all_damping_tangents) {
+      SCOPED_TRACE(testing::Message() << material::to_string(kind) << ", Δα₀ " << mass_damping);
+      RbfFitOptions options;
+      options.mass_damping = mass_damping; // its column −M v, with Δα₀ within the clamp
+      const RbfDesign design(rbf_correction().parameters().centres, options);
+      ASSERT_GT(design.damping_unknowns(), 0);
+      std::mt19937 rng(8);
+      std::uniform_real_distribution<double> u(-1.0, 1.0);
+      VecX unknowns(design.num_unknowns());
+      for (int i = 0; i < unknowns.size(); ++i)
+        unknowns[i] = (i < design.elastic_unknowns() ? 2e3 : 1e-3) * u(rng);
+      if (mass_damping)
+        unknowns[design.mass_damping_unknown()] = 0.15;
+      const material::RbfCorrection correction = design.correction(unknowns);
+      const ReconstructionMesh geometry(mesh, nominal(kind, scales));
+      ASSERT_EQ(clamped_elements(geometry, correction, s), 0);
+      CorrectionForceJacobian jacobian(geometry, dofs, design);
+      const VecX Jx = jacobian.transposed(s.x, s.v).transpose() * unknowns;
+      const VecX f = dofs.restrict(correction_force(geometry, correction, s.x, s.v));
+      // Linear in the unknowns up to round-off of the operator columns (measured 1e-15).
+      EXPECT_LE((Jx - f).lpNorm<Eigen::Infinity>(), 1e-9 * f.lpNorm<Eigen::Infinity>());
+      EXPECT_GT(f.norm(), 0.0);
+    }
 }

@@ -50,10 +50,11 @@ MatX centres() {
 }
 
 /// The stress-kernel design on centres() with elastic unknowns only (no Δα₁): kernel weights
-/// first, then the linear tail's own and other slopes.
-RbfDesign elastic_design() {
+/// first, then the linear tail's own and other slopes; with `mass_damping`, Δα₀ last.
+RbfDesign elastic_design(bool mass_damping = false) {
   RbfFitOptions rbf;
   rbf.fit_damping = false;
+  rbf.mass_damping = mass_damping;
   return RbfDesign(centres(), rbf);
 }
 
@@ -71,8 +72,9 @@ TEST(ForwardFit, SensitivityGradientMatchesFiniteDifferencesOfTheError) {
       material::ElasticModelType::NeoHookean, material::Lame::from_young_poisson(1.4e4, 0.4));
   const observe::Observation observed = observe_run(truth);
   const ReconstructionMesh mesh(nominal.mesh, nominal.material);
-  // Elastic unknowns only: with α₁ = 0 the clamp α₁ + Δα₁ ≥ 0 makes the force kink at Δα₁ = 0.
-  const RbfDesign design = elastic_design();
+  // No Δα₁: with α₁ = 0 the clamp α₁ + Δα₁ ≥ 0 makes the force kink at Δα₁ = 0. Δα₀ (whose
+  // column −M v enters the recursion) is smooth there: α₀ = 0.5.
+  const RbfDesign design = elastic_design(true);
   const VecX start = VecX::Zero(design.num_unknowns());
   const ForwardSensitivityPass pass
       = simulate_with_sensitivities(nominal, observed, mesh, design, start, Sensitivities::exact);
@@ -132,6 +134,32 @@ TEST(ForwardFit, RecoversACorrectionTheDesignCanExpressFromHalfTheVertices) {
   const Vec3 got = design.correction(fit.unknowns).correction(probe, Vec3::Zero());
   EXPECT_LE((got - want).norm(), 0.05 * want.norm())
       << "got " << got.transpose() << ", want " << want.transpose();
+}
+
+TEST(ForwardFit, RecoversTheTruthsMassDampingWithTheCorrection) {
+  // The truth damps with α₀ = 0.8 where the nominal has 0.5, and is stiffer by a Lamé change:
+  // the design with Δα₀ expresses it exactly, so the fit must find Δα₀ ≈ 0.3 and the error must
+  // fall far. Without Δα₀ the same fit cannot (its elastic unknowns cannot damp).
+  const sim::Scene nominal = small_bar();
+  const ReconstructionMesh mesh(nominal.mesh, nominal.material);
+  const RbfDesign design = elastic_design(true);
+  VecX truth_unknowns = VecX::Zero(design.num_unknowns());
+  truth_unknowns[4] = 8e3; // own slope a = 2Δμ + Δλ [Pa]
+  truth_unknowns[5] = 2e3; // other slope b = Δλ [Pa]
+  truth_unknowns[design.mass_damping_unknown()] = 0.3;
+  const observe::Observation observed = observe_run(sim::with_correction(
+      nominal, std::make_shared<material::RbfCorrection>(design.correction(truth_unknowns))));
+  ForwardFitOptions options;
+  options.max_iterations = 6;
+  const ForwardFitResult fit = fit_to_observations(
+      nominal, observed, mesh, design, VecX::Zero(design.num_unknowns()), options);
+  EXPECT_NEAR(fit.unknowns[design.mass_damping_unknown()], 0.3, 0.03);
+  EXPECT_LT(fit.rms_history.back(), 1e-2 * fit.rms_history.front())
+      << "rms " << fit.rms_history.front() << " → " << fit.rms_history.back();
+  const RbfDesign without = elastic_design(false);
+  const ForwardFitResult held = fit_to_observations(
+      nominal, observed, mesh, without, VecX::Zero(without.num_unknowns()), options);
+  EXPECT_GT(held.rms_history.back(), 10 * fit.rms_history.back());
 }
 
 TEST(ForwardFit, ShortensAStepToAnUnstableMaterialInsteadOfRejectingIt) {

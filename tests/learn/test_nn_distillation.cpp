@@ -25,7 +25,7 @@ namespace {
 /// A teacher like the learning loop's: the isotropic linear tail of nominal Lamé parameters off
 /// by Δμ = 3 kPa, Δλ = 4 kPa (a = 2Δμ + Δλ, b = Δλ), 4 centres around rest with elastic weights
 /// ~1e3 Pa (over the sampled box the linear and kernel stresses are both ~1e3 Pa), and a damping
-/// RBF Δα₁ ~ 1e-3 s, which distillation carries over instead of fitting.
+/// RBF Δα₁ ~ 1e-3 s with Δα₀ 0.3 /s, which distillation carries over instead of fitting.
 material::RbfCorrection smooth_teacher() {
   material::RbfCorrection::Parameters p;
   p.centres.resize(4, 3);
@@ -35,6 +35,7 @@ material::RbfCorrection smooth_teacher() {
   p.other_slope = 4e3;
   p.damping_weights = Eigen::Vector4d(4e-3, -2e-3, 3e-3, -1e-3);
   p.damping_constant = 1e-3;
+  p.mass_damping = 0.3;
   p.epsilon = 0.05;
   return material::RbfCorrection(std::move(p));
 }
@@ -327,6 +328,14 @@ TEST(NnDistillation, TeacherDampingIsCarriedOverExactly) {
     EXPECT_EQ(damped.correction(sigma, rate), r.correction.correction(sigma, rate));
   }
   EXPECT_NE(teacher.stiffness_damping(Vec3(1.1, 1, 0.9)), 0);
+  // Δα₀ travels with the damping RBF, also when it is the teacher's only damping.
+  EXPECT_EQ(damped.mass_damping(), teacher.mass_damping());
+  auto mass_only = teacher.parameters();
+  mass_only.damping_weights.resize(0);
+  mass_only.damping_constant = 0;
+  mass_only.mass_damping = -0.25;
+  EXPECT_EQ(
+      with_teacher_damping(r.correction, material::RbfCorrection(mass_only)).mass_damping(), -0.25);
   // A network teacher passes its damping on; a teacher without damping gives none.
   EXPECT_EQ(
       with_teacher_damping(r.correction, damped).parameters().damping, damped.parameters().damping);

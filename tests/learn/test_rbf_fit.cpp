@@ -328,6 +328,29 @@ TEST(RbfDesign, EnergyKernelsRoundTripAndMatchTheCorrection) {
   EXPECT_THROW(RbfDesign(centres, stress).unknowns(n), InputError);
 }
 
+TEST(RbfDesign, MassDampingIsTheLastUnknownAndRoundTrips) {
+  RbfFitOptions options = energy_options();
+  options.mass_damping = true;
+  const RbfDesign design(energy_centres(), options);
+  const RbfDesign without(energy_centres(), energy_options());
+  EXPECT_EQ(design.num_unknowns(), without.num_unknowns() + 1);
+  EXPECT_EQ(design.mass_damping_unknown(), design.num_unknowns() - 1);
+  EXPECT_EQ(without.mass_damping_unknown(), -1);
+  VecX x = random_unknowns(design, 12);
+  x[design.mass_damping_unknown()] = 0.37;
+  const material::RbfCorrection c = design.correction(x);
+  EXPECT_EQ(c.mass_damping(), 0.37);
+  EXPECT_LE((design.unknowns(c) - x).norm(), 1e-12 * x.norm());
+  // The other unknowns mean what they mean without Δα₀.
+  VecX rest = x.head(without.num_unknowns());
+  const material::RbfCorrection d = without.correction(rest);
+  for (const Vec3& s : { Vec3(1.05, 0.93, 0.97), Vec3(0.8, 1.2, 1.0) }) {
+    EXPECT_EQ(c.correction(s, Vec3::Zero()), d.correction(s, Vec3::Zero()));
+    EXPECT_EQ(c.stiffness_damping(s), d.stiffness_damping(s));
+  }
+  EXPECT_THROW(without.unknowns(c), InputError) << "a Δα₀ the design cannot express";
+}
+
 TEST(RbfDesign, StressFreeRestKeepsTheRestShapeUnstressed) {
   // Every hyperelastic model is stress-free at rest, and an unloaded object simulated with a
   // learned material must stay at rest: under stress_free_rest any weights give N(1, 1, 1) = 0,

@@ -210,7 +210,8 @@ def test_learn_flags_set_what_the_cli_sets(learning_case, cli, tmp_path):
     scene, observations = learning_case
     flags = dict(LEARN_OPTIONS, max_iterations=1, no_parameter_fit=True, pod_forward_only=True,
                  unprojected_reconstruction=True, full_space_weight=0.2, no_damping=True,
-                 linear_tail=True, stress_kernels=True, neo_hookean_tail=True,
+                 linear_tail=True, stress_kernels=True, no_neo_hookean_tail=True,
+                 no_mass_damping=True,
                  allow_rest_stress=True, validation_fraction=0.25, frame_stride=2,
                  smoothness=0.05, no_backtrack=True, forward_fit_tolerance=0.05)
     r = cli("learn", scene, "--observations", observations, "-o", tmp_path / "cli.json", "-q",

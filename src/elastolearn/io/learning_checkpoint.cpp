@@ -15,7 +15,8 @@ constexpr int k_checkpoint_version = 3;
 
 /// A checkpoint's options with the fields added since it was written set to the values every run
 /// had before (so that it still resumes under those options): rbf.smoothness 0,
-/// rbf.continuation bounded_softening, backtrack false, forward_fit.function_tolerance 0.
+/// rbf.continuation bounded_softening, rbf.mass_damping false, backtrack false,
+/// forward_fit.function_tolerance 0.
 nlohmann::json with_former_defaults(nlohmann::json options) {
   const auto fill = [](nlohmann::json& loop) {
     if (!loop.is_object())
@@ -24,6 +25,8 @@ nlohmann::json with_former_defaults(nlohmann::json options) {
       loop["rbf"]["smoothness"] = 0.0;
     if (loop.contains("rbf") && loop["rbf"].is_object() && !loop["rbf"].contains("continuation"))
       loop["rbf"]["continuation"] = "bounded_softening";
+    if (loop.contains("rbf") && loop["rbf"].is_object() && !loop["rbf"].contains("mass_damping"))
+      loop["rbf"]["mass_damping"] = false;
     // "patience" marks the loop's object (the recipe's options hold it under "loop").
     if (loop.contains("patience") && !loop.contains("backtrack"))
       loop["backtrack"] = false;
@@ -224,7 +227,8 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
             { "regularization", o.rbf.regularization },
             { "damping_regularization", o.rbf.damping_regularization },
             { "smoothness", o.rbf.smoothness },
-            { "continuation", material::continuation_name(o.rbf.continuation) } } },
+            { "continuation", material::continuation_name(o.rbf.continuation) },
+            { "mass_damping", o.rbf.mass_damping } } },
     { "reconstruction",
         { { "method", learn::reconstruction_method_name(o.reconstruction.method) },
             { "frame_stride", o.reconstruction.frame_stride },

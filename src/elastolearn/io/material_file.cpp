@@ -69,6 +69,8 @@ Json rbf_to_json(const material::RbfCorrection& c) {
     { "damping_slopes", vector_to_json(p.damping_slopes) },
     { "damping_constant", p.damping_constant },
     { "damping_quadratic", vector_to_json(p.damping_quadratic) }, { "damping_floor", floor } };
+  if (p.mass_damping != 0) // written only when learned, so other files keep their exact form
+    out["mass_damping"] = p.mass_damping;
   continuation_to_json(p.trusted, out);
   return out;
 }
@@ -184,7 +186,7 @@ template <typename Make> auto construct(const JsonObject& o, Make&& make) {
 std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o) {
   o.reject_unknown_keys({ "type", "energy_kernels", "epsilon", "centres", "weights", "own_slope",
       "other_slope", "constant", "quadratic", "neo_hookean", "damping_weights", "damping_slopes",
-      "damping_slope", "damping_constant", "damping_quadratic", "damping_floor",
+      "damping_slope", "damping_constant", "damping_quadratic", "damping_floor", "mass_damping",
       "trusted_stretches", "continuation", "nominal_stiffness", "kept_stiffness", "clamp_width" });
   material::RbfCorrection::Parameters p;
   p.energy_kernels = o.boolean("energy_kernels", false); // absent: the stress kernels
@@ -218,6 +220,7 @@ std::shared_ptr<const material::RbfCorrection> rbf_from_json(const JsonObject& o
     p.damping_quadratic = read_vector(o, "damping_quadratic", 3);
   if (o.has("damping_floor") && !o.json().at("damping_floor").is_null())
     p.damping_floor = o.number("damping_floor");
+  p.mass_damping = o.number("mass_damping", 0.0);
   p.trusted = trusted_from_json(o);
   return construct(
       o, [&] { return std::make_shared<const material::RbfCorrection>(std::move(p)); });

@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
+#include <elastolearn/fem/tet_element.hpp>
 #include <elastolearn/learn/correction_force.hpp>
 #include <elastolearn/learn/element_force_operator.hpp>
 #include <elastolearn/material/element_stress.hpp>
@@ -43,6 +44,17 @@ material::DampingTangent nominal_damping_tangent(const ReconstructionMesh& mesh)
   return material::damping_tangent_of(mesh.nominal.damping.get());
 }
 
+/// Lumped mass of every dof (flat 3n) [kg]: a quarter of each element's ρ V at its vertices, the
+/// mass the mass damping scales (fem::ElasticForce with MassType::Lumped).
+VecX lumped_dof_masses(const ReconstructionMesh& mesh) {
+  VecX masses = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));
+  for (int e = 0; e < mesh.num_tets(); ++e)
+    for (int a = 0; a < 4; ++a)
+      masses.segment<3>(3 * mesh.tets(e, a)).array()
+          += mesh.nominal.density * mesh.rest[e].volume / 4.0;
+  return masses;
+}
+
 constexpr int k_jacobian_batch = 512; ///< elements per batch of CorrectionForceJacobian
 
 } // namespace
@@ -59,12 +71,19 @@ CorrectionForceJacobian::CorrectionForceJacobian(
   if (design.damping_unknowns() > 0 && mesh.nominal.elastic == nullptr)
     correction_force_error(
         "nominal", "fitting the damping correction needs the nominal elastic model");
+  if (design.mass_damping_unknown() >= 0) {
+    const VecX masses = lumped_dof_masses(mesh);
+    m_free_dofs = dofs.free_dofs();
+    m_free_masses.resize(static_cast<Eigen::Index>(m_free_dofs.size()));
+    for (size_t i = 0; i < m_free_dofs.size(); ++i)
+      m_free_masses[static_cast<Eigen::Index>(i)] = masses[m_free_dofs[i]];
+  }
 }
 
 void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
     RbfDesign::OutputMatrix& outputs, RbfDesign::OutputGradient& gradients,
     Eigen::RowVectorXd& damping_row) const {
-  const int u = m_design.num_unknowns(), u_elastic = m_design.elastic_unknowns();
+  const int u_elastic = m_design.elastic_unknowns();
   const ElementState& st = m_states[e];
   const fem::TetRestData& rest = m_mesh.rest[e];
   // The kernel without a correction gives how a correction's N and Δα₁ enter the element's
@@ -85,9 +104,11 @@ void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
     m_design.output_matrix(st.frame.stretches, outputs);
     rows.leftCols(u_elastic).noalias() = G * outputs;
   }
-  if (u > u_elastic) {
+  if (m_design.mass_damping_unknown() >= 0)
+    rows.col(m_design.mass_damping_unknown()).setZero(); // transposed adds −M v at once
+  if (m_design.damping_unknowns() > 0) {
     m_design.damping_row(st.frame.stretches, damping_row);
-    rows.rightCols(u - u_elastic).noalias()
+    rows.middleCols(u_elastic, m_design.damping_unknowns()).noalias()
         = element_stiffness_damping_force(rest, st,
               material::damping_tangent(st.frame, nominal.damped_per_alpha1_change(), kind))
         * damping_row;
@@ -96,7 +117,7 @@ void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
 
 const MatX& CorrectionForceJacobian::transposed(const VecX& x, const VecX& v) {
   const int m = m_mesh.num_tets();
-  const int u = m_design.num_unknowns(), u_elastic = m_design.elastic_unknowns();
+  const int u_elastic = m_design.elastic_unknowns();
   compute_element_states(m_mesh, x, v, m_states);
   m_jt.setZero();
   for (int first = 0; first < m; first += k_jacobian_batch) {
@@ -105,7 +126,7 @@ const MatX& CorrectionForceJacobian::transposed(const VecX& x, const VecX& v) {
       // Per-task work space: a few small buffers per 32 elements, next to their O(u) products.
       RbfDesign::OutputMatrix outputs(3, u_elastic);
       RbfDesign::OutputGradient gradients(9, u_elastic);
-      Eigen::RowVectorXd damping_row(u - u_elastic);
+      Eigen::RowVectorXd damping_row(m_design.damping_unknowns());
       for (int i = r.begin(); i < r.end(); ++i)
         element_rows(first + i, m_batch.middleRows(12 * i, 12), outputs, gradients, damping_row);
     });
@@ -115,6 +136,10 @@ const MatX& CorrectionForceJacobian::transposed(const VecX& x, const VecX& v) {
         if (row >= 0)
           m_jt.col(row) += m_batch.row(12 * i + l).transpose();
       }
+  }
+  if (const int k = m_design.mass_damping_unknown(); k >= 0) { // Δα₀'s force −M v (lumped)
+    for (Eigen::Index i = 0; i < m_free_masses.size(); ++i)
+      m_jt(k, i) = -m_free_masses[i] * v[m_free_dofs[i]];
   }
   return m_jt;
 }
@@ -139,8 +164,15 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
         damping = material::damping_tangent(s.frame, stress.damped_by_correction(), kind);
       const Mat3 P = material::element_first_piola(
           s.frame, stress.correction, damped ? &damping : nullptr, s.deformation_rate);
-      Eigen::Map<Eigen::Matrix<double, 3, 4>>(element_forces[e].data()).noalias()
-          = -mesh.rest[e].volume * P * mesh.rest[e].gradients;
+      auto force = Eigen::Map<Eigen::Matrix<double, 3, 4>>(element_forces[e].data());
+      force.noalias() = -mesh.rest[e].volume * P * mesh.rest[e].gradients;
+      // Δα₀ as applied (kept α₀ + Δα₀ ≥ 0) on the lumped mass, as fem::ElasticForce damps it.
+      const material::ElementMaterial nominal = element_material(mesh, nullptr, e);
+      const double alpha0_change = stress.alpha.alpha0
+          - (nominal.damping ? nominal.damping->coefficients(s.frame.stretches[0]).alpha0 : 0.0);
+      if (alpha0_change != 0)
+        force -= alpha0_change * (mesh.nominal.density * mesh.rest[e].volume / 4.0)
+            * fem::gather_tet(v, mesh.tets.row(e).transpose());
     }
   });
   VecX f = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));

@@ -18,7 +18,8 @@ namespace elastolearn::learn {
 /// (Eq. 1's N term; the nominal Rayleigh α₁ on the correction's share of the corrected damping
 /// stiffness and Eq. 13's Δα₁, kept α₁ + Δα₁ ≥ 0, on the nominal one: ElementStress::
 /// damped_by_correction), with α₁, the stiffness scale s_e and the damping tangent K^d of
-/// mesh.nominal. Without mesh.nominal.elastic only the N term. Parallel over elements.
+/// mesh.nominal, and the mass damping a Δα₀ adds on the lumped mass, −Δα₀ (ρ V_e / 4) v_a (kept
+/// α₀ + Δα₀ ≥ 0). Without mesh.nominal.elastic only the N and Δα₀ terms. Parallel over elements.
 VecX correction_force(const ReconstructionMesh& mesh, const material::Correction& correction,
     const VecX& x, const VecX& v);
 
@@ -29,8 +30,10 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
 /// correction_damping_weight α₁, damped_per_alpha1_change s_e P̂ whose damping force is
 /// −K_e^nom v_e; D_e = element_stiffness_damping_operator), exact up to Δα₁'s clamp. The element
 /// blocks are computed in parallel in batches and added in element order, so J does not depend
-/// on the thread count. Owns its work space (allocated once); one instance per concurrent caller.
-/// `mesh`, `dofs` and `design` must outlive it.
+/// on the thread count. With Δα₀ (RbfDesign::mass_damping_unknown) its column is −M v, M the
+/// lumped mass (exact up to the clamp α₀ + Δα₀ ≥ 0; a consistent-mass scene damps with its own
+/// mass matrix, which this column approximates). Owns its work space (allocated once); one instance
+/// per concurrent caller. `mesh`, `dofs` and `design` must outlive it.
 class CorrectionForceJacobian {
   public:
   /// Throws InputError if the design fits damping but mesh.nominal has no elastic model.
@@ -49,6 +52,9 @@ class CorrectionForceJacobian {
   std::vector<std::array<int, 12>>
       m_free_rows; ///< free index of each element's local dofs (−1: prescribed)
   std::vector<ElementState> m_states;
+  /// With Δα₀ in the design: the free dofs (flat indices) and their lumped masses [kg].
+  std::vector<int> m_free_dofs;
+  VecX m_free_masses;
   MatX m_jt;
   MatX m_batch; ///< 12 rows per element of one batch
 };

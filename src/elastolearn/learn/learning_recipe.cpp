@@ -47,6 +47,11 @@ RecipeOptions::RecipeOptions() {
   loop.rbf.energy_kernels = true;
   loop.rbf.epsilon = 0.03;
   loop.rbf.smoothness = 1e-2;
+  // The neo-Hookean tail and Δα₀ together (docs/learning_recipe.md, "The nominal's damping,
+  // learned with the correction"): the parameter fit's α₀ absorbs part of the corotated
+  // nominal's elastic misfit, and a correction learned with α₀ held there compensates for it.
+  loop.rbf.neo_hookean_tail = true;
+  loop.rbf.mass_damping = true;
 }
 
 void RecipeOptions::validate() const {
@@ -544,6 +549,8 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     std::string label = "candidate " + to_string(kind);
     if (iteration >= 0) // append, not " " + to_string(): GCC 12 warns -Wrestrict on that wrongly
       label.append(" ").append(std::to_string(iteration));
+    if (c.correction && c.correction->mass_damping() != 0) // the damping it learned
+      label.append(format(" (Δα₀ %+.3g 1/s)", c.correction->mass_damping()));
     say(callbacks,
         label
             + (c.completed ? format(": validation error rms %.4f %%, max %.4f %%",

@@ -381,7 +381,7 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
       p.neo_hookean = x.segment<2>(m_neo_hookean);
   }
   if (m_damping > 0) {
-    const auto v = x.tail(m_damping);
+    const auto v = x.segment(m_elastic, m_damping);
     p.damping_weights = v.head(m);
     if (m_options.damping_polynomial) {
       p.damping_slopes = v.segment<3>(m);
@@ -391,6 +391,8 @@ material::RbfCorrection RbfDesign::correction(ConstRef<VecX> x) const {
     }
     p.damping_floor = m_options.damping_floor;
   }
+  if (m_options.mass_damping)
+    p.mass_damping = x[mass_damping_unknown()];
   return material::RbfCorrection(std::move(p));
 }
 
@@ -407,7 +409,8 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
       = !p.damping_slopes.isZero(0) || p.damping_constant != 0 || !p.damping_quadratic.isZero(0);
   const bool has_damping = p.damping_weights.size() > 0 || has_damping_tail;
   if ((has_tail && !m_options.elastic_polynomial) || (!p.quadratic.isZero() && m_quadratic < 0)
-      || (!p.neo_hookean.isZero() && m_neo_hookean < 0) || (has_damping && m_damping == 0))
+      || (!p.neo_hookean.isZero() && m_neo_hookean < 0) || (has_damping && m_damping == 0)
+      || (p.mass_damping != 0 && !m_options.mass_damping))
     rbf_fit_error("correction", "it has a term the design does not fit");
   VecX x = VecX::Zero(num_unknowns());
   x.head(m) = p.weights;
@@ -446,6 +449,8 @@ VecX RbfDesign::unknowns(const material::RbfCorrection& c) const {
     } else if (has_damping_tail)
       rbf_fit_error("correction", "it has a damping tail the design does not fit");
   }
+  if (m_options.mass_damping)
+    x[mass_damping_unknown()] = p.mass_damping;
   return x;
 }
 
@@ -461,7 +466,9 @@ MatX stretch_views(ConstRef<MatX> stretches) {
 VecX RbfDesign::regularization_weights() const {
   VecX w(num_unknowns());
   w.head(m_elastic).setConstant(m_options.regularization);
-  w.tail(m_damping).setConstant(m_options.damping_regularization);
+  w.segment(m_elastic, m_damping).setConstant(m_options.damping_regularization);
+  if (m_options.mass_damping)
+    w[mass_damping_unknown()] = m_options.damping_regularization;
   return w;
 }
 

@@ -32,11 +32,8 @@ struct RbfFitOptions {
   /// Also fit the quadratic tail q (material::quadratic_tail_basis; needs elastic_polynomial).
   bool quadratic_tail = true;
   /// Also fit the neo-Hookean tail r (material::neo_hookean_tail_basis; needs elastic_polynomial).
-  /// Off by default: it makes the end-to-end regression case (tests/learn/test_learning_loop.cpp)
-  /// and its distilled network learn worse. Together with a prior on Δα₁ in the forward fit
-  /// (ForwardFitOptions::damping_prior) it keeps the sphere-compression test simulation from
-  /// diverging; alone it does so on the quick mesh but tests above the nominal there
-  /// (docs/learning.md, "Neo-Hookean tail").
+  /// The recipe (learn::RecipeOptions) turns it on together with mass_damping: alone, with the
+  /// fitted nominal's α₀ held fixed, it learned worse (docs/learning.md, "Neo-Hookean tail").
   bool neo_hookean_tail = false;
   /// Fit the stiffness-damping RBF Δα₁(σ) (only the stress reconstruction can: it needs the
   /// elements' damping forces, which principal stress samples do not carry).
@@ -59,6 +56,11 @@ struct RbfFitOptions {
   double smoothness = 0;
   /// Floor of Δα₁ written into the correction (material::RbfCorrection::damping_floor) [s].
   double damping_floor = -std::numeric_limits<double>::infinity();
+  /// Also fit Δα₀ (material::Correction::mass_damping), one unknown after the others: a constant
+  /// change of the nominal's mass damping, learned with the correction. Only fits that see nodal
+  /// forces or motions (CorrectionForceJacobian: the loop's reconstruction, the forward fit) can;
+  /// stress samples carry no mass damping, and fit_rbf_correction leaves it 0.
+  bool mass_damping = false;
   /// Throws InputError("rbf_fit.<field>", ...) for an out-of-range field.
   void validate() const;
 };
@@ -67,7 +69,8 @@ struct RbfFitOptions {
 /// Δα₁. Unknowns x = [x_e; x_d] with x_e = [w (m); a, b, c, q, r (with the elastic tail; c only
 /// without stress_free_rest, q only with quadratic_tail, r only with neo_hookean_tail)] and x_d =
 /// [v (m); a_d (3), a₀ (with the damping tail); d (3) (with damping_quadratic_tail)] (only when
-/// fit_damping), in the notation of material::RbfCorrection (before Δα₁'s floor):
+/// fit_damping), then Δα₀ (only with mass_damping), in the notation of material::RbfCorrection
+/// (before Δα₁'s floor):
 ///   N(σ) = A(σ) x_e,   row k of A = [φ_i(y_k) − r_i …, y_k1 − 1, y_k2 + y_k3 − 2, 1, t(y_k)ᵀ,
 ///   g(y_k)ᵀ], Δα₁(σ) = d(σ) x_d, d = [φ_i(s) …, (s − 1)ᵀ, 1, ((s − 1)²)ᵀ], s = sort↓ σ,
 /// with r_i = φ_i(1, 1, 1) under stress_free_rest (else 0).
@@ -90,7 +93,9 @@ class RbfDesign {
   /// m (+ 2 or 3 with the tail, + 4 quadratic, or 3 with energy kernels, + 2 neo-Hookean)
   int elastic_unknowns() const { return m_elastic; }
   int damping_unknowns() const { return m_damping; } ///< 0, or m (+ 4 with the tail)
-  int num_unknowns() const { return m_elastic + m_damping; }
+  /// The index of Δα₀ (the last unknown), or −1 without mass_damping.
+  int mass_damping_unknown() const { return m_options.mass_damping ? m_elastic + m_damping : -1; }
+  int num_unknowns() const { return m_elastic + m_damping + (m_options.mass_damping ? 1 : 0); }
   const RbfFitOptions& options() const { return m_options; }
   using OutputGradient = Eigen::Matrix<double, 9, Eigen::Dynamic>;
   /// A(σ) into `out` (3 × elastic_unknowns()), for stretches in any order. No allocation.

@@ -38,6 +38,12 @@ class Correction {
   /// learned damping is linear in Δα₁ and damps every deformation mode, not only the stretch
   /// rates. Default: none.
   virtual double stiffness_damping(const Vec3& /*stretches*/) const { return 0; }
+  /// Δα₀ [1/s]: a constant change of the Rayleigh mass-damping coefficient. The element's mass
+  /// damping becomes −(α₀ + Δα₀)⁺ M_e v_e. A nominal whose α₀ was fitted without the correction
+  /// may have absorbed an elastic misfit into α₀; learning Δα₀ with the correction lets it go
+  /// back (docs/learning_recipe.md, "The nominal's damping, learned with the correction").
+  /// Default: none.
+  virtual double mass_damping() const { return 0; }
   virtual std::unique_ptr<Correction> clone() const = 0;
 };
 
@@ -47,6 +53,11 @@ class Correction {
 inline double corrected_stiffness_damping(
     double alpha1, const Correction* correction, const Vec3& stretches) {
   return correction ? std::max(0.0, alpha1 + correction->stiffness_damping(stretches)) : alpha1;
+}
+
+/// An element's mass-damping coefficient with a correction: α₀ + Δα₀, kept ≥ 0 as α₁ + Δα₁ is.
+inline double corrected_mass_damping(double alpha0, const Correction* correction) {
+  return correction ? std::max(0.0, alpha0 + correction->mass_damping()) : alpha0;
 }
 
 } // namespace elastolearn::material

@@ -142,6 +142,8 @@ class NnCorrection final : public Correction {
       Mat3& d_stretch_rates) const override;
   std::unique_ptr<Correction> clone() const override;
   bool depends_on_rates() const override { return m_p.kind == NnKind::Stress; }
+  /// Δα₀ of `damping` (0 without one).
+  double mass_damping() const override { return m_p.damping ? m_p.damping->mass_damping() : 0; }
   /// Δα₁(σ) of `damping` (0 without one).
   double stiffness_damping(const Vec3& stretches) const override {
     return m_p.damping ? m_p.damping->stiffness_damping(stretches) : 0;

@@ -129,6 +129,7 @@ RbfCorrection::RbfCorrection(Parameters p)
   finite("damping_weights", m_p.damping_weights.allFinite());
   finite("damping_slopes", m_p.damping_slopes.allFinite());
   finite("damping_constant", std::isfinite(m_p.damping_constant));
+  finite("mass_damping", std::isfinite(m_p.mass_damping));
   finite("damping_quadratic", m_p.damping_quadratic.allFinite());
   if (std::isnan(m_p.damping_floor) || m_p.damping_floor == std::numeric_limits<double>::infinity())
     rbf_correction_error("damping_floor", "must be a number or −infinity");
@@ -387,7 +388,8 @@ Vec3 RbfCorrection::elastic_correction(const Vec3& stretches) const {
 
 bool RbfCorrection::has_damping() const {
   return m_p.damping_weights.size() > 0 || !m_p.damping_slopes.isZero(0)
-      || m_p.damping_constant != 0 || !m_p.damping_quadratic.isZero(0) || m_p.damping_floor > 0;
+      || m_p.damping_constant != 0 || !m_p.damping_quadratic.isZero(0) || m_p.damping_floor > 0
+      || m_p.mass_damping != 0;
 }
 
 bool RbfCorrection::has_elastic_part() const {
@@ -438,6 +440,7 @@ RbfCorrection blend(const RbfCorrection& a, const RbfCorrection* b, double t) {
   p.damping_slopes = (1 - t) * p.damping_slopes + t * q.damping_slopes;
   p.damping_constant = (1 - t) * p.damping_constant + t * q.damping_constant;
   p.damping_quadratic = (1 - t) * p.damping_quadratic + t * q.damping_quadratic;
+  p.mass_damping = (1 - t) * p.mass_damping + t * q.mass_damping;
   return RbfCorrection(std::move(p));
 }
 

@@ -107,6 +107,8 @@ class RbfCorrection final : public Correction {
     /// Δα₁ is clamped below at this value [s] when evaluated: set it to −α₁ of the nominal
     /// model so that the total stiffness damping never turns negative (energy would grow).
     double damping_floor = -std::numeric_limits<double>::infinity();
+    /// Δα₀ [1/s] (Correction::mass_damping): a constant change of the nominal's mass damping.
+    double mass_damping = 0;
     double epsilon = 1e-3; ///< kernel smoothing ε [-] (≥ 0)
     /// The kernels as an energy (energy_kernel_gradient): N = ∇_σ ΔΨ with
     /// ΔΨ = Σ_i w_i S_i(σ) + the tails' energies, instead of N_k = Σ_i w_i φ_i(y_k). Then ∂N/∂σ is
@@ -135,6 +137,7 @@ class RbfCorrection final : public Correction {
 
   /// Δα₁(σ) (its gradient is not needed: the Jacobian treats α₁ as constant, as for Rayleigh).
   double stiffness_damping(const Vec3& stretches) const override;
+  double mass_damping() const override { return m_p.mass_damping; }
   bool depends_on_rates() const override { return false; }
 
   /// N(σ) [Pa], the same as correction(stretches, ·).
@@ -142,7 +145,7 @@ class RbfCorrection final : public Correction {
   /// ΔΨ(σ) [J/m³] up to a constant, whose gradient is N; only for energy_kernels (throws
   /// InputError otherwise).
   double elastic_energy(const Vec3& stretches) const;
-  /// True if Δα₁ is not identically zero.
+  /// True if Δα₁ is not identically zero or Δα₀ ≠ 0.
   bool has_damping() const;
   /// True if N is not identically zero (a weight, slope, constant, quadratic or neo-Hookean term ≠
   /// 0).
