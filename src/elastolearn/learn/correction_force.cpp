@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
+#include <elastolearn/fem/mass.hpp>
 #include <elastolearn/fem/tet_element.hpp>
 #include <elastolearn/learn/correction_force.hpp>
 #include <elastolearn/learn/element_force_operator.hpp>
@@ -44,17 +45,6 @@ material::DampingTangent nominal_damping_tangent(const ReconstructionMesh& mesh)
   return material::damping_tangent_of(mesh.nominal.damping.get());
 }
 
-/// Lumped mass of every dof (flat 3n) [kg]: a quarter of each element's ρ V at its vertices, the
-/// mass the mass damping scales (fem::ElasticForce with MassType::Lumped).
-VecX lumped_dof_masses(const ReconstructionMesh& mesh) {
-  VecX masses = VecX::Zero(3 * Eigen::Index(mesh.num_vertices));
-  for (int e = 0; e < mesh.num_tets(); ++e)
-    for (int a = 0; a < 4; ++a)
-      masses.segment<3>(3 * mesh.tets(e, a)).array()
-          += mesh.nominal.density * mesh.rest[e].volume / 4.0;
-  return masses;
-}
-
 constexpr int k_jacobian_batch = 512; ///< elements per batch of CorrectionForceJacobian
 
 } // namespace
@@ -72,7 +62,8 @@ CorrectionForceJacobian::CorrectionForceJacobian(
     correction_force_error(
         "nominal", "fitting the damping correction needs the nominal elastic model");
   if (design.mass_damping_unknown() >= 0) {
-    const VecX masses = lumped_dof_masses(mesh);
+    const VecX masses = fem::lumped_dof_masses(
+        fem::lumped_vertex_masses(mesh.tets, mesh.rest, mesh.num_vertices, mesh.nominal.density));
     m_free_dofs = dofs.free_dofs();
     m_free_masses.resize(static_cast<Eigen::Index>(m_free_dofs.size()));
     for (size_t i = 0; i < m_free_dofs.size(); ++i)
