@@ -9,6 +9,7 @@
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/sim/linear_solver.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -282,15 +283,25 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
     return material_stability(
         *motions.front().scene.material.elastic, &c, options.stability_stretches);
   };
+  // A trial's Δα₀ is kept ≥ −α₀ of the nominal (at rest): below, the simulation clamps the mass
+  // damping at 0 and Δα₀'s column −M v no longer describes what a step changes.
+  const int mass = design.mass_damping_unknown();
+  const auto& damping = motions.front().scene.material.damping;
+  const double mass_floor = damping ? -damping->coefficients(1.0).alpha0 : 0.0;
+  const auto trial_at = [&](double fraction, const VecX& step) {
+    trial_unknowns = result.unknowns + fraction * step;
+    if (mass >= 0)
+      trial_unknowns[mass] = std::max(trial_unknowns[mass], mass_floor);
+  };
   problem.evaluate = [&](const VecX& step) {
-    trial_unknowns = result.unknowns + step;
+    trial_at(1.0, step);
     if (options.stability_stretches.rows() > 0) {
       // A step to an unstable material is shortened along its direction first: the check costs
       // no simulation, so a trial is spent on a simulated step whenever a shorter one is stable
       // (rejecting it instead would cost a whole trial and only grow μ).
       StabilityReport stability = stability_of(trial_unknowns);
       for (int halving = 1; !stability.stable() && halving <= kStabilityStepHalvings; ++halving) {
-        trial_unknowns = result.unknowns + std::ldexp(1.0, -halving) * step;
+        trial_at(std::ldexp(1.0, -halving), step);
         stability = stability_of(trial_unknowns);
       }
       if (!stability.stable()) {

@@ -49,7 +49,8 @@ RecipeOptions::RecipeOptions() {
   loop.rbf.smoothness = 1e-2;
   // The neo-Hookean tail and Δα₀ together (docs/learning_recipe.md, "The nominal's damping,
   // learned with the correction"): the parameter fit's α₀ absorbs part of the corotated
-  // nominal's elastic misfit, and a correction learned with α₀ held there compensates for it.
+  // nominal's elastic misfit, and a correction learned with α₀ held there compensates for it;
+  // learn_material applies both only where the fitted α₀ is positive.
   loop.rbf.neo_hookean_tail = true;
   loop.rbf.mass_damping = true;
 }
@@ -518,6 +519,16 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
           options.loop.stretch_samples, callbacks.loop.progress);
   LearningOptions loop_options = options.loop;
   loop_options.forward_fit.stability_stretches = reachable;
+  // Δα₀ gives back mass damping the parameter fit put into the nominal, with the neo-Hookean
+  // tail to carry the elasticity that damping stood in for (docs/learning_recipe.md, "The
+  // nominal's damping, learned with the correction"). With α₀ = 0 there is none to give back:
+  // a negative Δα₀ is clamped away in the simulation (α₀ + Δα₀ ≥ 0) while the fits' linear
+  // column still counts it, and the tail alone learned worse as often as better, so the
+  // correction is learned as before.
+  if (!(result.parameter_fit.fitted.alpha0 > 0)) {
+    loop_options.rbf.mass_damping = false;
+    loop_options.rbf.neo_hookean_tail = false;
+  }
   if (!run_learning(split.training, loop_options, result.loop, callbacks.loop)) {
     result.interrupted = true;
     return result;
@@ -528,7 +539,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // The unknowns the loop's design fitted for an RBF correction (a network takes its teacher's).
   const auto fitted_unknowns = [&](const material::Correction* correction) {
     const auto* rbf = dynamic_cast<const material::RbfCorrection*>(correction);
-    return rbf ? RbfDesign(rbf->parameters().centres, options.loop.rbf, rbf->parameters().trusted)
+    return rbf ? RbfDesign(rbf->parameters().centres, loop_options.rbf, rbf->parameters().trusted)
                      .num_unknowns()
                : 0;
   };

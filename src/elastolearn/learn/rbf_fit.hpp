@@ -32,8 +32,9 @@ struct RbfFitOptions {
   /// Also fit the quadratic tail q (material::quadratic_tail_basis; needs elastic_polynomial).
   bool quadratic_tail = true;
   /// Also fit the neo-Hookean tail r (material::neo_hookean_tail_basis; needs elastic_polynomial).
-  /// The recipe (learn::RecipeOptions) turns it on together with mass_damping: alone, with the
-  /// fitted nominal's α₀ held fixed, it learned worse (docs/learning.md, "Neo-Hookean tail").
+  /// The recipe (learn::RecipeOptions) turns it on together with mass_damping where the fitted α₀
+  /// is positive: alone, with α₀ held fixed, it learned worse (docs/learning.md, "Neo-Hookean
+  /// tail").
   bool neo_hookean_tail = false;
   /// Fit the stiffness-damping RBF Δα₁(σ) (only the stress reconstruction can: it needs the
   /// elements' damping forces, which principal stress samples do not carry).
