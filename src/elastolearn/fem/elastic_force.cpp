@@ -85,7 +85,7 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
       const material::ElementStress stress
           = material::element_stress(element, c.frame.stretches, rates);
       c.stress = stress.corrected();
-      c.alpha0 = stress.alpha.alpha0;
+      c.alpha0 = stress.mass_damping;
       c.has_damping = stress.has_damping();
       if (c.has_damping)
         c.damping = material::damping_tangent(c.frame, stress.damped(), m_damping_tangent);

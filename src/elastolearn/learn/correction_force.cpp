@@ -158,9 +158,7 @@ VecX correction_force(const ReconstructionMesh& mesh, const material::Correction
       auto force = Eigen::Map<Eigen::Matrix<double, 3, 4>>(element_forces[e].data());
       force.noalias() = -mesh.rest[e].volume * P * mesh.rest[e].gradients;
       // Δα₀ as applied (kept α₀ + Δα₀ ≥ 0) on the lumped mass, as fem::ElasticForce damps it.
-      const material::ElementMaterial nominal = element_material(mesh, nullptr, e);
-      const double alpha0_change = stress.alpha.alpha0
-          - (nominal.damping ? nominal.damping->coefficients(s.frame.stretches[0]).alpha0 : 0.0);
+      const double alpha0_change = stress.mass_damping - stress.alpha.alpha0;
       if (alpha0_change != 0)
         force -= alpha0_change * (mesh.nominal.density * mesh.rest[e].volume / 4.0)
             * fem::gather_tet(v, mesh.tets.row(e).transpose());

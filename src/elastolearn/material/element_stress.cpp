@@ -19,7 +19,7 @@ ElementStress element_stress(
   out.nominal = nominal;
   out.has_correction = correction != nullptr;
   out.alpha = alpha;
-  out.alpha.alpha0 = corrected_mass_damping(alpha.alpha0, correction);
+  out.mass_damping = corrected_mass_damping(alpha.alpha0, correction);
   if (material.stiffness_scale != 1.0) {
     out.nominal.stress *= material.stiffness_scale;
     out.nominal.d_stretches *= material.stiffness_scale;

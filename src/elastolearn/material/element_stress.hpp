@@ -52,9 +52,10 @@ struct ElementStress {
   /// tangent of a rate-dependent N would blow up where σᵢ ≈ σⱼ but ḟᵢ ≠ ḟⱼ). Zero if nothing
   /// damps it (has_damping() false).
   StressPair correction_elastic { Vec3 {}, Mat3 {} };
-  /// The damping model's α₀ [1/s], α₁ [s] at σ₀ (0 without one), α₀ with the correction's Δα₀
-  /// (corrected_mass_damping): the mass damping is the element's whole, not split in parts.
-  RayleighCoefficients alpha;
+  RayleighCoefficients alpha; ///< the damping model's α₀ [1/s], α₁ [s] at σ₀ (0 without one)
+  /// The mass-damping coefficient applied: (α₀ + Δα₀)⁺ with the correction's Δα₀
+  /// (corrected_mass_damping), α₀ without one [1/s].
+  double mass_damping = 0;
   double alpha1_change = 0; ///< Δα₁ as applied: (α₁ + Δα₁)⁺ − α₁ ≥ −α₁ [s]
 
   /// s P̂ + N, ∂(s P̂ + N)/∂σ and ∂N/∂ḟ: the corrected stress of Eq. 1.
