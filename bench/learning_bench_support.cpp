@@ -122,10 +122,11 @@ void print_iteration(const learn::IterationRecord& record, double size, const ch
         step->centres, f.seconds());
   else if (const auto* t = learn::stages_of(record))
     std::printf(
-        "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N, step kept %.3g; "
+        "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N, %d cuts, step kept "
+        "%.3g; "
         "forward %.1f s, constrained %.1f s, space-time %.1f s (%d GN), reconstruction %.1f s\n",
         t->modes, t->centres, t->control_force_rms, t->correction_misfit, t->correction_target,
-        t->step_kept, f.seconds(), t->seconds_constrained, t->seconds_space_time,
+        t->stability_cuts, t->step_kept, f.seconds(), t->seconds_constrained, t->seconds_space_time,
         t->space_time_iterations, t->seconds_reconstruction);
   else if (!f.completed())
     std::printf(" -> this correction's forward simulation DIVERGED (%.1f s: %s); %s\n", f.seconds(),

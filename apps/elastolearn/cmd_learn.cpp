@@ -78,6 +78,9 @@ void print_loop_iteration(const elastolearn::learn::LoopRecord& r, double diagon
         t->control_force_rms, t->modes, t->centres, f.seconds() + t->seconds(), f.seconds(),
         t->seconds_constrained, t->seconds_space_time, t->space_time_iterations,
         t->seconds_reconstruction);
+    if (t->stability_cuts > 0)
+      std::printf(
+          "      the reconstruction was held stable by %d stability cuts\n", t->stability_cuts);
     if (t->step_kept < 1)
       std::printf("      the reconstructed correction is unstable within the training stretches "
                   "(smallest tangent eigenvalue %.2f × the nominal's): %s\n",

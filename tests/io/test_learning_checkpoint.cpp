@@ -169,6 +169,7 @@ std::vector<learn::IterationRecord> every_kind_of_step() {
   t.correction_target = 0.75;
   t.stability = -0.125;
   t.step_kept = 0.5;
+  t.stability_cuts = 12;
   t.seconds_pod = 0.5;
   t.seconds_constrained = 1.5;
   t.seconds_space_time = 2.5;
@@ -226,6 +227,7 @@ void expect_same_record(const learn::IterationRecord& a, const learn::IterationR
     EXPECT_EQ(ta->correction_target, tb->correction_target);
     EXPECT_EQ(ta->stability, tb->stability);
     EXPECT_EQ(ta->step_kept, tb->step_kept);
+    EXPECT_EQ(ta->stability_cuts, tb->stability_cuts);
     EXPECT_EQ(ta->seconds_pod, tb->seconds_pod);
     EXPECT_EQ(ta->seconds_constrained, tb->seconds_constrained);
     EXPECT_EQ(ta->seconds_space_time, tb->seconds_space_time);
@@ -313,6 +315,7 @@ TEST(LearningCheckpoint, ReadsTheFlatRecordsOfVersion2) {
   ASSERT_TRUE(t);
   EXPECT_EQ(t->modes, 20);
   EXPECT_EQ(t->step_kept, 0.5);
+  EXPECT_EQ(t->stability_cuts, 0); // older checkpoints have none
   EXPECT_EQ(t->seconds_reconstruction, 3.5);
   EXPECT_EQ(learn::forward_of(read.history[0]).error().worst_vertex, 34);
 }

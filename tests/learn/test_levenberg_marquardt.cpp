@@ -4,6 +4,7 @@
 // each of its reasons.
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/levenberg_marquardt.hpp>
+#include <elastolearn/learn/stability_cuts.hpp>
 
 #include <gtest/gtest.h>
 
@@ -105,6 +106,25 @@ INSTANTIATE_TEST_SUITE_P(LevenbergMarquardt, BothScalings,
     ::testing::Values(DampingScaling::marquardt, DampingScaling::jacobi), [](const auto& info) {
       return info.param == DampingScaling::marquardt ? "marquardt" : "jacobi";
     });
+
+TEST(LevenbergMarquardt, AStepSolverHoldsEveryTrialToItsConditions) {
+  // Rosenbrock subject to x₁ ≤ 0.5 through solve_step (the forward fit's stability cuts): the
+  // constrained minimum of (1 − x₁)² + 100 (x₂ − x₁²)² is at (0.5, 0.25), on the boundary, and
+  // no trial point leaves the feasible side.
+  LeastSquares ls = rosenbrock();
+  LevenbergMarquardtProblem problem = ls.problem();
+  problem.solve_step = [&](const RegularisedNormalEquations& equations, const VecX& rhs) {
+    LinearInequalities bound; // −(x₁ + δ₁) ≥ −0.5
+    bound.rows = Eigen::RowVector2d(-1, 0);
+    bound.bounds = VecX::Constant(1, -0.5 + ls.x[0]);
+    return solve_with_inequalities(equations, rhs, bound);
+  };
+  levenberg_marquardt(problem, { .function_tolerance = 1e-14 });
+  EXPECT_NEAR(ls.x[0], 0.5, 1e-7);
+  EXPECT_NEAR(ls.x[1], 0.25, 1e-6);
+  for (const VecX& trial : ls.tried)
+    EXPECT_LE(trial[0], 0.5 + 1e-9);
+}
 
 TEST(LevenbergMarquardt, RejectsAWorseOrFailedStepAndRetriesShorterFromTheSamePoint) {
   // μ = 10⁻³: the first step is nearly the Gauss–Newton step to x ≈ −3.5, which raises the cost;

@@ -86,6 +86,7 @@ learn::SpaceTimeStages read_stages(
   t.correction_target = o.number("correction_target");
   t.stability = flat ? o.number("stability", 0.0) : o.number("stability");
   t.step_kept = flat ? o.number("step_kept", 1.0) : o.number("step_kept");
+  t.stability_cuts = o.integer("stability_cuts", 0); // absent before the cuts: none
   t.seconds_pod = seconds.number("pod");
   t.seconds_constrained = seconds.number("constrained");
   t.seconds_space_time = seconds.number("space_time");
@@ -147,7 +148,8 @@ nlohmann::json stages_json(const learn::SpaceTimeStages& t) {
     { "space_time_objective", t.space_time_objective },
     { "space_time_iterations", t.space_time_iterations }, { "centres", t.centres },
     { "correction_misfit", t.correction_misfit }, { "correction_target", t.correction_target },
-    { "stability", t.stability }, { "step_kept", t.step_kept } };
+    { "stability", t.stability }, { "step_kept", t.step_kept },
+    { "stability_cuts", t.stability_cuts } };
 }
 
 /// The names of LoopNext's alternatives (a loop record's "next").

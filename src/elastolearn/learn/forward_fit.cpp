@@ -2,6 +2,7 @@
 #include <elastolearn/learn/forward_fit.hpp>
 #include <elastolearn/learn/levenberg_marquardt.hpp>
 #include <elastolearn/learn/material_stability.hpp>
+#include <elastolearn/learn/stability_cuts.hpp>
 #include <elastolearn/learn/trajectory_physics.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 #include <elastolearn/sim/simulator.hpp>
@@ -293,17 +294,37 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
     if (mass >= 0)
       trial_unknowns[mass] = std::max(trial_unknowns[mass], mass_floor);
   };
+  // The longest fraction 2⁻ᵏ (k ≤ kStabilityStepHalvings) of `step` whose material is stable
+  // into trial_unknowns, and its stability (unstable if no fraction is). A step to an unstable
+  // material is shortened along its direction first: the check costs no simulation, so a trial
+  // is spent on a simulated step whenever a shorter one is stable (rejecting it instead would
+  // cost a whole trial and only grow μ).
+  const auto shorten = [&](const VecX& step) {
+    trial_at(1.0, step);
+    StabilityReport stability = stability_of(trial_unknowns);
+    for (int halving = 1; !stability.stable() && halving <= kStabilityStepHalvings; ++halving) {
+      trial_at(std::ldexp(1.0, -halving), step);
+      stability = stability_of(trial_unknowns);
+    }
+    return stability;
+  };
+  // Where no fraction of the step is stable, the step solved subject to stability cuts instead
+  // (stability_cuts.hpp), which would otherwise be rejected unsimulated. Only there: a cut step
+  // turns along the stability boundary, and cutting every step that shortening serves measured
+  // worse on most named cases (docs/learning_recipe.md, "Stability cuts").
+  if (options.stability_cuts && options.stability_stretches.rows() > 0)
+    problem.solve_step = [&](const RegularisedNormalEquations& equations, const VecX& rhs) {
+      VecX step = equations.solve(rhs);
+      if (!shorten(step).stable())
+        step = stable_least_squares(equations, rhs, design, *motions.front().scene.material.elastic,
+            options.stability_stretches, result.unknowns)
+                   .x;
+      return step;
+    };
   problem.evaluate = [&](const VecX& step) {
     trial_at(1.0, step);
     if (options.stability_stretches.rows() > 0) {
-      // A step to an unstable material is shortened along its direction first: the check costs
-      // no simulation, so a trial is spent on a simulated step whenever a shorter one is stable
-      // (rejecting it instead would cost a whole trial and only grow μ).
-      StabilityReport stability = stability_of(trial_unknowns);
-      for (int halving = 1; !stability.stable() && halving <= kStabilityStepHalvings; ++halving) {
-        trial_at(std::ldexp(1.0, -halving), step);
-        stability = stability_of(trial_unknowns);
-      }
+      const StabilityReport stability = shorten(step);
       if (!stability.stable()) {
         trial = {};
         trial.unstable = true;

@@ -101,6 +101,11 @@ struct ForwardFitOptions {
   /// the samples of the best correction's own runs added (the recipe sets the stretches its
   /// validation requires stability at).
   MatX stability_stretches;
+  /// A step none of whose fractions is stable is solved again subject to stability cuts at
+  /// stability_stretches (stability_cuts.hpp) instead of being rejected unsimulated: it keeps
+  /// the step's direction wherever the data ask and turns only where a state would lose its
+  /// stiffness.
+  bool stability_cuts = true;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;
 };

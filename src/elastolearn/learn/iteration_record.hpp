@@ -74,6 +74,9 @@ struct SpaceTimeStages {
   /// The fraction of the reconstructed correction kept to stay stable (1: all; 0: none, the
   /// next iteration simulates the nominal).
   double step_kept = 1;
+  /// Conditions the reconstruction was held to so that it stays stable (stability_cuts.hpp;
+  /// 0: it was stable as fitted).
+  int stability_cuts = 0;
   double seconds_pod = 0, seconds_constrained = 0, seconds_space_time = 0,
          seconds_reconstruction = 0;
   double seconds() const {

@@ -223,6 +223,7 @@ std::optional<TrajectoryStagesResult> trajectory_stages(std::span<const Motion> 
   record.correction_target = reconstructed.target;
   record.stability = reconstructed.stability;
   record.step_kept = reconstructed.step_kept;
+  record.stability_cuts = static_cast<int>(reconstructed.stability_cuts);
   out.correction = std::move(reconstructed.correction);
   record.seconds_reconstruction += seconds_since(t0);
   return out;

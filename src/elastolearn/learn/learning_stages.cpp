@@ -261,14 +261,22 @@ Reconstruction reconstruct_correction(std::span<const ReconstructionMesh> meshes
   const MatX stretches = trajectory_stretches(meshes, trajectories, options);
   const RbfDesign design(rbf_centres(stretches, options, seed), options.rbf,
       trusted_interval(stretches, options.rbf, *nominal.elastic));
+  std::vector<MatX> parts { stability_samples(*nominal.elastic, stretches) };
+  if (options.stability_cuts && options.forward_fit.stability_stretches.rows() > 0)
+    parts.push_back(options.forward_fit.stability_stretches);
+  const MatX samples = stacked_rows(parts, 3);
+  const StabilityRequirement requirement { *nominal.elastic, samples };
   const StressReconstructionResult reconstructed
-      = reconstruct_rbf_correction(blocks, design, reconstruction);
+      = reconstruct_rbf_correction(blocks, design, reconstruction,
+          options.stability_cuts && reconstruction.method == ReconstructionMethod::normal_equations
+              ? &requirement
+              : nullptr);
   Reconstruction out;
   out.centres = design.num_centres();
   out.misfit = reconstructed.misfit.rms_residual;
   out.target = reconstructed.misfit.rms_target;
-  stable_fraction(
-      reconstructed.correction, nominal, stability_samples(*nominal.elastic, stretches), out);
+  out.stability_cuts = reconstructed.stability_cuts;
+  stable_fraction(reconstructed.correction, nominal, samples, out);
   return out;
 }
 

@@ -107,6 +107,7 @@ struct Reconstruction {
   double target = 0; ///< RMS of the targets [N]
   double stability = 0; ///< min_relative_eigenvalue of the whole reconstructed correction
   double step_kept = 1; ///< the fraction of it kept to stay stable (0: none)
+  Eigen::Index stability_cuts = 0; ///< conditions its fit was held to (stability_cuts.hpp)
 };
 
 /// Stage 6: centres by k-means over every motion's optimised stretches (seeded with `seed`), one

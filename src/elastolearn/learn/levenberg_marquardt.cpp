@@ -22,9 +22,11 @@ constexpr double kInactiveDiagonal = 1e-14;
 /// The normal equations of one iteration and the damped steps from them.
 class DampedSystem {
   public:
-  DampedSystem(NormalEquations equations, DampingScaling scaling)
+  DampedSystem(
+      NormalEquations equations, DampingScaling scaling, const LevenbergMarquardtProblem& problem)
       : m_equations(std::move(equations))
-      , m_scaling(scaling) {
+      , m_scaling(scaling)
+      , m_problem(problem) {
     const MatX& h = m_equations.hessian;
     ELASTOLEARN_CHECK(
         h.rows() > 0 && h.rows() == h.cols() && m_equations.gradient.size() == h.rows(),
@@ -71,12 +73,15 @@ class DampedSystem {
 
   VecX jacobi_step(double mu) const {
     const Eigen::Index n = m_equations.hessian.rows();
-    return solve_regularised_normal_equations(
-        m_equations.hessian, -m_equations.gradient, VecX::Constant(n, mu), m_equations.samples);
+    const RegularisedNormalEquations damped(
+        m_equations.hessian, VecX::Constant(n, mu), m_equations.samples);
+    const VecX rhs = -m_equations.gradient;
+    return m_problem.solve_step ? m_problem.solve_step(damped, rhs) : VecX(damped.solve(rhs));
   }
 
   NormalEquations m_equations;
   DampingScaling m_scaling;
+  const LevenbergMarquardtProblem& m_problem;
   std::vector<bool> m_active; ///< marquardt: unknowns that move the residuals
   bool m_degenerate = false;
 };
@@ -132,7 +137,7 @@ LevenbergMarquardtSummary levenberg_marquardt(
     if (!equations)
       return end(LevenbergMarquardtStop::stopped);
     ++summary.iterations;
-    const DampedSystem system(std::move(*equations), options.scaling);
+    const DampedSystem system(std::move(*equations), options.scaling, problem);
     if (system.degenerate())
       return end(LevenbergMarquardtStop::degenerate);
     summary.rejections = 0;

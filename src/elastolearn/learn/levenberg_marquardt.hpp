@@ -8,6 +8,7 @@
 /// from the same equations is tried. The problem owns the point: the driver hands it steps δ and
 /// tells it which trial to keep. In the style of Ceres's Solver::Options / Summary.
 #include <elastolearn/core/types.hpp>
+#include <elastolearn/learn/rbf_fit.hpp>
 
 #include <functional>
 #include <limits>
@@ -92,6 +93,9 @@ struct LevenbergMarquardtProblem {
   /// Called after each trial step (after `accept` for an accepted one); returns false to end
   /// the solve there. Optional.
   std::function<bool(const LevenbergMarquardtStep& step)> on_step;
+  /// The jacobi scaling's step from its damped, factorised equations Q δ = rhs (−g), e.g.
+  /// subject to conditions on the trial point (stable_least_squares). Optional: Q⁻¹ rhs.
+  std::function<VecX(const RegularisedNormalEquations& equations, const VecX& rhs)> solve_step;
 };
 
 /// Why the solve ended.

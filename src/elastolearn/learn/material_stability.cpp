@@ -31,6 +31,18 @@ material::PrincipalFrame frame_of(const Vec3& stretches) {
 
 } // namespace
 
+double relative_stability(const material::ElasticModel& nominal,
+    const material::Correction* correction, const Vec3& stretches) {
+  const material::PrincipalFrame frame = frame_of(stretches);
+  const double reference
+      = std::max(smallest_eigenvalue(material::principal_tangent(nominal, frame, false)),
+          std::numeric_limits<double>::min());
+  const material::CorrectedStress c
+      = material::corrected_principal_stress(nominal, correction, stretches, Vec3::Zero());
+  return smallest_eigenvalue(material::principal_tangent(frame, c.stress, c.d_stretches, false))
+      / reference;
+}
+
 StabilityReport material_stability(const material::ElasticModel& nominal,
     const material::Correction* correction, ConstRef<MatX> stretches) {
   struct Partial {
@@ -43,18 +55,11 @@ StabilityReport material_stability(const material::ElasticModel& nominal,
       [&](const tbb::blocked_range<Eigen::Index>& range, Partial p) {
         for (Eigen::Index i = range.begin(); i < range.end(); ++i) {
           const Vec3 s = stretches.row(i).transpose();
-          const material::PrincipalFrame frame = frame_of(s);
-          const double reference
-              = std::max(smallest_eigenvalue(material::principal_tangent(nominal, frame, false)),
-                  std::numeric_limits<double>::min());
-          const material::CorrectedStress c
-              = material::corrected_principal_stress(nominal, correction, s, Vec3::Zero());
-          const double lowest = smallest_eigenvalue(
-              material::principal_tangent(frame, c.stress, c.d_stretches, false));
-          if (lowest < 0)
+          const double relative = relative_stability(nominal, correction, s);
+          if (relative < 0)
             ++p.unstable;
-          if (lowest / reference < p.worst) {
-            p.worst = lowest / reference;
+          if (relative < p.worst) {
+            p.worst = relative;
             p.at = s;
           }
         }

@@ -26,6 +26,12 @@ struct StabilityReport {
   bool stable() const { return unstable_samples == 0; }
 };
 
+/// The smallest eigenvalue (stretch block or twist) of nominal + `correction` (null: the
+/// nominal alone) at principal stretches σ, relative to the nominal's smallest there: < 0 where
+/// the corrected material is unstable.
+double relative_stability(const material::ElasticModel& nominal,
+    const material::Correction* correction, const Vec3& stretches);
+
 /// Check `correction` (null: the nominal alone) on top of `nominal` at every row of `stretches`
 /// (N × 3 principal stretches, e.g. collect_stretches of a trajectory). Parallel over samples.
 StabilityReport material_stability(const material::ElasticModel& nominal,

@@ -488,26 +488,35 @@ MatX RbfDesign::smoothness_penalty(ConstRef<MatX> normal) const {
   return penalty;
 }
 
-VecX solve_regularised_normal_equations(
-    MatX normal, ConstRef<VecX> rhs, ConstRef<VecX> regularization, long samples) {
+RegularisedNormalEquations::RegularisedNormalEquations(
+    MatX normal, ConstRef<VecX> regularization, long samples)
+    : m_scale(normal.diagonal().cwiseSqrt()) {
   const Eigen::Index u = normal.rows();
   // Jacobi scaling, then Tikhonov on the scaled unknowns (λ dimensionless).
-  VecX scale = normal.diagonal().cwiseSqrt();
   for (Eigen::Index i = 0; i < u; ++i)
-    if (!(scale[i] > 0))
-      scale[i] = 1; // an unused unknown (e.g. no stretch rate): only λ constrains it
-  normal = scale.cwiseInverse().asDiagonal() * normal * scale.cwiseInverse().asDiagonal();
+    if (!(m_scale[i] > 0))
+      m_scale[i] = 1; // an unused unknown (e.g. no stretch rate): only λ constrains it
+  normal = m_scale.cwiseInverse().asDiagonal() * normal * m_scale.cwiseInverse().asDiagonal();
   normal.diagonal() += regularization;
-  const Eigen::LLT<MatX> llt(normal);
-  if (llt.info() != Eigen::Success)
+  m_llt.compute(normal);
+  if (m_llt.info() != Eigen::Success)
     rbf_fit_error("regularization",
         "the normal equations are singular (" + to_text(samples) + " samples, " + to_text(u)
             + " unknowns); increase the regularisation or give more varied samples");
-  const VecX x = (llt.solve(rhs.cwiseQuotient(scale))).cwiseQuotient(scale);
+}
+
+MatX RegularisedNormalEquations::solve(ConstRef<MatX> rhs) const {
+  const MatX scaled = rhs.array().colwise() / m_scale.array();
+  MatX x = m_llt.solve(scaled).array().colwise() / m_scale.array();
   if (!x.allFinite())
     rbf_fit_error(
         "regularization", "the fit produced non-finite weights; increase the regularisation");
   return x;
+}
+
+VecX solve_regularised_normal_equations(
+    MatX normal, ConstRef<VecX> rhs, ConstRef<VecX> regularization, long samples) {
+  return RegularisedNormalEquations(std::move(normal), regularization, samples).solve(rhs);
 }
 
 RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& samples) {

@@ -6,6 +6,8 @@
 /// stress and to the stiffness-damping correction Δα₁.
 #include <elastolearn/material/rbf_correction.hpp>
 
+#include <Eigen/Cholesky>
+
 #include <limits>
 
 namespace elastolearn::learn {
@@ -210,10 +212,23 @@ RbfFitResult fit_rbf_correction(const RbfDesign& design, const StressSamples& sa
 /// j's three directions): the points the RBF centres should cover, e.g. by k-means.
 MatX stretch_views(ConstRef<MatX> stretches);
 
-/// Solve the normal equations `normal` x = `rhs` (symmetric, full) with Jacobi scaling
-/// S = √diag and Tikhonov λ_i (one per unknown) on the scaled unknowns:
-/// (S⁻¹ N S⁻¹ + diag λ) S x = S⁻¹ rhs.
-/// `samples` is only quoted in the error. Throws InputError if the system is singular.
+/// The normal matrix N (symmetric, full) with Jacobi scaling S = √diag and Tikhonov λ_i (one
+/// per unknown) on the scaled unknowns, factorised once: solve(rhs) is x of
+/// (S⁻¹ N S⁻¹ + diag λ) S x = S⁻¹ rhs, i.e. Q x = rhs with Q = N + S diag(λ) S. `samples` is only
+/// quoted in the error. Throws InputError if the system is singular.
+class RegularisedNormalEquations {
+  public:
+  RegularisedNormalEquations(MatX normal, ConstRef<VecX> regularization, long samples);
+  /// Q⁻¹ rhs (a vector, or each column of a matrix). Throws InputError if not finite.
+  MatX solve(ConstRef<MatX> rhs) const;
+  Eigen::Index size() const { return m_scale.size(); }
+
+  private:
+  VecX m_scale; ///< S
+  Eigen::LLT<MatX> m_llt; ///< of S⁻¹ N S⁻¹ + diag λ
+};
+
+/// RegularisedNormalEquations(normal, regularization, samples).solve(rhs).
 VecX solve_regularised_normal_equations(
     MatX normal, ConstRef<VecX> rhs, ConstRef<VecX> regularization, long samples);
 

@@ -1,6 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
 #include <elastolearn/core/timing.hpp>
+#include <elastolearn/learn/stability_cuts.hpp>
 #include <elastolearn/learn/stress_reconstruction.hpp>
 #include <elastolearn/learn/stress_reconstruction_lsqr.hpp>
 
@@ -139,7 +140,8 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
 }
 
 StressReconstructionResult reconstruct_rbf_correction(std::span<const ReconstructionMotion> motions,
-    const RbfDesign& design, const StressReconstructionOptions& options) {
+    const RbfDesign& design, const StressReconstructionOptions& options,
+    const StabilityRequirement* stability) {
   options.validate();
   if (motions.empty())
     stress_reconstruction_error("motions", "no motion to reconstruct from");
@@ -168,8 +170,13 @@ StressReconstructionResult reconstruct_rbf_correction(std::span<const Reconstruc
 
   const auto solve_start = Clock::now();
   normal += design.smoothness_penalty(normal);
-  VecX x = solve_regularised_normal_equations(
-      std::move(normal), rhs, design.regularization_weights(), samples);
+  const RegularisedNormalEquations equations(
+      std::move(normal), design.regularization_weights(), samples);
+  StableSolve solved { equations.solve(rhs) };
+  if (stability)
+    solved = stable_least_squares(equations, rhs, design, stability->nominal, stability->samples,
+        VecX::Zero(design.num_unknowns()));
+  VecX x = std::move(solved.x);
   material::RbfCorrection correction = design.correction(x);
   const double solve_seconds = seconds_since(solve_start);
 
@@ -178,7 +185,8 @@ StressReconstructionResult reconstruct_rbf_correction(std::span<const Reconstruc
   int rows = 0;
   for (const ReconstructionMotion& motion : motions)
     rows += motion.dofs.num_free();
-  StressReconstructionResult result { std::move(correction), std::move(x), misfit, rows };
+  StressReconstructionResult result { std::move(correction), std::move(x), misfit, solved.cuts,
+    rows };
   result.assembly_seconds = assembly_seconds;
   result.solve_seconds = solve_seconds;
   result.misfit_seconds = seconds_since(misfit_start);

@@ -45,10 +45,18 @@ struct StressReconstructionOptions {
   void validate() const;
 };
 
+/// Where a reconstructed correction must be stable: nominal + correction at every row of
+/// `samples` (principal stretches), held there by stability cuts (stability_cuts.hpp).
+struct StabilityRequirement {
+  const material::ElasticModel& nominal;
+  Eigen::Ref<const MatX> samples;
+};
+
 struct StressReconstructionResult {
   material::RbfCorrection correction; ///< design.correction(unknowns)
   VecX unknowns; ///< x in RbfDesign's layout
   ForceMisfit misfit; ///< of `correction` over the frames used
+  Eigen::Index stability_cuts = 0; ///< conditions the fit was held to (StabilityRequirement)
   int rows_per_frame = 0; ///< free dofs (summed over the motions)
   // lsqr method only:
   int lsqr_max_iterations = 0; ///< most CGLS iterations of any frame
@@ -105,9 +113,13 @@ StressReconstructionResult reconstruct_rbf_correction(const ReconstructionMesh& 
 /// above (its own blocks of frames) and the motions' sums added in order, so that one motion
 /// gives exactly the single-motion result. `misfit` is over all motions' frames together.
 /// options.frame_stride applies to every motion. The lsqr method fits one RBF to every motion's
-/// element-stress samples. Throws InputError as above, and for no motion.
+/// element-stress samples. With `stability` (normal_equations only), the least squares are
+/// solved subject to the stability cuts that hold the correction stable at its samples
+/// (stable_least_squares); the result may still be unstable where the cuts did not converge.
+/// Throws InputError as above, and for no motion.
 StressReconstructionResult reconstruct_rbf_correction(std::span<const ReconstructionMotion> motions,
-    const RbfDesign& design, const StressReconstructionOptions& options = {});
+    const RbfDesign& design, const StressReconstructionOptions& options = {},
+    const StabilityRequirement* stability = nullptr);
 
 /// The misfit of `correction` over every motion's frames 0, stride, 2·stride, …: the RMS over
 /// all of them (each motion's correction_force_misfit weighted by its frames × free vertices;

@@ -144,7 +144,7 @@ StressReconstructionResult reconstruct_rbf_correction_via_lsqr(
   int rows = 0;
   for (const ReconstructionMotion& motion : motions)
     rows += motion.dofs.num_free();
-  StressReconstructionResult result { std::move(fit.correction), std::move(fit.unknowns), misfit,
+  StressReconstructionResult result { std::move(fit.correction), std::move(fit.unknowns), misfit, 0,
     rows };
   result.lsqr_max_iterations = max_iterations;
   result.lsqr_max_relative_error = max_error;
