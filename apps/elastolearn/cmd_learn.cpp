@@ -36,6 +36,7 @@ struct LearnOptions {
   bool linear_tail = false;
   bool no_parameter_fit = false;
   bool no_backtrack = false;
+  bool no_stability_cuts = false;
   std::string network_kind = "auto";
   elastolearn::learn::RecipeOptions recipe;
 };
@@ -141,6 +142,10 @@ void run_learn(const LearnOptions& o) {
   options.fit_parameters = !o.no_parameter_fit;
   if (o.no_backtrack)
     loop.backtrack = false;
+  if (o.no_stability_cuts) {
+    loop.stability_cuts = false;
+    loop.forward_fit.stability_cuts = false;
+  }
   options.network.kind = learn::network_kind_from_name(o.network_kind, "--network-kind");
   options.validate();
 
@@ -311,6 +316,9 @@ void add_learn_command(CLI::App& root) {
   cmd->add_flag("--no-backtrack", o->no_backtrack,
       "run the loop's stages from a correction that is no better than the best (paper §3) "
       "instead of halving it towards the best");
+  cmd->add_flag("--no-stability-cuts", o->no_stability_cuts,
+      "keep a correction stable only by shrinking it (the loop) or shortening and rejecting a "
+      "step (the forward fit), without solving its fit subject to stability cuts");
   cmd->add_option("--modes", l.pod.max_modes, "POD modes r of the space-time optimisation")
       ->capture_default_str();
   cmd->add_option("--pod-stride", l.pod.frame_stride, "use every k-th frame for POD")

@@ -97,7 +97,8 @@ def learn(scene, observations=None, *, clouds=None, output=None, checkpoint=None
 
     options (keyword, the command line's flags with underscores; ``learn_options()`` lists them;
     a flag is a bool): noise (σ [m], None: estimated), validation_fraction, no_parameter_fit,
-    parameter_fit_iterations, max_iterations, patience, free_halvings, no_backtrack, modes,
+    parameter_fit_iterations, max_iterations, patience, free_halvings, no_backtrack,
+    no_stability_cuts, modes,
     pod_stride, full_space, pod_forward_only, kernels, position_weight, space_time_iterations,
     regularization, reconstruction ("normal_equations" | "lsqr"), frame_stride,
     unprojected_reconstruction, full_space_weight, no_damping, linear_tail,

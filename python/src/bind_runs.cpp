@@ -174,6 +174,12 @@ const std::vector<std::pair<std::string, Setter>>& learn_option_table() {
         [](S& s, H v) { s.recipe.loop.free_halvings = value<int>(v, "free_halvings"); } },
     { "no_backtrack",
         [](S& s, H v) { s.recipe.loop.backtrack = !value<bool>(v, "no_backtrack"); } },
+    { "no_stability_cuts",
+        [](S& s, H v) {
+          const bool cuts = !value<bool>(v, "no_stability_cuts");
+          s.recipe.loop.stability_cuts = cuts;
+          s.recipe.loop.forward_fit.stability_cuts = cuts;
+        } },
     { "modes", [](S& s, H v) { s.recipe.loop.pod.max_modes = value<int>(v, "modes"); } },
     { "pod_stride",
         [](S& s, H v) { s.recipe.loop.pod.frame_stride = value<int>(v, "pod_stride"); } },

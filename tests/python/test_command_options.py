@@ -213,7 +213,8 @@ def test_learn_flags_set_what_the_cli_sets(learning_case, cli, tmp_path):
                  linear_tail=True, stress_kernels=True, no_neo_hookean_tail=True,
                  no_mass_damping=True,
                  allow_rest_stress=True, validation_fraction=0.25, frame_stride=2,
-                 smoothness=0.05, no_backtrack=True, forward_fit_tolerance=0.05)
+                 smoothness=0.05, no_backtrack=True, no_stability_cuts=True,
+                 forward_fit_tolerance=0.05)
     r = cli("learn", scene, "--observations", observations, "-o", tmp_path / "cli.json", "-q",
             *cli_flags(flags))
     assert r.returncode == 0, r.stdout + r.stderr

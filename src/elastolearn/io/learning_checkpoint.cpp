@@ -16,7 +16,7 @@ constexpr int k_checkpoint_version = 3;
 /// A checkpoint's options with the fields added since it was written set to the values every run
 /// had before (so that it still resumes under those options): rbf.smoothness 0,
 /// rbf.continuation bounded_softening, rbf.mass_damping false, backtrack false,
-/// forward_fit.function_tolerance 0.
+/// forward_fit.function_tolerance 0, stability_cuts and forward_fit.stability_cuts false.
 nlohmann::json with_former_defaults(nlohmann::json options) {
   const auto fill = [](nlohmann::json& loop) {
     if (!loop.is_object())
@@ -30,9 +30,14 @@ nlohmann::json with_former_defaults(nlohmann::json options) {
     // "patience" marks the loop's object (the recipe's options hold it under "loop").
     if (loop.contains("patience") && !loop.contains("backtrack"))
       loop["backtrack"] = false;
-    if (loop.contains("forward_fit") && loop["forward_fit"].is_object()
-        && !loop["forward_fit"].contains("function_tolerance"))
-      loop["forward_fit"]["function_tolerance"] = 0.0;
+    if (loop.contains("patience") && !loop.contains("stability_cuts"))
+      loop["stability_cuts"] = false;
+    if (loop.contains("forward_fit") && loop["forward_fit"].is_object()) {
+      if (!loop["forward_fit"].contains("function_tolerance"))
+        loop["forward_fit"]["function_tolerance"] = 0.0;
+      if (!loop["forward_fit"].contains("stability_cuts"))
+        loop["forward_fit"]["stability_cuts"] = false;
+    }
   };
   fill(options);
   if (options.is_object() && options.contains("loop"))
@@ -207,6 +212,7 @@ nlohmann::json iteration_record_to_json(const learn::IterationRecord& record) {
 nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
   return { { "max_iterations", o.max_iterations }, { "patience", o.patience },
     { "free_halvings", o.free_halvings }, { "backtrack", o.backtrack },
+    { "stability_cuts", o.stability_cuts },
     { "pod",
         { { "max_modes", o.pod.max_modes }, { "energy_fraction", o.pod.energy_fraction },
             { "first_frame", o.pod.first_frame }, { "frame_count", o.pod.frame_count },
@@ -244,7 +250,8 @@ nlohmann::json learning_options_to_json(const learn::LearningOptions& o) {
         { { "max_iterations", o.forward_fit.max_iterations }, { "damping", o.forward_fit.damping },
             { "damping_prior", o.forward_fit.damping_prior },
             { "elastic_prior", o.forward_fit.elastic_prior },
-            { "function_tolerance", o.forward_fit.function_tolerance } } } };
+            { "function_tolerance", o.forward_fit.function_tolerance },
+            { "stability_cuts", o.forward_fit.stability_cuts } } } };
 }
 
 nlohmann::json recipe_options_to_json(const learn::RecipeOptions& o) {

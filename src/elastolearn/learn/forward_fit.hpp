@@ -104,8 +104,8 @@ struct ForwardFitOptions {
   /// A step none of whose fractions is stable is solved again subject to stability cuts at
   /// stability_stretches (stability_cuts.hpp) instead of being rejected unsimulated: it keeps
   /// the step's direction wherever the data ask and turns only where a state would lose its
-  /// stiffness.
-  bool stability_cuts = true;
+  /// stiffness. The recipe's (RecipeOptions); off by default, as before the cuts.
+  bool stability_cuts = false;
   /// Throws InputError("forward_fit.<field>", ...) for an out-of-range field.
   void validate() const;
 };

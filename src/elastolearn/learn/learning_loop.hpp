@@ -83,8 +83,9 @@ struct LearningOptions {
   /// samples and at forward_fit.stability_stretches (where the recipe's validation requires
   /// stability), instead of only shrinking an unstable result (the shrinking stays as the
   /// fallback): a correction fitted on one kind of motion is otherwise free to soften states
-  /// between its data, and shrinking it gives up its fit everywhere for them.
-  bool stability_cuts = true;
+  /// between its data, and shrinking it gives up its fit everywhere for them. The recipe's
+  /// (RecipeOptions); off by default, as before the cuts.
+  bool stability_cuts = false;
   /// Use at most this many frames of each motion in the reconstruction (a larger frame stride,
   /// the same for every motion, when the longest has more; 0 = all). Consecutive frames are
   /// nearly the same equations: 150 keep the fit's information at a fraction of the cost on

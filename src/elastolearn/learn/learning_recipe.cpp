@@ -53,6 +53,10 @@ RecipeOptions::RecipeOptions() {
   // learn_material applies both only where the fitted α₀ is positive.
   loop.rbf.neo_hookean_tail = true;
   loop.rbf.mass_damping = true;
+  // Fits held stable by cuts rather than only shrunk or rejected (docs/learning_recipe.md,
+  // "Stability cuts").
+  loop.stability_cuts = true;
+  loop.forward_fit.stability_cuts = true;
 }
 
 void RecipeOptions::validate() const {

@@ -59,8 +59,8 @@ struct RecipeOptions {
   /// Stage 5.
   NetworkOptions network;
   /// The recipe's defaults: a parameter fit of ≤ 20 Levenberg–Marquardt iterations; the loop
-  /// backtracking, with energy kernels and the smoothness penalty; up to 8 forward-fit steps
-  /// after it, stopped at a gain below 1 %.
+  /// backtracking, with energy kernels, the smoothness penalty and stability cuts; up to 8
+  /// forward-fit steps after it, stopped at a gain below 1 %.
   RecipeOptions();
   /// Throws InputError("learn.<field>", ...) for an out-of-range field.
   void validate() const;
