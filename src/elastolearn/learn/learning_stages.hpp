@@ -111,9 +111,12 @@ struct Reconstruction {
 };
 
 /// Stage 6: centres by k-means over every motion's optimised stretches (seeded with `seed`), one
-/// stress reconstruction whose equations are every motion's frames, then the largest fraction
-/// ½ᵏ (k ≤ 4) of the result that is stable where the trajectories go (stretches and σ^1.25);
-/// none if no fraction is. `meshes[i]` is motion i's reconstruction mesh.
+/// stress reconstruction whose equations are every motion's frames (with
+/// options.stability_cuts, solved subject to stability cuts at the samples below), then the
+/// largest fraction ½ᵏ (k ≤ 4) of the result that is stable where the trajectories go
+/// (stretches, σ^1.25 and the reachable stretches; with the cuts, also
+/// options.forward_fit.stability_stretches); none if no fraction is. `meshes[i]` is motion i's
+/// reconstruction mesh.
 Reconstruction reconstruct_correction(std::span<const ReconstructionMesh> meshes,
     const std::deque<OptimizedMotion>& motions, const fem::MaterialModel& nominal,
     const LearningOptions& options, const StressReconstructionOptions& reconstruction,
