@@ -172,10 +172,9 @@ StressReconstructionResult reconstruct_rbf_correction(std::span<const Reconstruc
   normal += design.smoothness_penalty(normal);
   const RegularisedNormalEquations equations(
       std::move(normal), design.regularization_weights(), samples);
-  StableSolve solved { equations.solve(rhs) };
-  if (stability)
-    solved = stable_least_squares(equations, rhs, design, stability->nominal, stability->samples,
-        VecX::Zero(design.num_unknowns()));
+  StableSolve solved = stability ? stable_least_squares(equations, rhs, design, stability->nominal,
+                           stability->samples, VecX::Zero(design.num_unknowns()))
+                                 : StableSolve { equations.solve(rhs) };
   VecX x = std::move(solved.x);
   material::RbfCorrection correction = design.correction(x);
   const double solve_seconds = seconds_since(solve_start);
