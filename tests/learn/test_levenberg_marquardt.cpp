@@ -10,10 +10,13 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace elastolearn::learn {
 namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// min ‖r(x)‖² from x0 with the Jacobian J(x) given: a LevenbergMarquardtProblem whose point is
 /// `x`, with a log of every trial step. `fails(x)` makes a trial's evaluation fail (a stand-in for
@@ -23,6 +26,7 @@ struct LeastSquares {
   std::function<MatX(const VecX&)> jacobian;
   VecX x;
   std::function<bool(const VecX&)> fails = [](const VecX&) { return false; };
+  VecX lower {}; ///< lower bounds on x (empty: none), given to the driver as lower_step
   VecX trial {};
   std::vector<VecX> tried {}; ///< every trial point
   std::vector<LevenbergMarquardtStep> steps {};
@@ -34,7 +38,11 @@ struct LeastSquares {
     LevenbergMarquardtProblem p;
     p.linearize = [this]() -> std::optional<NormalEquations> {
       const MatX j = jacobian(x);
-      return NormalEquations { j.transpose() * j, j.transpose() * residual(x), cost(x), 1 };
+      VecX lower_step;
+      if (lower.size() > 0)
+        lower_step = (lower - x).cwiseMin(0.0);
+      return NormalEquations { j.transpose() * j, j.transpose() * residual(x), cost(x), 1,
+        lower_step };
     };
     p.evaluate = [this](const VecX& step) {
       trial = x + step;
@@ -193,6 +201,42 @@ TEST(LevenbergMarquardt, MarquardtScalingHoldsAnUnknownThatMovesNothing) {
   const auto s = ls.solve(marquardt);
   EXPECT_EQ(s.stop, LevenbergMarquardtStop::degenerate);
   EXPECT_EQ(s.steps, 0);
+}
+
+TEST(LevenbergMarquardt, AnUnknownOnItsBoundIsHeldThereAndTheOthersStepInFull) {
+  // r = A x − b, linear, with x₂ ≥ 0 required and the unconstrained minimum at (3, −2, −20). The
+  // bounded minimum is (3, −2, 0): A's last column is orthogonal to the others, and its gradient
+  // there pushes x₂ down (the bound is active: KKT). Held at the bound, x₂ does not shorten the
+  // others' steps through max_step: the first trial is the bounded Gauss–Newton step (damped by
+  // μ = 10⁻³), and the solve ends at the bounded minimum in a few steps. Unbounded, the first
+  // step is scaled to x₂'s max_step of 4, and so x₀'s to 0.6.
+  MatX a(4, 3);
+  a << 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.5, 0.5, 0;
+  const VecX b = a * Eigen::Vector3d(3, -2, -20);
+  LeastSquares ls { .residual = [&](const VecX& x) { return VecX(a * x - b); },
+    .jacobian = [&](const VecX&) { return a; },
+    .x = Eigen::Vector3d::Zero(),
+    .lower = Eigen::Vector3d(-kInf, -kInf, 0) };
+  const LevenbergMarquardtOptions options { .max_iterations = 50,
+    .scaling = DampingScaling::marquardt,
+    .max_step = 4,
+    .function_tolerance = 1e-12 };
+  ls.solve(options);
+  const VecX bounded = Eigen::Vector3d(3, -2, 0);
+  ASSERT_GT((a.transpose() * (a * bounded - b))[2], 0); // the bound is active
+  EXPECT_LT((ls.tried.front() - bounded).norm(), 1e-2) << ls.tried.front().transpose();
+  EXPECT_LT((ls.x - bounded).norm(), 1e-9) << ls.x.transpose();
+  EXPECT_LE(ls.steps.size(), 6u);
+  for (const VecX& t : ls.tried)
+    EXPECT_EQ(t[2], 0.0);
+
+  LeastSquares unbounded = ls;
+  unbounded.x = Eigen::Vector3d::Zero();
+  unbounded.lower = VecX();
+  unbounded.tried.clear();
+  unbounded.solve(options);
+  EXPECT_NEAR(unbounded.tried.front()[0], 0.6, 1e-2);
+  EXPECT_LT((unbounded.x - Eigen::Vector3d(3, -2, -20)).norm(), 1e-9);
 }
 
 TEST(LevenbergMarquardt, ClipsLongStepsToMaxStep) {

@@ -274,7 +274,7 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
     smoothness = design.smoothness_penalty(current.normal);
     NormalEquations equations { current.normal,
       current.gradient + prior_weights.cwiseProduct(result.unknowns) + smoothness * result.unknowns,
-      objective(current, result.unknowns), current.error.samples };
+      objective(current, result.unknowns), current.error.samples, {} };
     equations.hessian.diagonal() += prior_weights;
     equations.hessian += smoothness;
     return equations;

@@ -478,8 +478,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     say(callbacks,
         format("parameter fit: E %.4g Pa, ν %.3f, α₀ %.3g 1/s, ", f.fitted.young, f.fitted.poisson,
             f.fitted.alpha0)
-            + format("α₁ %.3g s; training error rms %.4f %% -> %.4f %% (%.1f s)", f.fitted.alpha1,
-                100 * f.initial_rms / size, 100 * f.final_rms / size, f.seconds));
+            + format("α₁ %.3g s; training error rms %.4f %% -> %.4f %% ", f.fitted.alpha1,
+                100 * f.initial_rms / size, 100 * f.final_rms / size)
+            + format("(%.0f iterations, %.0f simulations, %.1f s)", f.iterations, f.simulations,
+                f.seconds));
     return f;
   };
   if (resume) {

@@ -31,6 +31,11 @@ class DampedSystem {
     ELASTOLEARN_CHECK(
         h.rows() > 0 && h.rows() == h.cols() && m_equations.gradient.size() == h.rows(),
         "the normal equations must be n × n and n with n ≥ 1");
+    const VecX& lower = m_equations.lower_step;
+    ELASTOLEARN_CHECK(lower.size() == 0
+            || (m_scaling == DampingScaling::marquardt && lower.size() == h.rows()
+                && (lower.array() <= 0).all()),
+        "lower step bounds need the marquardt scaling, one per unknown, each ≤ 0");
     if (m_scaling == DampingScaling::marquardt) {
       const double diag_max = h.diagonal().maxCoeff();
       m_degenerate = !(diag_max > 0);
@@ -54,21 +59,40 @@ class DampedSystem {
   }
 
   private:
+  /// (H + μ diag H) δ = −g over the unknowns that move, each held one at its lower bound where
+  /// the solve would cross it (at most n solves: each adds a held unknown).
   VecX marquardt_step(double mu) const {
     const Eigen::Index n = m_equations.hessian.rows();
-    MatX a = m_equations.hessian;
-    VecX rhs = -m_equations.gradient;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      if (m_active[static_cast<size_t>(i)]) {
-        a(i, i) *= 1 + mu;
-      } else {
-        a.row(i).setZero();
-        a.col(i).setZero();
-        a(i, i) = 1;
-        rhs[i] = 0;
+    const VecX& lower = m_equations.lower_step;
+    // held[i]: δ_i is fixed, at 0 (an unknown that does not move the residuals) or at its bound.
+    std::vector<bool> held(static_cast<size_t>(n));
+    VecX fixed = VecX::Zero(n);
+    for (Eigen::Index i = 0; i < n; ++i)
+      held[static_cast<size_t>(i)] = !m_active[static_cast<size_t>(i)];
+    while (true) {
+      MatX a = m_equations.hessian;
+      VecX rhs = -m_equations.gradient - m_equations.hessian * fixed;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (held[static_cast<size_t>(i)]) {
+          a.row(i).setZero();
+          a.col(i).setZero();
+          a(i, i) = 1;
+          rhs[i] = fixed[i];
+        } else {
+          a(i, i) *= 1 + mu;
+        }
       }
+      const VecX delta = a.ldlt().solve(rhs);
+      bool crossed = false;
+      for (Eigen::Index i = 0; i < lower.size(); ++i)
+        if (!held[static_cast<size_t>(i)] && delta[i] < lower[i]) {
+          held[static_cast<size_t>(i)] = true;
+          fixed[i] = lower[i];
+          crossed = true;
+        }
+      if (!crossed)
+        return delta;
     }
-    return a.ldlt().solve(rhs);
   }
 
   VecX jacobi_step(double mu) const {

@@ -57,6 +57,12 @@ struct NormalEquations {
   VecX gradient; ///< g, n: the undamped step solves H δ = −g
   double cost = 0; ///< Φ at the current point: a trial is accepted if its cost is lower
   long samples = 0; ///< observations behind H, quoted in the error if the jacobi solve fails
+  /// Marquardt scaling only, optional (empty = unbounded): the least step of each unknown,
+  /// ≤ 0 (the current point is within its bounds), −∞ for none. An unknown whose damped step
+  /// would go below its bound is held at it and the others are solved again (an active set), so
+  /// a parameter resting on its bound does not shorten every other unknown's step through
+  /// max_step. Scaling a step down keeps it within the bounds.
+  VecX lower_step;
 };
 
 /// A trial point's evaluation.

@@ -42,6 +42,17 @@ struct ParameterTransform {
     }
     return 0;
   }
+  /// The least u of a parameter (a damping's u at which it is 0), −∞ where there is none.
+  double lower_u(FitParameter which) const {
+    switch (which) {
+    case FitParameter::Alpha0:
+      return std::log(floor0);
+    case FitParameter::Alpha1:
+      return std::log(floor1);
+    default:
+      return -std::numeric_limits<double>::infinity();
+    }
+  }
   void set(FitParameter which, double u, NominalParameters& p) const {
     switch (which) {
     case FitParameter::Young:
@@ -51,12 +62,19 @@ struct ParameterTransform {
       p.poisson = kPoissonMax / (1 + std::exp(-u));
       break;
     case FitParameter::Alpha0:
-      p.alpha0 = std::max(0.0, std::exp(u) - floor0);
+      p.alpha0 = damping(u, floor0);
       break;
     case FitParameter::Alpha1:
-      p.alpha1 = std::max(0.0, std::exp(u) - floor1);
+      p.alpha1 = damping(u, floor1);
       break;
     }
+  }
+  /// eᵘ − floor, exactly 0 at and below the bound: a step onto it lands within a few ulps of
+  /// log(floor), whose round-off (~10⁻¹⁸ 1/s) must not count as a damping (the recipe learns Δα₀
+  /// only for a fitted α₀ > 0).
+  static double damping(double u, double floor) {
+    const double alpha = std::exp(u) - floor;
+    return alpha > 1e-9 * floor ? alpha : 0.0;
   }
 };
 
@@ -461,8 +479,13 @@ ParameterFitReport fit_parameters(std::span<const Motion> data, material::Elasti
     }
     // A column whose simulations all diverged (or that does not influence the motion) has a zero
     // diagonal in JᵀJ: the Marquardt scaling holds that parameter fixed.
+    // A damping at 0 rests on its bound when the data ask for less (the fit of a nominal that
+    // damps less than backward Euler already does, or of an undamped truth).
+    VecX lower_step(p);
+    for (int i = 0; i < p; ++i)
+      lower_step[i] = std::min(0.0, transform.lower_u(fitted[i]) - u[i]);
     return NormalEquations { J.transpose() * J, J.transpose() * current.residual, current.cost,
-      samples };
+      samples, std::move(lower_step) };
   };
   problem.evaluate = [&](const VecX& delta) {
     trial_parameters = report.fitted;
