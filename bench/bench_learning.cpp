@@ -93,7 +93,7 @@ double g_damping_regularization = -1, g_regularization = -1, g_position_weight =
        g_elastic_prior = -1, g_smoothness = -1, g_forward_fit_tolerance = -1;
 bool g_no_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
      g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false,
-     g_no_backtrack = false, g_no_stability_cuts = false;
+     g_no_backtrack = false, g_no_stability_cuts = false, g_exact_sensitivities = false;
 /// --smooth-clamp, --smooth-expansion: the continuation beyond the trusted stretches.
 std::optional<material::Continuation> g_continuation;
 
@@ -136,6 +136,8 @@ void apply_overrides(learn::LearningOptions& o) {
     o.full_space = true;
   if (g_no_backtrack)
     o.backtrack = false;
+  if (g_exact_sensitivities)
+    o.forward_fit.sensitivities = learn::Sensitivities::exact;
   if (g_no_stability_cuts) {
     o.stability_cuts = false;
     o.forward_fit.stability_cuts = false;
@@ -501,6 +503,8 @@ int main(int argc, char** argv) {
       g_no_backtrack = true;
     else if (a == "--no-stability-cuts")
       g_no_stability_cuts = true;
+    else if (a == "--exact-sensitivities")
+      g_exact_sensitivities = true;
     else if (a == "--forward-fit-tolerance" && i + 1 < argc)
       g_forward_fit_tolerance = std::stod(argv[++i]);
     else if (a == "--no-damping")
@@ -530,7 +534,7 @@ int main(int argc, char** argv) {
                   "[--modes "
                   "R] [--kernels M] [--iterations K] [--patience P] [--free-halvings H] "
                   "[--forward-fit F] [--forward-fit-tolerance T] [--no-backtrack] "
-                  "[--no-stability-cuts] [--damping-prior "
+                  "[--no-stability-cuts] [--exact-sensitivities] [--damping-prior "
                   "RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
                   "[--smoothness L] "
