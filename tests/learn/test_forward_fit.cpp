@@ -162,6 +162,52 @@ TEST(ForwardFit, RecoversTheTruthsMassDampingWithTheCorrection) {
   EXPECT_GT(held.rms_history.back(), 10 * fit.rms_history.back());
 }
 
+TEST(ForwardFit, ADeltaAlpha0AtItsFloorIsHeldThereWhileTheElasticUnknownsConverge) {
+  // An undamped truth (Δα₀ = −α₀) swung about the clamp, simulated with a quarter of the fit's
+  // time step: backward Euler at the fit's step damps the swing more than the data show, so the
+  // data ask for α₀ + Δα₀ < 0 and the bound Δα₀ ≥ −α₀ is active. Held there in the step's
+  // solve, the elastic unknowns are solved for the Δα₀ the trial gets, and the fit does as well
+  // as a fit of the same model written without mass damping (α₀ = 0, no Δα₀ unknown). Measured:
+  // 1.006× its RMS error after six trials; with the solved step clamped instead (the elastic
+  // unknowns moved for a Δα₀ the trial did not get, two trials rejected) 1.10×.
+  sim::Scene nominal = small_bar();
+  nominal.frames = 80;
+  nominal.initial.kind = sim::InitialCondition::Kind::Velocity;
+  nominal.initial.angular_velocity = Vec3(0, 3, 0);
+  nominal.initial.center = Vec3(0, 0.03, 0.03);
+  const RbfDesign design = elastic_design(true);
+  VecX truth_unknowns = VecX::Zero(design.num_unknowns());
+  truth_unknowns[design.mass_damping_unknown()] = -0.5;
+  sim::Scene fine = sim::with_correction(
+      nominal, std::make_shared<material::RbfCorrection>(design.correction(truth_unknowns)));
+  fine.dt /= 4;
+  fine.frames *= 4;
+  const sim::ForwardRun run = sim::simulate_positions(fine);
+  ASSERT_TRUE(run.completed) << run.message;
+  std::vector<Positions> frames;
+  for (size_t i = 0; i < run.positions.size(); i += 4)
+    frames.emplace_back(unflatten(run.positions[i]));
+  const observe::Observation observed = observe::observe_vertices(
+      frames, nominal.dt, observe::select_visible_vertices(nominal.mesh, 0.5, 3), 0.0, 1);
+  ForwardFitOptions options;
+  options.max_iterations = 6;
+  const ReconstructionMesh mesh(nominal.mesh, nominal.material);
+  const ForwardFitResult fit = fit_to_observations(
+      nominal, observed, mesh, design, VecX::Zero(design.num_unknowns()), options);
+  EXPECT_EQ(fit.unknowns[design.mass_damping_unknown()], -0.5);
+
+  sim::Scene undamped = nominal;
+  undamped.material.damping = nullptr;
+  const RbfDesign without = elastic_design(false);
+  const ReconstructionMesh undamped_mesh(undamped.mesh, undamped.material);
+  const ForwardFitResult held = fit_to_observations(
+      undamped, observed, undamped_mesh, without, VecX::Zero(without.num_unknowns()), options);
+  const auto best = [](const ForwardFitResult& f) {
+    return *std::min_element(f.rms_history.begin(), f.rms_history.end());
+  };
+  EXPECT_LT(best(fit), 1.03 * best(held)) << best(fit) << " against " << best(held);
+}
+
 /// The truth softens near kernel 0 (weight 16e3 Pa at (1.05, 1, 0.98)) past stability there
 /// (relative eigenvalue −0.56), yet its sag stays clear of that state and simulates. A fit
 /// required to be stable at that state cannot reach it: the Gauss–Newton step towards it is

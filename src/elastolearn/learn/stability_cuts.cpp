@@ -160,10 +160,10 @@ VecX solve_with_inequalities(const RegularisedNormalEquations& equations, ConstR
 
 StableSolve stable_least_squares(const RegularisedNormalEquations& equations, ConstRef<VecX> rhs,
     const RbfDesign& design, const material::ElasticModel& nominal, ConstRef<MatX> samples,
-    ConstRef<VecX> base, int max_rounds) {
+    ConstRef<VecX> base, int max_rounds, const LinearInequalities& kept) {
   StableSolve out;
-  out.x = equations.solve(rhs);
-  LinearInequalities conditions;
+  LinearInequalities conditions = kept;
+  out.x = solve_with_inequalities(equations, rhs, conditions);
   for (int round = 0; round < max_rounds; ++round) {
     LinearInequalities cuts = stability_cuts(design, nominal, base + out.x, samples);
     if (cuts.size() == 0)
@@ -173,7 +173,7 @@ StableSolve stable_least_squares(const RegularisedNormalEquations& equations, Co
     out.x = solve_with_inequalities(equations, rhs, conditions);
     out.rounds = round + 1;
   }
-  out.cuts = conditions.size();
+  out.cuts = conditions.size() - kept.size();
   return out;
 }
 

@@ -62,9 +62,10 @@ struct StableSolve {
 /// `max_rounds` solves with cuts; `base` is added to x for the stability check and the cuts
 /// (the correction is design.correction(base + x): zero for a fit of the whole correction, the
 /// current point for a step of the forward fit). The result may still be unstable after
-/// max_rounds (the caller's check decides).
+/// max_rounds (the caller's check decides). `kept` are conditions every solve keeps besides the
+/// cuts (e.g. a bound on an unknown); StableSolve::cuts counts only the cuts.
 StableSolve stable_least_squares(const RegularisedNormalEquations& equations, ConstRef<VecX> rhs,
     const RbfDesign& design, const material::ElasticModel& nominal, ConstRef<MatX> samples,
-    ConstRef<VecX> base, int max_rounds = 8);
+    ConstRef<VecX> base, int max_rounds = 8, const LinearInequalities& kept = {});
 
 } // namespace elastolearn::learn
