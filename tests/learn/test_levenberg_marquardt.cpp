@@ -121,7 +121,8 @@ TEST(LevenbergMarquardt, AStepSolverHoldsEveryTrialToItsConditions) {
   // no trial point leaves the feasible side.
   LeastSquares ls = rosenbrock();
   LevenbergMarquardtProblem problem = ls.problem();
-  problem.solve_step = [&](const RegularisedNormalEquations& equations, const VecX& rhs) {
+  problem.solve_step = [&](const RegularisedNormalEquations& equations, const VecX& rhs,
+                           const LinearInequalities&) {
     LinearInequalities bound; // −(x₁ + δ₁) ≥ −0.5
     bound.rows = Eigen::RowVector2d(-1, 0);
     bound.bounds = VecX::Constant(1, -0.5 + ls.x[0]);

@@ -264,6 +264,22 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
   // and `trial`.
   VecX trial_unknowns;
   ForwardSensitivityPass trial;
+  // A trial's Δα₀ is kept ≥ −α₀ of the nominal (at rest): below, the simulation clamps the mass
+  // damping at 0 and Δα₀'s column −M v no longer describes what a step changes. The bound is a
+  // condition of the step's solve (NormalEquations::lower_step: held there, the other unknowns
+  // are solved again), not only a clamp of the solved step, whose other unknowns would have moved
+  // for a Δα₀ the trial does not get.
+  const int mass = design.mass_damping_unknown();
+  const auto& damping = motions.front().scene.material.damping;
+  const double mass_floor = damping ? -damping->coefficients(1.0).alpha0 : 0.0;
+  const auto mass_floor_step = [&] {
+    VecX lower;
+    if (mass >= 0) {
+      lower = VecX::Constant(start.size(), -std::numeric_limits<double>::infinity());
+      lower[mass] = mass_floor - result.unknowns[mass];
+    }
+    return lower;
+  };
   LevenbergMarquardtProblem problem;
   problem.linearize = [&]() -> std::optional<NormalEquations> {
     prior_weights = VecX::Zero(start.size());
@@ -274,7 +290,7 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
     smoothness = design.smoothness_penalty(current.normal);
     NormalEquations equations { current.normal,
       current.gradient + prior_weights.cwiseProduct(result.unknowns) + smoothness * result.unknowns,
-      objective(current, result.unknowns), current.error.samples, {} };
+      objective(current, result.unknowns), current.error.samples, mass_floor_step() };
     equations.hessian.diagonal() += prior_weights;
     equations.hessian += smoothness;
     return equations;
@@ -283,22 +299,6 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
     const material::RbfCorrection c = design.correction(unknowns);
     return material_stability(
         *motions.front().scene.material.elastic, &c, options.stability_stretches);
-  };
-  // A trial's Δα₀ is kept ≥ −α₀ of the nominal (at rest): below, the simulation clamps the mass
-  // damping at 0 and Δα₀'s column −M v no longer describes what a step changes. The bound is a
-  // condition of the step's solve (held there, the other unknowns are solved again), not a clamp
-  // of the solved step, whose other unknowns would have moved for a Δα₀ the trial does not get.
-  const int mass = design.mass_damping_unknown();
-  const auto& damping = motions.front().scene.material.damping;
-  const double mass_floor = damping ? -damping->coefficients(1.0).alpha0 : 0.0;
-  const auto mass_bound = [&] {
-    LinearInequalities bound;
-    if (mass >= 0) {
-      bound.rows = MatX::Zero(1, start.size());
-      bound.rows(0, mass) = 1;
-      bound.bounds = VecX::Constant(1, mass_floor - result.unknowns[mass]);
-    }
-    return bound;
   };
   const auto trial_at = [&](double fraction, const VecX& step) {
     trial_unknowns = result.unknowns + fraction * step;
@@ -323,14 +323,13 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
   // (stability_cuts.hpp), which would otherwise be rejected unsimulated. Only there: a cut step
   // turns along the stability boundary, and cutting every step that shortening serves measured
   // worse on most named cases (docs/learning_recipe.md, "Stability cuts").
-  const bool cuts = options.stability_cuts && options.stability_stretches.rows() > 0;
-  if (cuts || mass >= 0)
-    problem.solve_step = [&, cuts](const RegularisedNormalEquations& equations, const VecX& rhs) {
-      const LinearInequalities bound = mass_bound();
-      VecX step = solve_with_inequalities(equations, rhs, bound);
-      if (cuts && !shorten(step).stable())
+  if (options.stability_cuts && options.stability_stretches.rows() > 0)
+    problem.solve_step = [&](const RegularisedNormalEquations& equations, const VecX& rhs,
+                             const LinearInequalities& bounds) {
+      VecX step = solve_with_inequalities(equations, rhs, bounds);
+      if (!shorten(step).stable())
         step = stable_least_squares(equations, rhs, design, *motions.front().scene.material.elastic,
-            options.stability_stretches, result.unknowns, 8, bound)
+            options.stability_stretches, result.unknowns, 8, bounds)
                    .x;
       return step;
     };

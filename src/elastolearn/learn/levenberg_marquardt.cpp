@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace elastolearn::learn {
@@ -33,9 +34,17 @@ class DampedSystem {
         "the normal equations must be n × n and n with n ≥ 1");
     const VecX& lower = m_equations.lower_step;
     ELASTOLEARN_CHECK(lower.size() == 0
-            || (m_scaling == DampingScaling::marquardt && lower.size() == h.rows()
-                && (lower.array() <= 0).all()),
-        "lower step bounds need the marquardt scaling, one per unknown, each ≤ 0");
+            || (lower.size() == h.rows()
+                && (lower.array() < std::numeric_limits<double>::infinity()).all()),
+        "lower step bounds must be one per unknown, each below +∞ (−∞: none)");
+    const Eigen::Index bounded = lower.array().isFinite().count();
+    m_bounds.rows = MatX::Zero(bounded, h.rows());
+    m_bounds.bounds.resize(bounded);
+    for (Eigen::Index i = 0, k = 0; i < lower.size(); ++i)
+      if (std::isfinite(lower[i])) {
+        m_bounds.rows(k, i) = 1;
+        m_bounds.bounds[k++] = lower[i];
+      }
     if (m_scaling == DampingScaling::marquardt) {
       const double diag_max = h.diagonal().maxCoeff();
       m_degenerate = !(diag_max > 0);
@@ -100,13 +109,15 @@ class DampedSystem {
     const RegularisedNormalEquations damped(
         m_equations.hessian, VecX::Constant(n, mu), m_equations.samples);
     const VecX rhs = -m_equations.gradient;
-    return m_problem.solve_step ? m_problem.solve_step(damped, rhs) : VecX(damped.solve(rhs));
+    return m_problem.solve_step ? m_problem.solve_step(damped, rhs, m_bounds)
+                                : solve_with_inequalities(damped, rhs, m_bounds);
   }
 
   NormalEquations m_equations;
   DampingScaling m_scaling;
   const LevenbergMarquardtProblem& m_problem;
   std::vector<bool> m_active; ///< marquardt: unknowns that move the residuals
+  LinearInequalities m_bounds; ///< jacobi: the finite lower_step entries as δ_i ≥ lower_i
   bool m_degenerate = false;
 };
 

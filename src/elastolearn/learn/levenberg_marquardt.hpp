@@ -9,6 +9,7 @@
 /// tells it which trial to keep. In the style of Ceres's Solver::Options / Summary.
 #include <elastolearn/core/types.hpp>
 #include <elastolearn/learn/rbf_fit.hpp>
+#include <elastolearn/learn/stability_cuts.hpp>
 
 #include <functional>
 #include <limits>
@@ -57,11 +58,12 @@ struct NormalEquations {
   VecX gradient; ///< g, n: the undamped step solves H δ = −g
   double cost = 0; ///< Φ at the current point: a trial is accepted if its cost is lower
   long samples = 0; ///< observations behind H, quoted in the error if the jacobi solve fails
-  /// Marquardt scaling only, optional (empty = unbounded): the least step of each unknown,
-  /// ≤ 0 (the current point is within its bounds), −∞ for none. An unknown whose damped step
-  /// would go below its bound is held at it and the others are solved again (an active set), so
-  /// a parameter resting on its bound does not shorten every other unknown's step through
-  /// max_step. Scaling a step down keeps it within the bounds.
+  /// Optional (empty = unbounded): the least step of each unknown, −∞ for none. An unknown whose
+  /// damped step would go below its bound is held at it and the others are solved again
+  /// (marquardt: an active set; jacobi: solve_with_inequalities of stability_cuts.hpp), so a
+  /// parameter resting on its bound does not take the others' steps with it (through max_step,
+  /// or through a clamp after the solve). With every bound ≤ 0 (the current point within its
+  /// bounds), scaling a step down keeps it within them.
   VecX lower_step;
 };
 
@@ -99,9 +101,13 @@ struct LevenbergMarquardtProblem {
   /// Called after each trial step (after `accept` for an accepted one); returns false to end
   /// the solve there. Optional.
   std::function<bool(const LevenbergMarquardtStep& step)> on_step;
-  /// The jacobi scaling's step from its damped, factorised equations Q δ = rhs (−g), e.g.
-  /// subject to conditions on the trial point (stable_least_squares). Optional: Q⁻¹ rhs.
-  std::function<VecX(const RegularisedNormalEquations& equations, const VecX& rhs)> solve_step;
+  /// The jacobi scaling's step from its damped, factorised equations Q δ = rhs (−g) subject to
+  /// `bounds` (NormalEquations::lower_step as rows δ_i ≥ lower_i; none if it is empty), e.g.
+  /// with more conditions on the trial point (stable_least_squares). Optional:
+  /// solve_with_inequalities(equations, rhs, bounds).
+  std::function<VecX(const RegularisedNormalEquations& equations, const VecX& rhs,
+      const LinearInequalities& bounds)>
+      solve_step;
 };
 
 /// Why the solve ended.
