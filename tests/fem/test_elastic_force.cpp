@@ -3,6 +3,7 @@
 #include <elastolearn/material/corotated.hpp>
 #include <elastolearn/material/neohookean.hpp>
 #include <elastolearn/material/rayleigh_damping.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
 #include <elastolearn/material/spline_edited.hpp>
 #include <elastolearn/material/stvk.hpp>
 #include <elastolearn/mesh/primitives.hpp>
@@ -423,6 +424,40 @@ TEST(StiffnessScale, UniformScaleIsAStifferNominalAndLeavesTheCorrectionUnscaled
   EXPECT_LE((fa - fb).norm(), 1e-12 * fb.norm());
   EXPECT_LE((Ja - Jb).norm(), 1e-12 * Jb.norm());
   EXPECT_NEAR(a.elastic_energy(x), b.elastic_energy(x), 1e-12 * b.elastic_energy(x));
+}
+
+TEST(LearnedEnergy, TheEnergyOfAnEnergyCorrectionIsPartOfTheElasticEnergy) {
+  // Energy kernels and linear tails (a softening kernel, a Lamé change), on a stiffness-scaled
+  // nominal: −∇E = f at v = 0 by central differences (1e-6 relative, as for the nominals), and the
+  // correction's share is ~10 % of the force, so an energy without ΔΨ fails by far.
+  const auto mesh = small_bar();
+  material::RbfCorrection::Parameters p;
+  p.energy_kernels = true;
+  p.epsilon = 0.1;
+  p.centres = Eigen::RowVector3d(1.05, 1.0, 0.97);
+  p.weights = VecX::Constant(1, -2e3);
+  p.own_slope = 3e4;
+  p.other_slope = 1e4;
+  const auto correction = std::make_shared<material::RbfCorrection>(std::move(p));
+  ASSERT_TRUE(correction->has_elastic_energy());
+  fem::MaterialModel m { model(0), correction, nullptr, 1000 };
+  m.stiffness_scale = std::make_shared<std::vector<double>>(mesh.num_tets(), 1.3);
+  fem::ElasticForce term(mesh, m);
+  term.set_project_tangent(false);
+  EXPECT_TRUE(term.is_hyperelastic());
+  fem::MaterialModel plain = m;
+  plain.correction = nullptr;
+  fem::ElasticForce nominal(mesh, plain);
+  const VecX x = deformed(mesh, 0.3);
+  const VecX v = VecX::Zero(x.size());
+  VecX f;
+  const Eigen::MatrixXd K = jacobian_at(term, x, v, 1.0, 0.0, f);
+  ASSERT_GT((f - force_at(nominal, x, v)).norm(), 0.03 * f.norm());
+  expect_consistent_stiffness_and_energy(term, x, v, K, f);
+  // A correction without an energy leaves the nominal's: not hyperelastic.
+  fem::MaterialModel stress = m;
+  stress.correction = std::make_shared<QuadraticCorrection>(0.004, 0.0);
+  EXPECT_FALSE(fem::ElasticForce(mesh, stress).is_hyperelastic());
 }
 
 TEST(StiffnessScale, RejectsAScaleOfTheWrongSize) {

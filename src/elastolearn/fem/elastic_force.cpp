@@ -179,12 +179,18 @@ void ElasticForce::gather_forces(VecX& f) const {
 
 double ElasticForce::elastic_energy(const VecX& x) const {
   const auto& scales = m_material.stiffness_scale;
+  const material::Correction* correction
+      = m_material.correction && m_material.correction->has_elastic_energy()
+      ? m_material.correction.get()
+      : nullptr;
   double energy = 0;
   for (Eigen::Index e = 0; e < m_tets.rows(); ++e) {
     const auto frame = material::principal_frame(
         deformation_gradient(gather_tet(x, m_tets.row(e).transpose()), m_rest[e]));
-    energy += m_rest[e].volume * (scales ? (*scales)[e] : 1.0)
-        * m_material.elastic->energy(frame.stretches);
+    double psi = (scales ? (*scales)[e] : 1.0) * m_material.elastic->energy(frame.stretches);
+    if (correction)
+      psi += correction->elastic_energy(frame.stretches);
+    energy += m_rest[e].volume * psi;
   }
   return energy;
 }

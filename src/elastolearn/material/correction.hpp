@@ -2,6 +2,7 @@
 /// \file The material correction hook N(F̂, Ḟ̂) of paper 000, Eq. (1):
 ///   P = U (P̂(F̂) + N(F̂, Ḟ̂)) Vᵀ,
 /// with F̂ the principal stretches (sorted descending) and Ḟ̂ = diag(Uᵀ Ḟ V) the stretch rates.
+#include <elastolearn/core/error.hpp>
 #include <elastolearn/core/types.hpp>
 
 #include <algorithm>
@@ -44,6 +45,15 @@ class Correction {
   /// back (docs/learning_recipe.md, "The nominal's damping, learned with the correction").
   /// Default: none.
   virtual double mass_damping() const { return 0; }
+  /// Whether the elastic part N(F̂, 0) is the gradient of an energy ΔΨ(F̂) (elastic_energy): the
+  /// corrected material is then hyperelastic, and a static solve can line-search on its energy
+  /// (fem::ElasticForce::elastic_energy). Default: no.
+  virtual bool has_elastic_energy() const { return false; }
+  /// ΔΨ(F̂) [J/m³] up to a constant, with ∇ΔΨ = N(F̂, 0). Only where has_elastic_energy();
+  /// throws InputError otherwise.
+  virtual double elastic_energy(const Vec3& /*stretches*/) const {
+    throw InputError(name(), "the correction is not the gradient of an energy");
+  }
   virtual std::unique_ptr<Correction> clone() const = 0;
 };
 

@@ -153,7 +153,8 @@ class NnCorrection final : public Correction {
   /// is non-null, ∂g/∂x. Throws InputError for an energy network.
   double evaluate(const NnInput& x, NnInput* d_input = nullptr) const;
   /// Energy kind: ΔΨ(σ) [J/m³] (its gradient is N). Throws InputError for a stress network.
-  double elastic_energy(const Vec3& stretches) const;
+  double elastic_energy(const Vec3& stretches) const override;
+  bool has_elastic_energy() const override { return m_p.kind == NnKind::Energy; }
 
   const Parameters& parameters() const { return m_p; }
   int num_inputs() const { return m_p.kind == NnKind::Stress ? 6 : 3; }

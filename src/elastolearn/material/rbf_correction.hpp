@@ -144,7 +144,8 @@ class RbfCorrection final : public Correction {
   Vec3 elastic_correction(const Vec3& stretches) const;
   /// ΔΨ(σ) [J/m³] up to a constant, whose gradient is N; only for energy_kernels (throws
   /// InputError otherwise).
-  double elastic_energy(const Vec3& stretches) const;
+  double elastic_energy(const Vec3& stretches) const override;
+  bool has_elastic_energy() const override { return m_p.energy_kernels; }
   /// True if Δα₁ is not identically zero or Δα₀ ≠ 0.
   bool has_damping() const;
   /// True if N is not identically zero (a weight, slope, constant, quadratic or neo-Hookean term ≠
