@@ -87,9 +87,9 @@ void print_candidate_tests(const learn::RecipeResult& result, const sim::Scene& 
         : -1;
     const auto& x = c.larger_motion;
     std::printf("   candidate %-22s validation rms %.4f %%, z %+.1f (resolution %.1f, training z "
-                "%+.1f), %s (motion ×%.1f: %s); test err_L %.3f %%%s\n",
+                "%+.1f), %s (larger motion and droop: %s); test err_L %.3f %%%s\n",
         name.c_str(), 100 * c.validation.rms / size, c.significance, c.resolution,
-        c.training_significance, c.eligible() ? "eligible" : "not eligible", learn::kLargerMotion,
+        c.training_significance, c.eligible() ? "eligible" : "not eligible",
         !x.checked ? "not checked" : (x.completed ? "passed" : x.message.c_str()), test_error,
         int(i) == result.chosen ? "  <- chosen" : "");
     if (c.completed && c.kind != learn::CandidateKind::Nominal

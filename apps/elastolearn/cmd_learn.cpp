@@ -227,8 +227,10 @@ void run_learn(const LearnOptions& o) {
                       + " 1/s on the nominal's mass damping)"
                   : std::string());
     else if (c.completed && !c.eligible())
-      note = "   (diverged in a motion driven " + elastolearn::to_text(learn::kLargerMotion)
-          + "× as hard: not eligible)";
+      note = "   (not eligible: "
+          + (c.larger_motion.completed ? std::string("unstable where another motion may go")
+                                       : "failed in " + c.larger_motion.message)
+          + ")";
     else if (c.completed && c.kind == learn::CandidateKind::Network && c.teacher == result.chosen)
       note = "   (" + elastolearn::to_text(-c.gain_over_teacher) + " noise deviations and "
           + elastolearn::to_text(

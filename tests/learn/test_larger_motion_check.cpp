@@ -1,10 +1,12 @@
-// check_larger_motion (the validation choice's larger motion): substeps are the solver's
-// business; a material that follows the recorded motion but diverges in the larger one fails.
+// check_larger_motion (the validation choice's larger motion and droop): substeps are the
+// solver's business; a material that follows the recorded motion but diverges in the larger one,
+// or cannot hold the droop, fails; the droop's load makes the reference droop as far as asked.
 #include <elastolearn/learn/element_state.hpp>
 #include <elastolearn/learn/larger_motion_check.hpp>
 #include <elastolearn/material/analytic_correction.hpp>
 #include <elastolearn/sim/amplified_scene.hpp>
 #include <elastolearn/sim/forward_run.hpp>
+#include <elastolearn/sim/simulator.hpp>
 
 #include "../support/bar_scene.hpp"
 
@@ -66,7 +68,62 @@ TEST(LargerMotionCheck, FailsAMaterialThatFollowsTheRecordedMotionButNotALargerO
   const LargerMotionCheck check = check_larger_motion(softened, "droop");
   EXPECT_TRUE(check.checked);
   EXPECT_FALSE(check.completed);
-  EXPECT_EQ(check.message.rfind("droop: diverged at frame ", 0), 0u) << check.message;
+  EXPECT_EQ(check.message.rfind("droop driven 1.5× as hard (diverged at frame ", 0), 0u)
+      << check.message;
   // The nominal alone follows the larger motion.
   EXPECT_TRUE(check_larger_motion(scene, "droop").completed);
+}
+
+TEST(LargerMotionCheck, FailsAMaterialThatCannotHoldTheDroop) {
+  // The bar at rest without gravity: its recorded motion, and the one driven harder, stay at
+  // rest. Under a body load of 3 g the nominal droops statically to strains of ~6 %; the
+  // softening cubic cancels the nominal's stretch stiffness at 3 %, so that droop has no
+  // equilibrium, and the check fails in it, naming the droop.
+  sim::Scene scene = droop(4e-3);
+  scene.gravity.setZero();
+  scene.frames = 5;
+  const Vec3 load(0, -3 * 9.81, 0);
+  EXPECT_TRUE(check_larger_motion(scene, "rest", load).completed);
+  const sim::Scene softened = with_cubic(scene, -2.14e6 / (3 * 0.03 * 0.03));
+  const LargerMotionCheck check = check_larger_motion(softened, "rest", load);
+  EXPECT_FALSE(check.completed);
+  EXPECT_EQ(check.message.rfind("the droop of rest under a body load of 29.43 m/s", 0), 0u)
+      << check.message;
+  // Without a droop (zero load) only the motion is checked, and it passes.
+  EXPECT_TRUE(check_larger_motion(softened, "rest").completed);
+}
+
+TEST(LargerMotionCheck, TheDroopLoadMakesTheReferenceDroopAsFarAsTheLargerMotion) {
+  // A swing without gravity (ω about z): the body load points along the largest displacement
+  // (a tip vertex's, mostly along y), and the reference's static droop under it is kLargerMotion
+  // times that displacement. The load is scaled from the linear response to a small trial
+  // load, and the swing strains the bar by a few percent: within 10 %.
+  sim::Scene scene = droop(4e-3);
+  scene.gravity.setZero();
+  scene.initial.kind = sim::InitialCondition::Kind::Velocity;
+  scene.initial.angular_velocity = Vec3(0, 0, 2.0);
+  const sim::ForwardRun run = sim::simulate_positions(scene);
+  ASSERT_TRUE(run.completed);
+  const VecX rest = flatten(scene.mesh.rest_positions());
+  double moved = 0;
+  for (const VecX& x : run.positions)
+    for (Eigen::Index v = 0; v < x.size() / 3; ++v)
+      moved = std::max(moved, (x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
+  ASSERT_GT(moved, 0.005);
+  const Vec3 a = droop_acceleration(scene, run.positions);
+  ASSERT_GT(a.norm(), 0);
+  EXPECT_GT(std::abs(a.y()), 0.8 * a.norm()); // mostly across the bar, as the swing moves it
+  sim::Scene held = scene;
+  held.initial = {};
+  held.initial.kind = sim::InitialCondition::Kind::StaticLoad;
+  held.gravity = a;
+  sim::Simulator simulator(held);
+  ASSERT_TRUE(simulator.apply_initial_condition().converged);
+  double drooped = 0;
+  const VecX& x = simulator.positions();
+  for (Eigen::Index v = 0; v < x.size() / 3; ++v)
+    drooped = std::max(drooped, (x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
+  EXPECT_NEAR(drooped, kLargerMotion * moved, 0.1 * kLargerMotion * moved);
+  // No motion, no droop.
+  EXPECT_EQ(droop_acceleration(scene, { rest, rest }), Vec3::Zero());
 }

@@ -136,6 +136,29 @@ TEST(LearningRecipe, ACandidateReplacesTheFittedNominalOnlyBeyondNoise) {
   }
 }
 
+TEST(LearningRecipe, TheGivenNominalIsComparedButNotChosenBesideAFittedOne) {
+  // Noise-free held-out data: the given nominal predicts them exactly, the fitted nominal is off
+  // by 1 mm, a correction by 0.5 mm. With a fit the correction wins although the given nominal
+  // validates best; without one the given nominal is the reference and is chosen.
+  const Eigen::Index n = 300;
+  VecX observed(n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    observed[i] = 0.01 * std::sin(0.1 * static_cast<double>(i));
+  const std::vector<VecX> p { observed, observed.array() + 1e-3, observed.array() + 5e-4 };
+  std::vector<Candidate> c(3);
+  const CandidateKind kinds[]
+      = { CandidateKind::Nominal, CandidateKind::FittedNominal, CandidateKind::Loop };
+  for (size_t i = 0; i < c.size(); ++i) {
+    c[i].kind = kinds[i];
+    c[i].completed = true;
+    c[i].validation.rms = (p[i] - observed).norm() / std::sqrt(n / 3.0);
+  }
+  EXPECT_EQ(choose_candidate(c, { p, observed }, {}, 1, 0.0), 2);
+  EXPECT_TRUE(c[0].beats_reference); // reported as better than the fit
+  std::vector<Candidate> alone(c.begin(), c.begin() + 1);
+  EXPECT_EQ(choose_candidate(alone, { { p[0] }, observed }, {}, 0, 0.0), 0);
+}
+
 TEST(LearningRecipe, WhereTheHeldOutDataCannotResolveACandidateTheFittedNominalStays) {
   // A motion that has died out by its held-out tail: there every prediction is the truth to
   // within 2 µm, far below what σ = 1 mm over 300 coordinates can resolve (‖c − r‖ / 2σ ≪ 2).

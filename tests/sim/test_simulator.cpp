@@ -1,7 +1,6 @@
 // The backward-Euler simulator: physics it must reproduce and contracts it must keep.
 #include <elastolearn/material/analytic_correction.hpp>
 #include <elastolearn/material/neohookean.hpp>
-#include <elastolearn/material/rbf_correction.hpp>
 #include <elastolearn/mesh/vertex_selection.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 #include <elastolearn/sim/simulator.hpp>
@@ -133,38 +132,6 @@ TEST(Newton, ASolveTheProjectedTangentCannotFinishIsRetriedWithTheExactOne) {
   const double droop = -mean_tip_y(s.mesh, projected.positions());
   EXPECT_GT(droop, 0.05);
   EXPECT_LE((retried.positions() - projected.positions()).cwiseAbs().maxCoeff(), 1e-8 * droop);
-}
-
-TEST(Statics, ALearnedEnergyKeepsTheLineSearchOfTheStaticSolve) {
-  // The large-droop bar (E 2e4) as a stiffer nominal (E 8e4) with a learned correction that
-  // removes the difference exactly: the linear tail N_k = 2Δμ eₖ + Δλ Σe of the Lamé change, as
-  // an energy (energy kernels). The static solve line-searches on the nominal's energy plus the
-  // correction's and finds the E 2e4 bar's equilibrium in one load step. An energy without the
-  // correction's part (the nominal's alone) refuses Newton's steps toward the softer
-  // equilibrium, and the solve fails.
-  const auto scene
-      = [](double young) { return test::bar_scene({ .young = young, .poisson = 0.3 }); };
-  const auto soft = material::Lame::from_young_poisson(2e4, 0.3);
-  const auto stiff = material::Lame::from_young_poisson(8e4, 0.3);
-  const auto lame_change = [&](bool energy) {
-    material::RbfCorrection::Parameters p;
-    p.centres.resize(0, 3);
-    p.energy_kernels = energy;
-    p.own_slope = 2 * (soft.mu - stiff.mu) + (soft.lambda - stiff.lambda);
-    p.other_slope = soft.lambda - stiff.lambda;
-    return std::make_shared<material::RbfCorrection>(std::move(p));
-  };
-  sim::Simulator reference(scene(2e4));
-  ASSERT_TRUE(reference.solve_static(1).converged);
-  const double droop = -mean_tip_y(reference.scene().mesh, reference.positions());
-  ASSERT_GT(droop, 0.05);
-
-  auto corrected = scene(8e4);
-  corrected.material.correction = lame_change(true);
-  sim::Simulator with_energy(corrected);
-  const auto report = with_energy.solve_static(1);
-  ASSERT_TRUE(report.converged) << report.message;
-  EXPECT_LE((with_energy.positions() - reference.positions()).cwiseAbs().maxCoeff(), 1e-6 * droop);
 }
 
 TEST(Statics, CantileverTipDeflectionConvergesToBeamTheory) {

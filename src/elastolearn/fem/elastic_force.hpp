@@ -59,14 +59,10 @@ class ElasticForce final : public ForceTerm {
   void add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) override;
 
   /// Total elastic energy Σ vol (s_e Ψ(F̂) + ΔΨ(F̂)) [J], ΔΨ the correction's energy where it has
-  /// one (is_hyperelastic), else the nominal model's alone. Its gradient is minus the force at
-  /// v = 0 where is_hyperelastic().
+  /// one (material::Correction::has_elastic_energy), else the nominal model's alone; its gradient
+  /// is then minus the force at v = 0. The static solve line-searches on it only without a
+  /// correction (Simulator::solve_static).
   double elastic_energy(const VecX& x) const;
-  /// Whether the forces at rest velocity are −∇ elastic_energy: no correction, or one with an
-  /// energy (material::Correction::has_elastic_energy).
-  bool is_hyperelastic() const {
-    return !m_material.correction || m_material.correction->has_elastic_energy();
-  }
 
   /// Use the exact tangent instead of the PSD projection (for derivative tests; Newton wants
   /// the projection, which is the default).

@@ -1,17 +1,91 @@
+#include <elastolearn/core/format.hpp>
 #include <elastolearn/learn/larger_motion_check.hpp>
 #include <elastolearn/sim/amplified_scene.hpp>
 #include <elastolearn/sim/forward_run.hpp>
+#include <elastolearn/sim/simulator.hpp>
 
 namespace elastolearn::learn {
+namespace {
 
-LargerMotionCheck check_larger_motion(const sim::Scene& scene, const std::string& name) {
+/// The scene's object held still under the body acceleration `a` alone.
+sim::Scene droop_scene(sim::Scene scene, const Vec3& a) {
+  scene.initial = {};
+  scene.initial.kind = sim::InitialCondition::Kind::StaticLoad;
+  scene.gravity = a;
+  return scene;
+}
+
+/// The largest vertex displacement from `rest` in `x` [m] and, if `direction` is non-null, its
+/// unit direction.
+double largest_displacement(const VecX& x, const VecX& rest, Vec3* direction = nullptr) {
+  double largest = 0;
+  for (Eigen::Index v = 0; v < x.size() / 3; ++v) {
+    const Vec3 d = x.segment<3>(3 * v) - rest.segment<3>(3 * v);
+    if (d.norm() > largest) {
+      largest = d.norm();
+      if (direction)
+        *direction = d / largest;
+    }
+  }
+  return largest;
+}
+
+/// The static droop of `scene` under `a`: its largest displacement, or −1 if not found.
+double droop_of(const sim::Scene& scene, const Vec3& a, const VecX& rest) {
+  sim::Simulator simulator(droop_scene(scene, a));
+  if (!simulator.apply_initial_condition().converged)
+    return -1;
+  return largest_displacement(simulator.positions(), rest);
+}
+
+} // namespace
+
+Vec3 droop_acceleration(const sim::Scene& scene, const std::vector<VecX>& run) {
+  const VecX rest = flatten(scene.mesh.rest_positions());
+  double moved = 0;
+  Vec3 direction = Vec3::Zero();
+  for (const VecX& x : run) {
+    Vec3 d;
+    const double u = largest_displacement(x, rest, &d);
+    if (u > moved) {
+      moved = u;
+      direction = d;
+    }
+  }
+  if (!(moved > 0))
+    return Vec3::Zero();
+  // The linear response to a small trial load (0.1 m/s², a hundredth of a weight), scaled.
+  const Vec3 trial = 0.1 * direction;
+  const double trial_droop = droop_of(scene, trial, rest);
+  if (!(trial_droop > 0))
+    return Vec3::Zero();
+  Vec3 a = trial * (kLargerMotion * moved / trial_droop);
+  for (int halvings = 0; halvings < 4; ++halvings, a *= 0.5)
+    if (droop_of(scene, a, rest) >= 0)
+      return a;
+  return Vec3::Zero();
+}
+
+LargerMotionCheck check_larger_motion(
+    const sim::Scene& scene, const std::string& name, const Vec3& droop) {
   LargerMotionCheck out;
   out.checked = true;
   const sim::ForwardRun run = sim::simulate_positions(sim::amplified_scene(scene, kLargerMotion));
   out.completed = run.completed;
   out.first_substepped_frame = run.first_substepped_frame;
-  if (!run.completed)
-    out.message = name + ": " + run.message;
+  if (!run.completed) {
+    out.message = name + " driven " + to_text(kLargerMotion) + "× as hard (" + run.message + ")";
+    return out;
+  }
+  if (droop.isZero(0))
+    return out;
+  sim::Simulator simulator(droop_scene(scene, droop));
+  const sim::NewtonReport held = simulator.apply_initial_condition();
+  if (!held.converged) {
+    out.completed = false;
+    out.message = "the droop of " + name + " under a body load of " + to_text(droop.norm())
+        + " m/s² (" + held.message + ")";
+  }
   return out;
 }
 

@@ -205,13 +205,20 @@ struct CandidatePredictions {
   VecX training; ///< of the training observations (as recorded)
 };
 
-/// Where every correction must be stable, in the validation (Candidate::stability) and in the
-/// forward fit before it: learn::reachable_stretches around the runs of the reference material
-/// (the fitted nominal, or the given one without a fit) over every whole motion, training and
-/// held-out frames. Simulating the held-out frames uses none of their observations. Empty if a
-/// run diverged (the reference then is no candidate either).
-MatX reference_reachable_stretches(const Split& split, const fem::MaterialModel& reference,
+/// Where the reference material (the fitted nominal, or the given one without a fit) goes in
+/// every whole motion, training and held-out frames; simulating the held-out frames uses none of
+/// their observations.
+struct ReferenceReach {
+  /// Where every correction must be stable, in the validation (Candidate::stability) and in the
+  /// forward fit before it: learn::reachable_stretches around the runs. Empty if a run diverged
+  /// (the reference then is no candidate either).
+  MatX stretches;
+  std::vector<Vec3> droops; ///< per motion, droop_acceleration of its run (the larger-motion check)
+};
+
+ReferenceReach reference_reach(const Split& split, const fem::MaterialModel& reference,
     const StretchSampleOptions& sampling, const ProgressCallback& progress) {
+  ReferenceReach reach;
   std::vector<MatX> run_stretches;
   for (const HeldOut& piece : split.validation) {
     sim::Scene scene = piece.motion.scene;
@@ -221,15 +228,17 @@ MatX reference_reachable_stretches(const Split& split, const fem::MaterialModel&
       return {};
     run_stretches.push_back(
         collect_stretches(ReconstructionMesh(scene.mesh, reference), run.positions, sampling));
+    reach.droops.push_back(droop_acceleration(scene, run.positions));
   }
-  return reachable_stretches(*reference.elastic, stacked_rows(run_stretches, 3));
+  reach.stretches = reachable_stretches(*reference.elastic, stacked_rows(run_stretches, 3));
+  return reach;
 }
 
 /// The candidate's error on the held-out data (completed false if a simulation diverged) and,
-/// for a correction, its run of the larger motion. Each motion is simulated once, whole: the
-/// run predicts its training frames too (c.training).
-CandidatePredictions validate_candidate(
-    Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
+/// for a correction, its runs of the larger motion and the droop (`droops`: per motion). Each
+/// motion is simulated once, whole: the run predicts its training frames too (c.training).
+CandidatePredictions validate_candidate(Candidate& c, const Split& split,
+    const fem::MaterialModel& nominal, const std::vector<Vec3>& droops) {
   std::vector<ErrorSummary> errors, training_errors;
   std::vector<VecX> predictions, training_predictions;
   // The held-out motion's scene with the candidate's material.
@@ -260,10 +269,12 @@ CandidatePredictions validate_candidate(
   c.validation = combined_error(errors);
   c.training = combined_error(training_errors);
   if (c.correction) {
-    for (const HeldOut& piece : split.validation) {
+    for (size_t i = 0; i < split.validation.size(); ++i) {
+      const HeldOut& piece = split.validation[i];
       // The first substepped frame of the first motion that needed substeps is kept.
       const int substepped = c.larger_motion.first_substepped_frame;
-      c.larger_motion = check_larger_motion(with_candidate(piece), piece.motion.name);
+      c.larger_motion = check_larger_motion(
+          with_candidate(piece), piece.motion.name, i < droops.size() ? droops[i] : Vec3::Zero());
       if (substepped > 0)
         c.larger_motion.first_substepped_frame = substepped;
       if (!c.larger_motion.completed)
@@ -273,12 +284,12 @@ CandidatePredictions validate_candidate(
   return { stacked_rows(predictions), stacked_rows(training_predictions) };
 }
 
-/// "; failed in the motion driven 1.5× as hard (...)" when the larger motion failed, else "".
+/// "; failed in <the motion driven 1.5× as hard, or its droop> (...): not eligible" when the
+/// larger-motion check failed, else "".
 std::string describe_larger_motion(const LargerMotionCheck& larger) {
   if (larger.completed)
     return {};
-  return "; failed in the motion driven " + to_text(kLargerMotion) + "× as hard (" + larger.message
-      + "): not eligible";
+  return "; failed in " + larger.message + ": not eligible";
 }
 
 /// "; unstable at N of M stretches a motion of another kind may reach (...)" or "".
@@ -364,7 +375,11 @@ int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& val
     const bool is_reference = !ref || static_cast<int>(i) == reference;
     if (!is_reference)
       compare_with_reference(candidates, i, reference, validation, training, sigma);
-    if (!c.eligible())
+    // The given nominal beside a fitted one is reported, not chosen: it is a guess the data did
+    // not inform, and the result is promised never worse than the fit. It can beat the fit on
+    // the held-out tail where the tail is unlike the motion (a decayed tail, whose small
+    // stretches see a stretch-dependent damping at its small-stretch value).
+    if (!c.eligible() || (!is_reference && c.kind == CandidateKind::Nominal))
       continue;
     if ((is_reference || c.beats_reference)
         && (chosen < 0
@@ -520,9 +535,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     m.scene.material = result.fitted_nominal;
   // The forward fit's steps must be stable where the validation will require it, else its last
   // step, the main candidate, is not eligible and its steps were spent for nothing.
-  const MatX reachable
-      = reference_reachable_stretches(split, options.fit_parameters ? result.fitted_nominal : given,
+  const ReferenceReach reach
+      = reference_reach(split, options.fit_parameters ? result.fitted_nominal : given,
           options.loop.stretch_samples, callbacks.loop.progress);
+  const MatX& reachable = reach.stretches;
   LearningOptions loop_options = options.loop;
   loop_options.forward_fit.stability_stretches = reachable;
   // Δα₀ gives back mass damping the parameter fit put into the nominal, with the neo-Hookean
@@ -558,7 +574,7 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     const fem::MaterialModel& material
         = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
     c.unknowns = fitted_unknowns(c.correction.get());
-    CandidatePredictions p = validate_candidate(c, split, material);
+    CandidatePredictions p = validate_candidate(c, split, material, reach.droops);
     held_out.predictions.push_back(std::move(p.held_out));
     trained.predictions.push_back(std::move(p.training));
     if (c.correction && c.completed)

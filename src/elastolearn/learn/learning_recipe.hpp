@@ -12,10 +12,11 @@
 ///   3. learning loop (learning_loop.hpp) on the fitted nominal, then the forward fit, whose
 ///      steps must be stable where stage 4 will check its last one (the reachable stretches of
 ///      the fitted nominal's runs of the whole motions);
-///   4. validation: every candidate (the given nominal, the fitted nominal, the loop's
-///      corrections with the lowest training errors and the forward fit's last accepted step)
-///      simulates the held-out data; among those
-///      whose material survives a larger motion (kLargerMotion) and that beat the fitted nominal
+///   4. validation: every candidate (the given nominal, reported but not chosen beside a
+///      fitted one; the fitted nominal; the loop's corrections with the lowest training errors
+///      and the forward fit's last accepted step) simulates the held-out data; among those
+///      whose material survives a larger motion and a droop (kLargerMotion) and that beat the
+///      fitted nominal
 ///      by more than noise could (z ≥ kSignificance), the one with the smallest RMS error there
 ///      is the result; the fitted nominal if none, also where the held-out data cannot resolve
 ///      a candidate from it (a motion that has died out under noise: the training data, which
@@ -92,9 +93,10 @@ struct Candidate {
   bool completed = false; ///< the validation simulation completed
   std::string failure; ///< why it did not (names the motion and the frame); empty if it did
   ErrorSummary validation; ///< at the held-out observations [m]
-  /// Whether its material survives a larger motion of the same kind: every held-out motion's
-  /// scene driven kLargerMotion times as hard (sim::amplified_scene) must simulate to its end
-  /// (check_larger_motion; substeps allowed). A user's next motion is rarely the one recorded.
+  /// Whether its material survives a larger motion: every held-out motion's scene driven
+  /// kLargerMotion times as hard (sim::amplified_scene) must simulate to its end (substeps
+  /// allowed), and the object must hold its droop under a body load as large
+  /// (check_larger_motion, droop_acceleration). A user's next motion is rarely the one recorded.
   /// Not checked (passed) for the nominals.
   LargerMotionCheck larger_motion;
   /// Its material at the stretches a motion of another kind may reach (reachable_stretches of
@@ -218,7 +220,8 @@ void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int re
 /// noise per coordinate. Compares every other completed candidate with the reference
 /// (compare_with_reference) and returns the index of the eligible candidate with the lowest
 /// validation RMS among the reference and the candidates that beat it on the held-out data
-/// (`training`, if it holds predictions, only sets their training_significance). −1 if no
+/// (`training`, if it holds predictions, only sets their training_significance). With a
+/// reference, the given nominal (CandidateKind::Nominal) is compared but never chosen. −1 if no
 /// candidate is eligible.
 int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
     const ComparedData& training, int reference, double sigma);

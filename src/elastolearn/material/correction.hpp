@@ -46,8 +46,8 @@ class Correction {
   /// Default: none.
   virtual double mass_damping() const { return 0; }
   /// Whether the elastic part N(F̂, 0) is the gradient of an energy ΔΨ(F̂) (elastic_energy): the
-  /// corrected material is then hyperelastic, and a static solve can line-search on its energy
-  /// (fem::ElasticForce::elastic_energy). Default: no.
+  /// corrected material is then hyperelastic, and fem::ElasticForce::elastic_energy counts it.
+  /// Default: no.
   virtual bool has_elastic_energy() const { return false; }
   /// ΔΨ(F̂) [J/m³] up to a constant, with ∇ΔΨ = N(F̂, 0). Only where has_elastic_energy();
   /// throws InputError otherwise.

@@ -270,9 +270,7 @@ NewtonReport Simulator::solve_static(int load_steps) {
     state_from(u);
     sum_jacobians(m_x_new, zero, m_time, 1.0, 0.0);
   };
-  // With an energy the line search keeps Newton from overshooting where a learned correction
-  // softens the material; statics has no mass term to do that.
-  if (m_elastic->is_hyperelastic() && m_extra_terms.empty())
+  if (!m_scene.material.correction && m_extra_terms.empty())
     problem.energy = [&](const VecX& u) {
       state_from(u);
       m_force.setZero(m_x_new.size());
