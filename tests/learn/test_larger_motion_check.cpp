@@ -41,6 +41,14 @@ double larger_motion_strain(const sim::Scene& scene) {
   return std::max(s.maxCoeff() - 1, 1 - s.minCoeff());
 }
 
+/// The largest vertex displacement of `x` from `rest` [m].
+double largest_displacement(const VecX& x, const VecX& rest) {
+  double largest = 0;
+  for (Eigen::Index v = 0; v < x.size() / 3; ++v)
+    largest = std::max(largest, (x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
+  return largest;
+}
+
 } // namespace
 
 TEST(LargerMotionCheck, PassesAStableCorrectionWhoseRunNeedsSubsteps) {
@@ -107,8 +115,7 @@ TEST(LargerMotionCheck, TheDroopLoadMakesTheReferenceDroopAsFarAsTheLargerMotion
   const VecX rest = flatten(scene.mesh.rest_positions());
   double moved = 0;
   for (const VecX& x : run.positions)
-    for (Eigen::Index v = 0; v < x.size() / 3; ++v)
-      moved = std::max(moved, (x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
+    moved = std::max(moved, largest_displacement(x, rest));
   ASSERT_GT(moved, 0.005);
   const Vec3 a = droop_acceleration(scene, run.positions);
   ASSERT_GT(a.norm(), 0);
@@ -119,10 +126,7 @@ TEST(LargerMotionCheck, TheDroopLoadMakesTheReferenceDroopAsFarAsTheLargerMotion
   held.gravity = a;
   sim::Simulator simulator(held);
   ASSERT_TRUE(simulator.apply_initial_condition().converged);
-  double drooped = 0;
-  const VecX& x = simulator.positions();
-  for (Eigen::Index v = 0; v < x.size() / 3; ++v)
-    drooped = std::max(drooped, (x.segment<3>(3 * v) - rest.segment<3>(3 * v)).norm());
+  const double drooped = largest_displacement(simulator.positions(), rest);
   EXPECT_NEAR(drooped, kLargerMotion * moved, 0.1 * kLargerMotion * moved);
   // No motion, no droop.
   EXPECT_EQ(droop_acceleration(scene, { rest, rest }), Vec3::Zero());
