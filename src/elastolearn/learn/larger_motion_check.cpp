@@ -7,14 +7,6 @@
 namespace elastolearn::learn {
 namespace {
 
-/// The scene's object held still under the body acceleration `a` alone.
-sim::Scene droop_scene(sim::Scene scene, const Vec3& a) {
-  scene.initial = {};
-  scene.initial.kind = sim::InitialCondition::Kind::StaticLoad;
-  scene.gravity = a;
-  return scene;
-}
-
 /// The largest vertex displacement from `rest` in `x` [m] and, if `direction` is non-null, its
 /// unit direction.
 double largest_displacement(const VecX& x, const VecX& rest, Vec3* direction = nullptr) {
@@ -30,12 +22,18 @@ double largest_displacement(const VecX& x, const VecX& rest, Vec3* direction = n
   return largest;
 }
 
-/// The static droop of `scene` under `a`: its largest displacement, or −1 if not found.
-double droop_of(const sim::Scene& scene, const Vec3& a, const VecX& rest) {
-  sim::Simulator simulator(droop_scene(scene, a));
-  if (!simulator.apply_initial_condition().converged)
-    return -1;
-  return largest_displacement(simulator.positions(), rest);
+/// The static equilibrium of the scene's object under the body acceleration `a` alone; where it
+/// is found and `droop` is non-null, *droop = its largest displacement from `rest`.
+sim::NewtonReport hold_droop(
+    sim::Scene scene, const Vec3& a, const VecX& rest = {}, double* droop = nullptr) {
+  scene.initial = {};
+  scene.initial.kind = sim::InitialCondition::Kind::StaticLoad;
+  scene.gravity = a;
+  sim::Simulator simulator(scene);
+  const sim::NewtonReport held = simulator.apply_initial_condition();
+  if (held.converged && droop)
+    *droop = largest_displacement(simulator.positions(), rest);
+  return held;
 }
 
 } // namespace
@@ -56,12 +54,12 @@ Vec3 droop_acceleration(const sim::Scene& scene, const std::vector<VecX>& run) {
     return Vec3::Zero();
   // The linear response to a small trial load (0.1 m/s², a hundredth of a weight), scaled.
   const Vec3 trial = 0.1 * direction;
-  const double trial_droop = droop_of(scene, trial, rest);
-  if (!(trial_droop > 0))
+  double trial_droop = 0;
+  if (!hold_droop(scene, trial, rest, &trial_droop).converged || !(trial_droop > 0))
     return Vec3::Zero();
   Vec3 a = trial * (kLargerMotion * moved / trial_droop);
   for (int halvings = 0; halvings < 4; ++halvings, a *= 0.5)
-    if (droop_of(scene, a, rest) >= 0)
+    if (hold_droop(scene, a).converged)
       return a;
   return Vec3::Zero();
 }
@@ -79,8 +77,7 @@ LargerMotionCheck check_larger_motion(
   }
   if (droop.isZero(0))
     return out;
-  sim::Simulator simulator(droop_scene(scene, droop));
-  const sim::NewtonReport held = simulator.apply_initial_condition();
+  const sim::NewtonReport held = hold_droop(scene, droop);
   if (!held.converged) {
     out.completed = false;
     out.message = "the droop of " + name + " under a body load of " + to_text(droop.norm())
