@@ -4,6 +4,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/learn/learning_recipe.hpp>
 #include <elastolearn/learn/trajectory_error.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
 #include <elastolearn/observe/visible_vertices.hpp>
 #include <elastolearn/sim/forward_run.hpp>
 
@@ -134,6 +135,53 @@ TEST(LearningRecipe, ACandidateReplacesTheFittedNominalOnlyBeyondNoise) {
     EXPECT_FALSE(c[2].eligible());
     EXPECT_EQ(choose_candidate(c, { p, observed }, {}, 0, sigma), 0);
   }
+}
+
+TEST(LearningRecipe, TheLargerMotionIsCheckedFromTheBestCandidateDownUntilOnePasses) {
+  // Noise-free held-out data; the fitted nominal is off by 1 mm, four corrections by 0.1, 0.2,
+  // 0.3 and 0.4 mm. The two best fail the larger motion: the third is chosen, and the fourth,
+  // which the choice never reaches, is not checked (nor are the nominals).
+  const Eigen::Index n = 300;
+  VecX observed(n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    observed[i] = 0.01 * std::sin(0.1 * static_cast<double>(i));
+  const double offsets[] = { 1e-3, 1e-4, 2e-4, 3e-4, 4e-4 };
+  std::vector<VecX> p;
+  std::vector<Candidate> c(5);
+  material::RbfCorrection::Parameters none; // the checks below are stand-ins: any correction
+  none.centres = MatX::Ones(1, 3);
+  none.weights = VecX::Zero(1);
+  const auto correction = std::make_shared<const material::RbfCorrection>(none);
+  for (size_t i = 0; i < c.size(); ++i) {
+    p.push_back(observed.array() + offsets[i]);
+    c[i].kind = i == 0 ? CandidateKind::FittedNominal : CandidateKind::Loop;
+    c[i].iteration = static_cast<int>(i) - 1;
+    c[i].correction = i == 0 ? nullptr : correction;
+    c[i].completed = true;
+    c[i].validation.rms = (p[i] - observed).norm() / std::sqrt(n / 3.0);
+  }
+  std::vector<int> checked;
+  const int chosen = choose_checked_candidate(c, { p, observed }, {}, 0, 0.0, [&](Candidate& k) {
+    checked.push_back(k.iteration);
+    k.larger_motion.completed = k.iteration >= 2;
+  });
+  EXPECT_EQ(chosen, 3);
+  EXPECT_EQ(checked, (std::vector<int> { 0, 1, 2 }));
+  EXPECT_FALSE(c[0].larger_motion.checked);
+  EXPECT_TRUE(c[1].larger_motion.checked && !c[1].eligible());
+  EXPECT_TRUE(c[3].larger_motion.checked && c[3].eligible());
+  EXPECT_FALSE(c[4].larger_motion.checked);
+  // Every correction failing: the fitted nominal, after each was checked once.
+  for (Candidate& k : c)
+    k.larger_motion = {};
+  checked.clear();
+  EXPECT_EQ(choose_checked_candidate(c, { p, observed }, {}, 0, 0.0,
+                [&](Candidate& k) {
+                  checked.push_back(k.iteration);
+                  k.larger_motion.completed = false;
+                }),
+      0);
+  EXPECT_EQ(checked, (std::vector<int> { 0, 1, 2, 3 }));
 }
 
 TEST(LearningRecipe, TheGivenNominalIsComparedButNotChosenBesideAFittedOne) {
@@ -302,6 +350,10 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
   EXPECT_TRUE(r.choice().eligible());
   // A network replaces its teacher within kNetworkTolerance of its validation error.
   const double slack = r.choice().kind == CandidateKind::Network ? 1 + kNetworkTolerance : 1;
+  // Stage 4's choice (a network replaces it in stage 5).
+  const Candidate& stage4_choice = r.choice().kind == CandidateKind::Network
+      ? r.candidates[static_cast<size_t>(r.choice().teacher)]
+      : r.choice();
   for (const Candidate& k : r.candidates) {
     if (k.eligible()
         && (k.kind == CandidateKind::FittedNominal || k.significance >= kSignificance)) {
@@ -311,7 +363,16 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
       EXPECT_FALSE(k.larger_motion.checked) << "the nominals are not checked";
       EXPECT_EQ(k.stability.samples, 0) << "the nominals are not checked";
     } else if (k.completed) {
-      EXPECT_TRUE(k.larger_motion.checked);
+      // The larger motion is checked from the best candidate down until one passes: on the
+      // chosen one, and on every candidate the choice would have preferred (which failed it).
+      const bool preferred = k.kind != CandidateKind::Network && k.stability.stable()
+          && k.beats_reference && k.validation.rms < stage4_choice.validation.rms;
+      if (&k == &r.choice() || &k == &stage4_choice || preferred) {
+        EXPECT_TRUE(k.larger_motion.checked);
+      }
+      if (preferred) {
+        EXPECT_FALSE(k.larger_motion.completed) << "a better candidate that passed is chosen";
+      }
       // Checked where a motion of another kind may go (the fitted nominal's reachable grid).
       EXPECT_GT(k.stability.samples, 0);
       // The forward fit only took steps stable there.

@@ -28,7 +28,7 @@ nlohmann::json network_to_json(const learn::NetworkDistillation& d, bool chosen)
     { "seconds_training", d.seconds_training } };
 }
 
-/// null for a candidate not checked (the nominals).
+/// null for a candidate not checked (the nominals, and a correction ranked below the chosen one).
 nlohmann::json larger_motion_to_json(const learn::LargerMotionCheck& l) {
   if (!l.checked)
     return nullptr;
@@ -55,7 +55,13 @@ nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
         { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
         { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr },
         { "larger_motion", larger_motion_to_json(c.larger_motion) },
-        { "reachable_stretches", stability_to_json(c.stability) }, { "eligible", c.eligible() },
+        { "reachable_stretches",
+            stability_to_json(c.stability) }, // null: a correction ranked below the chosen
+                                              // candidate, whose larger motion was not run
+        { "eligible",
+            c.correction && c.completed && !c.larger_motion.checked
+                ? nlohmann::json(nullptr)
+                : nlohmann::json(c.eligible()) },
         // null: infinite (noise σ = 0), its sign that of the validation errors' difference
         { "significance", finite_or_null(c.significance) },
         // the z an exactly right candidate would reach on the held-out data; null: infinite

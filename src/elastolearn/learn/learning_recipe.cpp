@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 namespace elastolearn::learn {
 
@@ -213,7 +214,7 @@ struct ReferenceReach {
   /// forward fit before it: learn::reachable_stretches around the runs. Empty if a run diverged
   /// (the reference then is no candidate either).
   MatX stretches;
-  std::vector<Vec3> droops; ///< per motion, droop_acceleration of its run (the larger-motion check)
+  std::vector<std::vector<VecX>> runs; ///< per held-out motion, the reference's positions
 };
 
 ReferenceReach reference_reach(const Split& split, const fem::MaterialModel& reference,
@@ -223,34 +224,48 @@ ReferenceReach reference_reach(const Split& split, const fem::MaterialModel& ref
   for (const HeldOut& piece : split.validation) {
     sim::Scene scene = piece.motion.scene;
     scene.material = reference;
-    const sim::ForwardRun run = sim::simulate_positions(scene, progress);
+    sim::ForwardRun run = sim::simulate_positions(scene, progress);
     if (!run.completed)
       return {};
     run_stretches.push_back(
         collect_stretches(ReconstructionMesh(scene.mesh, reference), run.positions, sampling));
-    reach.droops.push_back(droop_acceleration(scene, run.positions));
+    reach.runs.push_back(std::move(run.positions));
   }
   reach.stretches = reachable_stretches(*reference.elastic, stacked_rows(run_stretches, 3));
   return reach;
 }
 
-/// The candidate's error on the held-out data (completed false if a simulation diverged) and,
-/// for a correction, its runs of the larger motion and the droop (`droops`: per motion). Each
+/// Per held-out motion, droop_acceleration of the reference's run (`reach.runs`; none where the
+/// reference diverged).
+std::vector<Vec3> droop_accelerations(
+    const Split& split, const fem::MaterialModel& reference, const ReferenceReach& reach) {
+  std::vector<Vec3> droops;
+  for (size_t i = 0; i < reach.runs.size(); ++i) {
+    sim::Scene scene = split.validation[i].motion.scene;
+    scene.material = reference;
+    droops.push_back(droop_acceleration(scene, reach.runs[i]));
+  }
+  return droops;
+}
+
+/// `material` (the nominal of candidate c) with c's correction, in the held-out motion's scene.
+sim::Scene with_candidate(
+    const HeldOut& piece, const fem::MaterialModel& nominal, const Candidate& c) {
+  sim::Scene scene = piece.motion.scene;
+  scene.material = nominal;
+  scene.material.correction = c.correction;
+  return scene;
+}
+
+/// The candidate's error on the held-out data (completed false if a simulation diverged). Each
 /// motion is simulated once, whole: the run predicts its training frames too (c.training).
-CandidatePredictions validate_candidate(Candidate& c, const Split& split,
-    const fem::MaterialModel& nominal, const std::vector<Vec3>& droops) {
+CandidatePredictions validate_candidate(
+    Candidate& c, const Split& split, const fem::MaterialModel& nominal) {
   std::vector<ErrorSummary> errors, training_errors;
   std::vector<VecX> predictions, training_predictions;
-  // The held-out motion's scene with the candidate's material.
-  const auto with_candidate = [&](const HeldOut& piece) {
-    sim::Scene scene = piece.motion.scene;
-    scene.material = nominal;
-    scene.material.correction = c.correction;
-    return scene;
-  };
   for (size_t i = 0; i < split.validation.size(); ++i) {
     const HeldOut& piece = split.validation[i];
-    const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece));
+    const sim::ForwardRun run = sim::simulate_positions(with_candidate(piece, nominal, c));
     c.completed = run.completed;
     if (!run.completed) {
       c.failure = piece.motion.name + ": " + run.message;
@@ -268,20 +283,24 @@ CandidatePredictions validate_candidate(Candidate& c, const Split& split,
   }
   c.validation = combined_error(errors);
   c.training = combined_error(training_errors);
-  if (c.correction) {
-    for (size_t i = 0; i < split.validation.size(); ++i) {
-      const HeldOut& piece = split.validation[i];
-      // The first substepped frame of the first motion that needed substeps is kept.
-      const int substepped = c.larger_motion.first_substepped_frame;
-      c.larger_motion = check_larger_motion(
-          with_candidate(piece), piece.motion.name, i < droops.size() ? droops[i] : Vec3::Zero());
-      if (substepped > 0)
-        c.larger_motion.first_substepped_frame = substepped;
-      if (!c.larger_motion.completed)
-        break;
-    }
-  }
   return { stacked_rows(predictions), stacked_rows(training_predictions) };
+}
+
+/// The larger-motion check of a correction candidate (Candidate::larger_motion) on every
+/// held-out motion, `droops` the droop loads per motion (none past its end).
+void check_candidate_larger_motion(Candidate& c, const Split& split,
+    const fem::MaterialModel& nominal, const std::vector<Vec3>& droops) {
+  for (size_t i = 0; i < split.validation.size(); ++i) {
+    const HeldOut& piece = split.validation[i];
+    // The first substepped frame of the first motion that needed substeps is kept.
+    const int substepped = c.larger_motion.first_substepped_frame;
+    c.larger_motion = check_larger_motion(with_candidate(piece, nominal, c), piece.motion.name,
+        i < droops.size() ? droops[i] : Vec3::Zero());
+    if (substepped > 0)
+      c.larger_motion.first_substepped_frame = substepped;
+    if (!c.larger_motion.completed)
+      break;
+  }
 }
 
 /// "; failed in <the motion driven 1.5× as hard, or its droop> (...): not eligible" when the
@@ -387,6 +406,21 @@ int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& val
       chosen = static_cast<int>(i);
   }
   return chosen;
+}
+
+int choose_checked_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
+    const ComparedData& training, int reference, double sigma,
+    const std::function<void(Candidate&)>& check_larger_motion) {
+  for (;;) {
+    const int chosen = choose_candidate(candidates, validation, training, reference, sigma);
+    if (chosen < 0)
+      return chosen;
+    Candidate& c = candidates[static_cast<size_t>(chosen)];
+    if (!c.correction || c.larger_motion.checked)
+      return chosen;
+    check_larger_motion(c); // if it fails, the next choice is another candidate
+    c.larger_motion.checked = true;
+  }
 }
 
 /// Stages 0 and 1: σ (given or estimated), the split into training and held-out data, and the
@@ -565,23 +599,29 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
                      .num_unknowns()
                : 0;
   };
+  const auto nominal_of = [&](CandidateKind kind) -> const fem::MaterialModel& {
+    return kind == CandidateKind::Nominal ? given : result.fitted_nominal;
+  };
+  const auto label_of = [&](const Candidate& c) {
+    std::string label = "candidate " + to_string(c.kind);
+    if (c.iteration >= 0) // append, not " " + to_string(): GCC 12 warns -Wrestrict on that wrongly
+      label.append(" ").append(std::to_string(c.iteration));
+    return label;
+  };
   auto add = [&](CandidateKind kind, int iteration,
                  std::shared_ptr<const material::Correction> correction) {
     Candidate c;
     c.kind = kind;
     c.iteration = iteration;
     c.correction = std::move(correction);
-    const fem::MaterialModel& material
-        = kind == CandidateKind::Nominal ? given : result.fitted_nominal;
+    const fem::MaterialModel& material = nominal_of(kind);
     c.unknowns = fitted_unknowns(c.correction.get());
-    CandidatePredictions p = validate_candidate(c, split, material, reach.droops);
+    CandidatePredictions p = validate_candidate(c, split, material);
     held_out.predictions.push_back(std::move(p.held_out));
     trained.predictions.push_back(std::move(p.training));
     if (c.correction && c.completed)
       c.stability = material_stability(*material.elastic, c.correction.get(), reachable);
-    std::string label = "candidate " + to_string(kind);
-    if (iteration >= 0) // append, not " " + to_string(): GCC 12 warns -Wrestrict on that wrongly
-      label.append(" ").append(std::to_string(iteration));
+    std::string label = label_of(c);
     if (c.correction && c.correction->mass_damping() != 0) // the damping it learned
       label.append(format(" (Δα₀ %+.3g 1/s)", c.correction->mass_damping()));
     say(callbacks,
@@ -589,9 +629,23 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
             + (c.completed ? format(": validation error rms %.4f %%, max %.4f %%",
                    100 * c.validation.rms / size, 100 * c.validation.max / size)
                            : ": its simulation of the held-out data diverged (" + c.failure + ")")
-            + (c.completed ? describe_larger_motion(c.larger_motion) : "")
             + describe_instability(c.stability));
     result.candidates.push_back(std::move(c));
+  };
+  // The larger-motion check costs a simulation of every motion driven harder and a static solve,
+  // so it runs only on a correction the choice would take (and the droop loads are computed for
+  // the first such): the candidates that rank below the chosen one are not checked.
+  std::optional<std::vector<Vec3>> droops;
+  const auto check = [&](Candidate& c) {
+    const fem::MaterialModel& reference = options.fit_parameters ? result.fitted_nominal : given;
+    if (!droops)
+      droops = droop_accelerations(split, reference, reach);
+    check_candidate_larger_motion(c, split, nominal_of(c.kind), *droops);
+    say(callbacks,
+        label_of(c)
+            + (c.larger_motion.completed ? format(
+                   ": survives its motions driven %.3g× as hard and their droops", kLargerMotion)
+                                         : describe_larger_motion(c.larger_motion)));
   };
   add(CandidateKind::Nominal, -1, nullptr);
   if (options.fit_parameters)
@@ -632,8 +686,8 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     trained_observed.push_back(flat_positions(m.observed));
   held_out.observed = stacked_rows(held_out_observed);
   trained.observed = stacked_rows(trained_observed);
-  result.chosen
-      = choose_candidate(result.candidates, held_out, trained, reference, result.noise.sigma);
+  result.chosen = choose_checked_candidate(
+      result.candidates, held_out, trained, reference, result.noise.sigma, check);
   if (result.chosen < 0)
     throw InputError(split.validation.front().motion.name,
         "no candidate, not even the nominal material, simulates the held-out data");
@@ -658,9 +712,15 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
             trained, result.noise.sigma);
       network.gain_over_teacher = paired_significance(held_out.predictions[static_cast<size_t>(t)],
           held_out.predictions.back(), held_out.observed, result.noise.sigma);
-      if (network_replaces_teacher(
-              network, result.candidates[static_cast<size_t>(t)], has_reference))
-        result.chosen = static_cast<int>(result.candidates.size()) - 1;
+      const auto replaces = [&] {
+        return network_replaces_teacher(
+            network, result.candidates[static_cast<size_t>(t)], has_reference);
+      };
+      if (replaces()) {
+        check(network);
+        if (replaces())
+          result.chosen = static_cast<int>(result.candidates.size()) - 1;
+      }
     }
   }
   result.seconds = seconds_since(start);

@@ -15,13 +15,13 @@
 ///   4. validation: every candidate (the given nominal, reported but not chosen beside a
 ///      fitted one; the fitted nominal; the loop's corrections with the lowest training errors
 ///      and the forward fit's last accepted step) simulates the held-out data; among those
-///      whose material survives a larger motion and a droop (kLargerMotion) and that beat the
-///      fitted nominal
-///      by more than noise could (z ≥ kSignificance), the one with the smallest RMS error there
-///      is the result; the fitted nominal if none, also where the held-out data cannot resolve
-///      a candidate from it (a motion that has died out under noise: the training data, which
-///      cannot see how a candidate forecasts, are compared and reported, not used;
-///      choose_candidate);
+///      that are stable where another motion may go and beat the fitted nominal by more than
+///      noise could (z ≥ kSignificance), the one with the smallest RMS error there whose material
+///      survives a larger motion and a droop (kLargerMotion; checked in that order, the best
+///      first, until one passes) is the result; the fitted nominal if none, also where the
+///      held-out data cannot resolve a candidate from it (a motion that has died out under
+///      noise: the training data, which cannot see how a candidate forecasts, are compared and
+///      reported, not used; choose_candidate);
 ///   5. network: a chosen correction is distilled into the network correction
 ///      (network_distillation.hpp), validated the same way, and replaces its teacher when it is
 ///      eligible, beats the fitted nominal by kSignificance, and is as good as its teacher
@@ -39,6 +39,7 @@
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>
 
+#include <functional>
 #include <limits>
 #include <memory>
 #include <span>
@@ -97,7 +98,9 @@ struct Candidate {
   /// kLargerMotion times as hard (sim::amplified_scene) must simulate to its end (substeps
   /// allowed), and the object must hold its droop under a body load as large
   /// (check_larger_motion, droop_acceleration). A user's next motion is rarely the one recorded.
-  /// Not checked (passed) for the nominals.
+  /// Not checked (passed) for the nominals, nor for a correction the choice did not reach: the
+  /// check costs a harder run of every motion and a static solve, so it runs on the best
+  /// candidate first and stops at the first that passes (learn_material).
   LargerMotionCheck larger_motion;
   /// Its material at the stretches a motion of another kind may reach (reachable_stretches of
   /// the fitted nominal's runs of the held-out motions): a correction must be stable there. Not
@@ -130,8 +133,8 @@ struct Candidate {
   /// kSignificance) and it gains there (significance ≥ kSignificance). False for the reference
   /// itself.
   bool beats_reference = false;
-  /// Eligible for the choice: its validation completed, it survives a larger motion and it is
-  /// stable where a motion of another kind may go.
+  /// Eligible for the choice: its validation completed, it survives a larger motion (or was not
+  /// checked for it) and it is stable where a motion of another kind may go.
   bool eligible() const { return completed && larger_motion.completed && stability.stable(); }
 };
 
@@ -225,6 +228,15 @@ void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int re
 /// candidate is eligible.
 int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
     const ComparedData& training, int reference, double sigma);
+
+/// Stage 4's choice with the larger-motion check run lazily: choose_candidate, and while the
+/// choice is a correction not yet checked, `check_larger_motion` sets its
+/// Candidate::larger_motion and the choice is made again (the candidate is then checked, and
+/// ineligible if it failed). Only the chosen correction and those the choice would have
+/// preferred are checked, each once. −1 if no candidate is eligible.
+int choose_checked_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
+    const ComparedData& training, int reference, double sigma,
+    const std::function<void(Candidate&)>& check_larger_motion);
 
 /// Run all stages (from `resume` on, if given: stage 2 is then not repeated). Returns with
 /// `interrupted` set if callbacks.loop.interrupted asked to stop (the last checkpoint holds the
