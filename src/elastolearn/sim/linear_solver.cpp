@@ -4,6 +4,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cstdlib>
 #include <tbb/parallel_for.h>
@@ -71,8 +72,14 @@ class DirectSolver final : public LinearSolver {
   }
   bool factorize(const fem::SparseMatrix& A) override {
     if (Type == LinearSolverType::Cholmod && openblas_set_num_threads
-        && !std::getenv("OPENBLAS_NUM_THREADS"))
-      openblas_set_num_threads(m_threaded_blas ? tbb::this_task_arena::max_concurrency() : 1);
+        && !std::getenv("OPENBLAS_NUM_THREADS")) {
+      // Set only on a change: OpenBLAS's setting is global and not thread-safe, and two solvers
+      // of the same system can factorise at once (sim::RunAhead beside the forward fit's).
+      static std::atomic<int> s_blas_threads { 0 };
+      const int threads = m_threaded_blas ? tbb::this_task_arena::max_concurrency() : 1;
+      if (s_blas_threads.exchange(threads) != threads)
+        openblas_set_num_threads(threads);
+    }
     m_factor.factorize(A);
     return m_factor.info() == Eigen::Success;
   }
