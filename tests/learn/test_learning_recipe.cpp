@@ -382,7 +382,8 @@ TEST(LearningRecipe, ChoosesTheCandidateWithTheLowestValidationErrorNeverAboveTh
     }
   }
   EXPECT_LE(r.choice().validation.rms, r.candidates[1].validation.rms);
-  // The forward fit's candidate is its last accepted step.
+  // The forward fit's candidates are its last accepted step and those before it on its plateau
+  // (training RMS within 1 % of the last's; on this noise-free case: none).
   std::vector<int> accepted, validated;
   for (const IterationRecord& h : r.loop.history)
     if (const ForwardFitRecord* step = forward_fit_of(h); step && step->accepted)
@@ -512,6 +513,25 @@ TEST(LearningRecipe, NoisyCaptureLearnsWithoutDivergenceAndBeatsTheNominal) {
         << "iteration " << iteration_of(it) << " diverged: " << forward_of(it).message();
   for (const Candidate& k : r.candidates)
     EXPECT_TRUE(k.completed) << to_string(k.kind) << " " << k.iteration;
+  // The forward fit's steps validated: the last accepted one, and those before it on its
+  // plateau (training RMS within 1 % of the last's), where the held-out data choose the stop.
+  std::vector<int> accepted, expected, validated;
+  for (const IterationRecord& h : r.loop.history)
+    if (const ForwardFitRecord* step = forward_fit_of(h); step && step->accepted)
+      accepted.push_back(step->iteration);
+  ASSERT_FALSE(accepted.empty()) << "the forward fit improved on the loop";
+  double last_rms = 0;
+  for (const IterationRecord& h : r.loop.history)
+    if (iteration_of(h) == accepted.back())
+      last_rms = forward_of(h).error().rms;
+  for (const IterationRecord& h : r.loop.history)
+    if (const ForwardFitRecord* step = forward_fit_of(h);
+        step && step->accepted && forward_of(h).error().rms <= 1.01 * last_rms)
+      expected.push_back(step->iteration);
+  for (const Candidate& k : r.candidates)
+    if (k.kind == CandidateKind::ForwardFit)
+      validated.push_back(k.iteration);
+  EXPECT_EQ(validated, expected);
   const double nominal = test_error(c.nominal.material, c.truth_swing);
   const double learned = test_error(r.material(c.nominal.material), c.truth_swing);
   ASSERT_GE(learned, 0) << "the learned material's test simulation diverged";

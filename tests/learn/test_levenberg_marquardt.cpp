@@ -276,6 +276,43 @@ TEST(LevenbergMarquardt, StopsAtTheBudgetsAndWhenTheProblemSaysSo) {
   EXPECT_EQ(s.iterations, 0);
 }
 
+TEST(LevenbergMarquardt, TheToleranceMeasuresADecreaseAgainstTheCostAboveItsFloor) {
+  // r = (atan x, 100): a residual of 100 no x fits (noise), and from x = 2 the learnable part
+  // atan²(2) ≈ 1.23 of a cost of 10⁴. Against the whole cost the first accepted step looks
+  // negligible (< 1 %) and ends the solve far from the minimum; against the cost above the
+  // floor of 10⁴ the solve goes on to it.
+  const auto noisy = [] {
+    return LeastSquares { [](const VecX& x) { return Eigen::Vector2d(std::atan(x[0]), 100.0); },
+      [](const VecX& x) {
+        MatX j = MatX::Zero(2, 1);
+        j(0, 0) = 1 / (1 + x[0] * x[0]);
+        return j;
+      },
+      VecX::Constant(1, 2.0) };
+  };
+  LeastSquares whole = noisy();
+  const auto stopped = whole.solve({ .function_tolerance = 0.01 });
+  EXPECT_EQ(stopped.stop, LevenbergMarquardtStop::converged);
+  EXPECT_EQ(stopped.accepted, 1);
+  EXPECT_GT(std::abs(whole.x[0]), 0.05);
+
+  LeastSquares above = noisy();
+  // (It ends where the cost's round-off, ~10⁻¹² of 10⁴, hides further decreases.)
+  const auto solved = above.solve({ .function_tolerance = 0.01, .cost_floor = 1e4 });
+  EXPECT_GT(solved.accepted, 1);
+  EXPECT_LT(std::abs(above.x[0]), 1e-3);
+
+  // A floor above the cost: the tolerance never ends the solve.
+  LeastSquares below = noisy();
+  const auto s = below.solve({ .max_steps = 20, .function_tolerance = 0.01, .cost_floor = 2e4 });
+  EXPECT_NE(s.stop, LevenbergMarquardtStop::converged);
+  EXPECT_EQ(below.steps.front().relative_decrease, 0); // rejected: the undamped overshoot
+  for (const auto& step : below.steps)
+    if (step.accepted) {
+      EXPECT_EQ(step.relative_decrease, kInf);
+    }
+}
+
 TEST(LevenbergMarquardt, RejectsBadOptions) {
   const auto bad = [](auto change) {
     LevenbergMarquardtOptions o;
@@ -293,6 +330,8 @@ TEST(LevenbergMarquardt, RejectsBadOptions) {
   bad([](auto& o) { o.failed_damping_increase = std::nan(""); });
   bad([](auto& o) { o.max_step = 0; });
   bad([](auto& o) { o.function_tolerance = -1; });
+  bad([](auto& o) { o.cost_floor = -1; });
+  bad([](auto& o) { o.cost_floor = kInf; });
 }
 
 } // namespace

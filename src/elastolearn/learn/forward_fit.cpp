@@ -50,6 +50,8 @@ void ForwardFitOptions::validate() const {
     throw InputError("forward_fit.damping", "must be finite and > 0");
   if (!std::isfinite(function_tolerance) || function_tolerance < 0)
     throw InputError("forward_fit.function_tolerance", "must be finite and ≥ 0");
+  if (!std::isfinite(noise) || noise < 0)
+    throw InputError("forward_fit.noise", "must be finite and ≥ 0");
   if (!std::isfinite(damping_prior) || damping_prior < 0)
     throw InputError("forward_fit.damping_prior", "must be finite and ≥ 0");
   if (!std::isfinite(elastic_prior) || elastic_prior < 0)
@@ -393,7 +395,8 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
           .min_damping = 0,
           .damping_increase = 10,
           .failed_damping_increase = 10,
-          .function_tolerance = options.function_tolerance });
+          .function_tolerance = options.function_tolerance,
+          .cost_floor = 3 * options.noise * options.noise * double(current.error.samples) });
   result.accepted = summary.accepted;
   result.converged = summary.stop == LevenbergMarquardtStop::converged;
   result.seconds = seconds_since(started);

@@ -14,7 +14,7 @@
 ///      the fitted nominal's runs of the whole motions);
 ///   4. validation: every candidate (the given nominal, reported but not chosen beside a
 ///      fitted one; the fitted nominal; the loop's corrections with the lowest training errors
-///      and the forward fit's last accepted step) simulates the held-out data; among those
+///      and the forward fit's last three accepted steps) simulates the held-out data; among those
 ///      that are stable where another motion may go and beat the fitted nominal by more than
 ///      noise could (z ≥ kSignificance), the one with the smallest RMS error there whose material
 ///      survives a larger motion and a droop (kLargerMotion; checked in that order, the best

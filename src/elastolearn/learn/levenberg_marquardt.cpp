@@ -149,6 +149,8 @@ void LevenbergMarquardtOptions::validate() const {
   if (!(function_tolerance >= 0 && std::isfinite(function_tolerance)))
     levenberg_marquardt_error(
         "function_tolerance", "must be finite and ≥ 0, got " + to_text(function_tolerance));
+  if (!(cost_floor >= 0 && std::isfinite(cost_floor)))
+    levenberg_marquardt_error("cost_floor", "must be finite and ≥ 0, got " + to_text(cost_floor));
 }
 
 LevenbergMarquardtSummary levenberg_marquardt(
@@ -189,7 +191,9 @@ LevenbergMarquardtSummary levenberg_marquardt(
       step.accepted = trial.completed && trial.cost < system.cost();
       step.cost = trial.completed ? trial.cost : std::numeric_limits<double>::infinity();
       if (step.accepted) {
-        step.relative_decrease = (system.cost() - trial.cost) / system.cost();
+        const double excess = system.cost() - options.cost_floor;
+        step.relative_decrease = excess > 0 ? (system.cost() - trial.cost) / excess
+                                            : std::numeric_limits<double>::infinity();
         summary.relative_decrease = step.relative_decrease;
         ++summary.accepted;
         mu = std::max(mu / options.damping_decrease, options.min_damping);

@@ -45,9 +45,14 @@ struct LevenbergMarquardtOptions {
   /// Largest |δ_i| of a trial step, in the unknowns' units (> 0; ∞ = no limit): a longer step
   /// is scaled down to it, keeping its direction.
   double max_step = std::numeric_limits<double>::infinity();
-  /// Stop when an accepted step lowers the cost by less than this fraction of it (≥ 0; 0 never
-  /// stops).
+  /// Stop when an accepted step lowers the cost by less than this fraction of its excess over
+  /// cost_floor (≥ 0; 0 never stops).
   double function_tolerance = 0;
+  /// The cost no point can be expected to go below (≥ 0, finite): for least squares on noisy
+  /// data, the noise's expected share. function_tolerance measures a decrease against the cost
+  /// above it, so that noise no model fits does not make every step look small; at or below
+  /// the floor the tolerance never stops the solve.
+  double cost_floor = 0;
   /// Throws InputError("levenberg_marquardt.<field>", ...) for an out-of-range field.
   void validate() const;
 };
@@ -83,7 +88,9 @@ struct LevenbergMarquardtStep {
   bool completed = false; ///< its evaluation completed
   bool accepted = false; ///< it lowered the cost and is the current point now
   double cost = std::numeric_limits<double>::infinity(); ///< its Φ (∞ if it failed)
-  double relative_decrease = 0; ///< (Φ_current − Φ_trial) / Φ_current if accepted, else 0
+  /// (Φ_current − Φ_trial) / (Φ_current − cost_floor) if accepted (+∞ where Φ_current ≤ the
+  /// floor), else 0
+  double relative_decrease = 0;
   int rejections = 0; ///< rejected steps in a row from these equations, this one included
   bool gives_up = false; ///< the max_rejections-th rejection in a row: the solve ends after it
   double damping = 0; ///< μ for the next trial step
