@@ -10,21 +10,8 @@
 
 using namespace elastolearn;
 
-namespace {
-
-/// A bar swinging up from ω = 2 rad/s about z under gravity, 20 frames: the initial velocity is
-/// not zero, so that the run must report it.
-sim::Scene swinging_bar() {
-  sim::Scene s = test::bar_scene({ .young = 3e5, .alpha1 = 0.005, .dt = 2e-3, .frames = 20 });
-  s.initial.kind = sim::InitialCondition::Kind::Velocity;
-  s.initial.angular_velocity = Vec3(0, 0, 2.0);
-  return s;
-}
-
-} // namespace
-
 TEST(ForwardRun, KeepsEveryStateOfTheSimulationAndTheInitialVelocity) {
-  const sim::Scene scene = swinging_bar();
+  const sim::Scene scene = test::swinging_bar(20);
   std::vector<VecX> streamed;
   VecX v0;
   const auto report
@@ -48,7 +35,7 @@ TEST(ForwardRun, KeepsEveryStateOfTheSimulationAndTheInitialVelocity) {
 
 TEST(ForwardRun, ADivergenceIsAResultWithoutPositions) {
   // One Newton iteration with a tolerance it cannot meet and no retry: the run stops at frame 1.
-  sim::Scene scene = swinging_bar();
+  sim::Scene scene = test::swinging_bar(20);
   scene.newton.max_iterations = 1;
   scene.newton.relative_tolerance = 1e-12;
   scene.newton.max_step_halvings = 0;
@@ -60,7 +47,7 @@ TEST(ForwardRun, ADivergenceIsAResultWithoutPositions) {
 }
 
 TEST(ForwardRun, WithCorrectionAttachesOnlyTheCorrection) {
-  const sim::Scene scene = swinging_bar();
+  const sim::Scene scene = test::swinging_bar(20);
   material::AnalyticCorrection::Parameters p;
   p.a = 1e8; // (σ − 1)³ stiffening, enough to change the swing
   const auto correction = std::make_shared<material::AnalyticCorrection>(p);

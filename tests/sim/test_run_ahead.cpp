@@ -9,20 +9,8 @@
 
 using namespace elastolearn;
 
-namespace {
-
-/// A bar swinging from ω = 2 rad/s about z under gravity, 30 frames.
-sim::Scene thirty_frame_swing() {
-  sim::Scene s = test::bar_scene({ .young = 3e5, .alpha1 = 0.005, .dt = 2e-3, .frames = 30 });
-  s.initial.kind = sim::InitialCondition::Kind::Velocity;
-  s.initial.angular_velocity = Vec3(0, 0, 2.0);
-  return s;
-}
-
-} // namespace
-
 TEST(RunAhead, PublishesTheFramesOfTheSameSimulationSteppedInPlace) {
-  const sim::Scene scene = thirty_frame_swing();
+  const sim::Scene scene = test::swinging_bar(30);
   const sim::ForwardRun in_place = sim::simulate_positions(scene);
   ASSERT_TRUE(in_place.completed) << in_place.message;
   sim::Simulator simulator(scene);
@@ -40,7 +28,7 @@ TEST(RunAhead, PublishesTheFramesOfTheSameSimulationSteppedInPlace) {
 
 TEST(RunAhead, ReportsADivergenceAtItsFrame) {
   // One Newton iteration with a tolerance it cannot meet and no retry: frame 1 fails.
-  sim::Scene scene = thirty_frame_swing();
+  sim::Scene scene = test::swinging_bar(30);
   scene.newton.max_iterations = 1;
   scene.newton.relative_tolerance = 1e-12;
   scene.newton.max_step_halvings = 0;
@@ -56,7 +44,7 @@ TEST(RunAhead, ReportsADivergenceAtItsFrame) {
 TEST(RunAhead, StopsWhenDroppedBeforeItsEnd) {
   // Dropped after its first frame: the destructor stops the stepping and joins (a hang here is
   // the failure), and the simulator has taken at most the frames it was asked for.
-  sim::Scene scene = thirty_frame_swing();
+  sim::Scene scene = test::swinging_bar(30);
   scene.frames = 100000;
   sim::Simulator simulator(scene);
   ASSERT_TRUE(simulator.apply_initial_condition().converged);

@@ -47,6 +47,15 @@ inline sim::Scene bar_scene(const BarOptions& o = {}) {
   return s;
 }
 
+/// The 96-tet bar (E 3e5, α₁ 0.005 s, 2 ms steps) swinging from ω = 2 rad/s about z under
+/// gravity for `frames` frames: a motion whose initial velocity is not zero.
+inline sim::Scene swinging_bar(int frames) {
+  sim::Scene s = bar_scene({ .young = 3e5, .alpha1 = 0.005, .dt = 2e-3, .frames = frames });
+  s.initial.kind = sim::InitialCondition::Kind::Velocity;
+  s.initial.angular_velocity = Vec3(0, 0, 2.0);
+  return s;
+}
+
 /// The 240-tet bar the learning tests learn from (0.4 × 0.1 × 0.1 m, ν = 0.43, α₁ 0.01 s, 60
 /// frames of 4 ms): at rest (a droop), or with `swing` turning at 2 rad/s about z.
 inline sim::Scene learning_bar(material::ElasticModelType type, double young, bool swing) {
