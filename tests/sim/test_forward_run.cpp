@@ -34,12 +34,8 @@ TEST(ForwardRun, KeepsEveryStateOfTheSimulationAndTheInitialVelocity) {
 }
 
 TEST(ForwardRun, ADivergenceIsAResultWithoutPositions) {
-  // One Newton iteration with a tolerance it cannot meet and no retry: the run stops at frame 1.
-  sim::Scene scene = test::swinging_bar(20);
-  scene.newton.max_iterations = 1;
-  scene.newton.relative_tolerance = 1e-12;
-  scene.newton.max_step_halvings = 0;
-  scene.newton.retry_exact_tangent = false;
+  // Newton cannot solve the first step: the run stops at frame 1.
+  const sim::Scene scene = test::failing_first_step(test::swinging_bar(20));
   const sim::ForwardRun run = sim::simulate_positions(scene);
   EXPECT_FALSE(run.completed);
   EXPECT_TRUE(run.positions.empty());

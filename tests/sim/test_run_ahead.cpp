@@ -27,12 +27,8 @@ TEST(RunAhead, PublishesTheFramesOfTheSameSimulationSteppedInPlace) {
 }
 
 TEST(RunAhead, ReportsADivergenceAtItsFrame) {
-  // One Newton iteration with a tolerance it cannot meet and no retry: frame 1 fails.
-  sim::Scene scene = test::swinging_bar(30);
-  scene.newton.max_iterations = 1;
-  scene.newton.relative_tolerance = 1e-12;
-  scene.newton.max_step_halvings = 0;
-  scene.newton.retry_exact_tangent = false;
+  // Newton cannot solve the first step: frame 1 fails.
+  const sim::Scene scene = test::failing_first_step(test::swinging_bar(30));
   sim::Simulator simulator(scene);
   ASSERT_TRUE(simulator.apply_initial_condition().converged);
   sim::RunAhead ahead(simulator, scene.frames);

@@ -56,6 +56,16 @@ inline sim::Scene swinging_bar(int frames) {
   return s;
 }
 
+/// `s` with Newton set up to fail its first step: one iteration to a tolerance it cannot meet,
+/// no substeps, no retry with the exact tangent.
+inline sim::Scene failing_first_step(sim::Scene s) {
+  s.newton.max_iterations = 1;
+  s.newton.relative_tolerance = 1e-12;
+  s.newton.max_step_halvings = 0;
+  s.newton.retry_exact_tangent = false;
+  return s;
+}
+
 /// The 240-tet bar the learning tests learn from (0.4 × 0.1 × 0.1 m, ν = 0.43, α₁ 0.01 s, 60
 /// frames of 4 ms): at rest (a droop), or with `swing` turning at 2 rad/s about z.
 inline sim::Scene learning_bar(material::ElasticModelType type, double young, bool swing) {

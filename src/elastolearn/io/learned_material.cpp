@@ -55,9 +55,8 @@ nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
         { "validation_rms_error_m", c.completed ? nlohmann::json(c.validation.rms) : nullptr },
         { "validation_max_error_m", c.completed ? nlohmann::json(c.validation.max) : nullptr },
         { "larger_motion", larger_motion_to_json(c.larger_motion) },
-        { "reachable_stretches",
-            stability_to_json(c.stability) }, // null: a correction ranked below the chosen
-                                              // candidate, whose larger motion was not run
+        { "reachable_stretches", stability_to_json(c.stability) },
+        // null: a correction ranked below the chosen candidate, whose larger motion was not run
         { "eligible",
             c.correction && c.completed && !c.larger_motion.checked
                 ? nlohmann::json(nullptr)

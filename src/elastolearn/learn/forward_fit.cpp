@@ -139,31 +139,18 @@ ForwardSensitivityPass untimed_pass(const sim::Scene& scene, const observe::Obse
     accumulate(0, frames[0]);
   }
 
-  // With sensitivities the simulation runs ahead on its own thread: frame t's sensitivities need
-  // frames t − 2 … t only, and overlap the steps after t.
-  std::optional<sim::RunAhead> ahead;
-  if (sensitivities)
-    ahead.emplace(simulator, scene.frames);
+  // The simulation runs ahead on its own thread: frame t's sensitivities need frames t − 2 … t
+  // only, and overlap the steps after t.
+  sim::RunAhead ahead(simulator, scene.frames);
   for (int t = 1; t <= scene.frames; ++t) {
-    double frame_time = 0;
-    if (ahead) {
-      if (!ahead->wait_for(t)) {
-        pass.message = ahead->message();
-        return pass;
-      }
-      frames.push_back(ahead->positions(t));
-      frame_time = ahead->time(t);
-    } else {
-      const auto report = simulator.step();
-      if (!report.converged) {
-        pass.message = "frame " + std::to_string(t) + ": " + report.message;
-        return pass;
-      }
-      frames.push_back(simulator.positions());
+    if (!ahead.wait_for(t)) {
+      pass.message = ahead.message();
+      return pass;
     }
+    frames.push_back(ahead.positions(t));
     if (sensitivities) {
       const VecX& x_before = t >= 2 ? frames[t - 2] : x_start_before;
-      physics.residual(x_before, frames[t - 1], frames[t], frame_time, residual);
+      physics.residual(x_before, frames[t - 1], frames[t], ahead.time(t), residual);
       physics.jacobians(system, damping); // K + D/h and D at the converged step
       system.add_diagonal(masses, 1.0 / (h * h));
       const bool factored = solver->factorize(system.matrix());

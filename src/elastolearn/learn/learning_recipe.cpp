@@ -125,6 +125,7 @@ constexpr size_t kLoopCandidates = 3;
 /// The forward fit's plateau: its accepted steps whose training RMS is within this fraction of
 /// its last one's are all validated.
 constexpr double kPlateau = 0.01;
+
 /// Frames [first, last] of an observation (first becomes frame 0).
 observe::Observation frame_range(const observe::Observation& o, int first, int last) {
   return o.frame_range(first, last);
@@ -573,9 +574,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
     m.scene.material = result.fitted_nominal;
   // The forward fit's steps must be stable where the validation will require it, else its last
   // step, the main candidate, is not eligible and its steps were spent for nothing.
-  const ReferenceReach reach
-      = reference_reach(split, options.fit_parameters ? result.fitted_nominal : given,
-          options.loop.stretch_samples, callbacks.loop.progress);
+  const fem::MaterialModel& reference_material
+      = options.fit_parameters ? result.fitted_nominal : given;
+  const ReferenceReach reach = reference_reach(
+      split, reference_material, options.loop.stretch_samples, callbacks.loop.progress);
   const MatX& reachable = reach.stretches;
   LearningOptions loop_options = options.loop;
   loop_options.forward_fit.stability_stretches = reachable;
@@ -656,9 +658,8 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // the first such): the candidates that rank below the chosen one are not checked.
   std::optional<std::vector<Vec3>> droops;
   const auto check = [&](Candidate& c) {
-    const fem::MaterialModel& reference = options.fit_parameters ? result.fitted_nominal : given;
     if (!droops)
-      droops = droop_accelerations(split, reference, reach);
+      droops = droop_accelerations(split, reference_material, reach);
     check_candidate_larger_motion(c, split, nominal_of(c.kind), *droops);
     say(callbacks,
         label_of(c)

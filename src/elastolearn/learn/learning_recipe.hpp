@@ -14,11 +14,12 @@
 ///      the fitted nominal's runs of the whole motions);
 ///   4. validation: every candidate (the given nominal, reported but not chosen beside a
 ///      fitted one; the fitted nominal; the loop's corrections with the lowest training errors
-///      and the forward fit's last three accepted steps) simulates the held-out data; among those
-///      that are stable where another motion may go and beat the fitted nominal by more than
-///      noise could (z ≥ kSignificance), the one with the smallest RMS error there whose material
-///      survives a larger motion and a droop (kLargerMotion; checked in that order, the best
-///      first, until one passes) is the result; the fitted nominal if none, also where the
+///      and the forward fit's last accepted step with the earlier ones on its plateau, within 1 %
+///      of its training error) simulates the held-out data; among those that are stable where
+///      another motion may go and beat the fitted nominal by more than noise could
+///      (z ≥ kSignificance), the one with the smallest RMS error there whose material survives a
+///      larger motion and a droop (kLargerMotion; checked in that order, the best first, until
+///      one passes) is the result; the fitted nominal if none, also where the
 ///      held-out data cannot resolve a candidate from it (a motion that has died out under
 ///      noise: the training data, which cannot see how a candidate forecasts, are compared and
 ///      reported, not used; choose_candidate);
