@@ -3,13 +3,14 @@
 #include <elastolearn/core/timing.hpp>
 #include <elastolearn/learn/energy_mlp_training.hpp>
 
+#include <tbb/parallel_for.h>
+
 #include <numeric>
 
 namespace elastolearn::learn {
 
-namespace {
-
-constexpr FieldErrors energy_mlp_training_error("mlp_training");
+// Named, not anonymous: GradientLoss::Chunk (a class with linkage) holds these.
+namespace energy_mlp_detail {
 
 /// Forward buffers of one layer over a batch (B columns): pre-activation Z, f(Z), f'(Z), f''(Z),
 /// and per input c the pre-activation tangent U_c = ∂Z/∂x_c and the activation tangent
@@ -18,6 +19,14 @@ struct Forward {
   MatX z, a, d1, d2;
   std::vector<MatX> u, t;
 };
+
+} // namespace energy_mlp_detail
+
+namespace {
+
+using energy_mlp_detail::Forward;
+
+constexpr FieldErrors energy_mlp_training_error("mlp_training");
 
 /// Forward pass with input tangents over the columns of x (d × B); `f` has one entry per layer.
 void forward(const BatchNormMlp& net, ConstRef<MatX> x, std::vector<Forward>& f) {
@@ -61,14 +70,18 @@ void forward(const BatchNormMlp& net, ConstRef<MatX> x, std::vector<Forward>& f)
   }
 }
 
-/// D_jᵀ ∇g for the columns of a forward pass (m × B).
-MatX stress_of(const std::vector<Forward>& f, ConstRef<MatX> maps, int d, int m) {
+/// D_jᵀ ∇g for the columns of a forward pass, into `s` (m × B).
+void stress_of(const std::vector<Forward>& f, ConstRef<MatX> maps, int d, int m, MatX& s) {
   const Forward& out = f.back();
-  MatX s = MatX::Zero(m, maps.cols());
+  s.setZero(m, maps.cols());
   for (int i = 0; i < m; ++i)
     for (int c = 0; c < d; ++c)
       s.row(i) += maps.row(c + d * i).cwiseProduct(out.t[std::size_t(c)].row(0));
-  return s;
+}
+
+/// The columns [begin, end) of `chunk` of `chunks` equal parts of n columns.
+std::pair<Eigen::Index, Eigen::Index> chunk_columns(Eigen::Index n, int chunk, int chunks) {
+  return { n * chunk / chunks, n * (chunk + 1) / chunks };
 }
 
 void check_set(const char* field, const GradientSamples& s, int d, int m) {
@@ -86,16 +99,118 @@ void check_set(const char* field, const GradientSamples& s, int d, int m) {
     energy_mlp_training_error(field, "contains a non-finite value");
 }
 
-double loss_of(const BatchNormMlp& net, const GradientSamples& s) {
-  return (network_stress(net, s) - s.targets).squaredNorm() / double(s.targets.size());
-}
-
 } // namespace
 
+/// Buffers of one chunk: its forward pass, the adjoints of each layer's activation (Ā) and
+/// activation tangents (T̄_c), and the chunk's share of the gradient.
+struct GradientLoss::Chunk {
+  std::vector<energy_mlp_detail::Forward> f;
+  std::vector<MatX> a_bar;
+  std::vector<std::vector<MatX>> t_bar;
+  MatX residual, z_bar, u_bar;
+  Eigen::RowVectorXd g_bar;
+  MlpGradient gradient;
+};
+
+GradientLoss::GradientLoss()
+    : m_chunks(std::size_t(kChunks)) { }
+GradientLoss::~GradientLoss() = default;
+
+const MlpGradient& GradientLoss::gradient(const BatchNormMlp& net, const GradientSamples& s) {
+  const int d = net.inputs();
+  const int m = static_cast<int>(s.targets.rows());
+  const Eigen::Index n = s.inputs.cols();
+  const std::size_t layers = net.layers.size();
+  // ∂L/∂(∂g/∂x_c) per sample: (2/(m·n)) Σ_i D(c, i) r_i.
+  const double scale = 2.0 / double(m * n);
+  tbb::parallel_for(0, kChunks, [&](int chunk) {
+    const auto [begin, end] = chunk_columns(n, chunk, kChunks);
+    const Eigen::Index cols = end - begin;
+    const auto x = s.inputs.middleCols(begin, cols);
+    const auto maps = s.maps.middleCols(begin, cols);
+    Chunk& w = m_chunks[std::size_t(chunk)];
+    w.f.resize(layers);
+    w.a_bar.resize(layers);
+    w.t_bar.resize(layers, std::vector<MatX>(std::size_t(d)));
+    w.gradient.weights.resize(layers);
+    w.gradient.biases.resize(layers);
+    auto& grad_w = w.gradient.weights;
+    auto& grad_b = w.gradient.biases;
+    forward(net, x, w.f);
+    stress_of(w.f, maps, d, m, w.residual);
+    w.residual -= s.targets.middleCols(begin, cols);
+    const std::size_t K = layers - 1;
+    const auto& last = net.layers[K];
+    grad_w[K].setZero(1, last.weight.cols());
+    grad_b[K].setZero(1);
+    for (int c = 0; c < d; ++c) {
+      w.g_bar.setZero(cols);
+      for (int i = 0; i < m; ++i)
+        w.g_bar += scale * maps.row(c + d * i).cwiseProduct(w.residual.row(i));
+      // ∂g/∂x_c = w_K T_{K−1,c} (or w_K e_c without hidden layers).
+      if (K > 0) {
+        grad_w[K].noalias() += w.g_bar * w.f[K - 1].t[std::size_t(c)].transpose();
+        w.t_bar[K - 1][std::size_t(c)].noalias() = last.weight.transpose() * w.g_bar;
+      } else {
+        grad_w[K](0, c) += w.g_bar.sum();
+      }
+    }
+    if (K > 0)
+      w.a_bar[K - 1].setZero(last.weight.cols(), cols); // g's value is not in the loss
+    for (std::size_t k = K; k-- > 0;) {
+      const auto& l = net.layers[k];
+      const Forward& fk = w.f[k];
+      // Z̄ = f' ⊙ Ā + f'' ⊙ Σ_c T̄_c ⊙ U_c;  Ū_c = f' ⊙ T̄_c.
+      w.z_bar = fk.d1.cwiseProduct(w.a_bar[k]);
+      for (int c = 0; c < d; ++c)
+        w.z_bar
+            += fk.d2.cwiseProduct(w.t_bar[k][std::size_t(c)].cwiseProduct(fk.u[std::size_t(c)]));
+      grad_b[k] = w.z_bar.rowwise().sum();
+      if (k == 0)
+        grad_w[k].noalias() = w.z_bar * x.transpose();
+      else
+        grad_w[k].noalias() = w.z_bar * w.f[k - 1].a.transpose();
+      for (int c = 0; c < d; ++c) {
+        w.u_bar = fk.d1.cwiseProduct(w.t_bar[k][std::size_t(c)]);
+        if (k == 0) {
+          grad_w[k].col(c) += w.u_bar.rowwise().sum(); // T_{−1,c} = e_c
+        } else {
+          grad_w[k].noalias() += w.u_bar * w.f[k - 1].t[std::size_t(c)].transpose();
+          w.t_bar[k - 1][std::size_t(c)].noalias() = l.weight.transpose() * w.u_bar;
+        }
+      }
+      if (k > 0)
+        w.a_bar[k - 1].noalias() = l.weight.transpose() * w.z_bar;
+    }
+  });
+  // Summed in chunk order, so the result does not depend on the threads that ran them.
+  MlpGradient& total = m_chunks.front().gradient;
+  for (std::size_t chunk = 1; chunk < m_chunks.size(); ++chunk)
+    for (std::size_t k = 0; k < layers; ++k) {
+      total.weights[k] += m_chunks[chunk].gradient.weights[k];
+      total.biases[k] += m_chunks[chunk].gradient.biases[k];
+    }
+  return total;
+}
+
 MatX network_stress(const BatchNormMlp& net, const GradientSamples& s) {
-  std::vector<Forward> f(net.layers.size());
-  forward(net, s.inputs, f);
-  return stress_of(f, s.maps, net.inputs(), static_cast<int>(s.targets.rows()));
+  const int m = static_cast<int>(s.targets.rows());
+  MatX stress(m, s.inputs.cols());
+  const Eigen::Index n = s.inputs.cols();
+  const int chunks = static_cast<int>(std::min<Eigen::Index>(n, GradientLoss::kChunks));
+  tbb::parallel_for(0, chunks, [&](int chunk) {
+    const auto [begin, end] = chunk_columns(n, chunk, chunks);
+    std::vector<Forward> f(net.layers.size());
+    forward(net, s.inputs.middleCols(begin, end - begin), f);
+    MatX part;
+    stress_of(f, s.maps.middleCols(begin, end - begin), net.inputs(), m, part);
+    stress.middleCols(begin, end - begin) = part;
+  });
+  return stress;
+}
+
+double gradient_loss(const BatchNormMlp& net, const GradientSamples& s) {
+  return (network_stress(net, s) - s.targets).squaredNorm() / double(s.targets.size());
 }
 
 MlpTrainingResult train_gradient_mlp(
@@ -121,97 +236,48 @@ MlpTrainingResult train_gradient_mlp(
     energy_mlp_training_error("training", "needs ≥ 2 samples, got " + to_text(n));
   const Eigen::Index batches = n / batch;
 
-  std::vector<Forward> f(layers);
   std::vector<AdamMoments> adam_w, adam_b;
   for (const auto& l : net.layers) {
     adam_w.emplace_back(l.weight);
     adam_b.emplace_back(MatX(l.bias));
   }
-  std::vector<MatX> grad_w(layers), grad_b(layers);
-  MatX x(d, batch), maps(d * m, batch), t(m, batch);
+  GradientSamples samples { MatX(d, batch), MatX(d * m, batch), MatX(m, batch) };
+  GradientLoss loss;
   std::vector<int> order(static_cast<std::size_t>(n));
   std::iota(order.begin(), order.end(), 0);
   std::mt19937_64 rng(o.seed ^ 0x9e3779b97f4a7c15ULL);
 
   MlpTrainingResult result { net, {} };
-  EarlyStopping stopping { loss_of(net, valid) };
+  EarlyStopping stopping { gradient_loss(net, valid) };
   double learning_rate = o.learning_rate;
   long steps = 0;
-  // Adjoints: of each layer's activation (Ā) and activation tangents (T̄_c), per layer.
-  std::vector<MatX> a_bar(layers);
-  std::vector<std::vector<MatX>> t_bar(layers, std::vector<MatX>(std::size_t(d)));
   for (int epoch = 1; epoch <= o.max_epochs; ++epoch) {
     shuffle_in_place(order, rng);
     for (Eigen::Index bi = 0; bi < batches; ++bi) {
       for (Eigen::Index j = 0; j < batch; ++j) {
         const Eigen::Index s = order[static_cast<std::size_t>(bi * batch + j)];
-        x.col(j) = train.inputs.col(s);
-        maps.col(j) = train.maps.col(s);
-        t.col(j) = train.targets.col(s);
+        samples.inputs.col(j) = train.inputs.col(s);
+        samples.maps.col(j) = train.maps.col(s);
+        samples.targets.col(j) = train.targets.col(s);
       }
-      forward(net, x, f);
-      const MatX residual = stress_of(f, maps, d, m) - t;
-      // Ḡ_c = ∂L/∂(∂g/∂x_c) per sample: (2/(m·B)) Σ_i D(c, i) r_i.
-      const double scale = 2.0 / double(m * batch);
-      const std::size_t K = layers - 1;
-      auto& last = net.layers[K];
-      grad_w[K] = MatX::Zero(1, last.weight.cols());
-      grad_b[K] = MatX::Zero(1, 1);
-      for (int c = 0; c < d; ++c) {
-        Eigen::RowVectorXd g_bar = Eigen::RowVectorXd::Zero(batch);
-        for (int i = 0; i < m; ++i)
-          g_bar += scale * maps.row(c + d * i).cwiseProduct(residual.row(i));
-        // ∂g/∂x_c = w_K T_{K−1,c} (or w_K e_c without hidden layers).
-        if (K > 0) {
-          grad_w[K].noalias() += g_bar * f[K - 1].t[std::size_t(c)].transpose();
-          t_bar[K - 1][std::size_t(c)].noalias() = last.weight.transpose() * g_bar;
-        } else {
-          grad_w[K](0, c) += g_bar.sum();
-        }
-      }
-      if (K > 0)
-        a_bar[K - 1] = MatX::Zero(last.weight.cols(), batch); // g's value is not in the loss
-      for (std::size_t k = K; k-- > 0;) {
-        const auto& l = net.layers[k];
-        Forward& w = f[k];
-        // Z̄ = f' ⊙ Ā + f'' ⊙ Σ_c T̄_c ⊙ U_c;  Ū_c = f' ⊙ T̄_c.
-        MatX z_bar = w.d1.cwiseProduct(a_bar[k]);
-        for (int c = 0; c < d; ++c)
-          z_bar += w.d2.cwiseProduct(t_bar[k][std::size_t(c)].cwiseProduct(w.u[std::size_t(c)]));
-        grad_b[k] = z_bar.rowwise().sum();
-        if (k == 0)
-          grad_w[k].noalias() = z_bar * x.transpose();
-        else
-          grad_w[k].noalias() = z_bar * f[k - 1].a.transpose();
-        for (int c = 0; c < d; ++c) {
-          const MatX u_bar = w.d1.cwiseProduct(t_bar[k][std::size_t(c)]);
-          if (k == 0) {
-            grad_w[k].col(c) += u_bar.rowwise().sum(); // T_{−1,c} = e_c
-          } else {
-            grad_w[k].noalias() += u_bar * f[k - 1].t[std::size_t(c)].transpose();
-            t_bar[k - 1][std::size_t(c)].noalias() = l.weight.transpose() * u_bar;
-          }
-        }
-        if (k > 0)
-          a_bar[k - 1].noalias() = l.weight.transpose() * z_bar;
-      }
+      const MlpGradient& g = loss.gradient(net, samples);
       const double step = adam_step(o, learning_rate, ++steps);
       for (std::size_t k = 0; k < layers; ++k) {
-        adam_update(net.layers[k].weight, grad_w[k], adam_w[k], o, step);
+        adam_update(net.layers[k].weight, g.weights[k], adam_w[k], o, step);
         if (k + 1 < layers)
-          adam_update(net.layers[k].bias, grad_b[k], adam_b[k], o, step);
+          adam_update(net.layers[k].bias, g.biases[k], adam_b[k], o, step);
       }
     }
-    const double loss = loss_of(net, valid);
-    if (!std::isfinite(loss)) {
+    const double validation_loss = gradient_loss(net, valid);
+    if (!std::isfinite(validation_loss)) {
       energy_mlp_training_error("learning_rate",
-          "training diverged at epoch " + to_text(epoch) + " (validation loss " + to_text(loss)
-              + "); lower the learning rate");
+          "training diverged at epoch " + to_text(epoch) + " (validation loss "
+              + to_text(validation_loss) + "); lower the learning rate");
     }
-    result.report.validation_history.push_back(loss);
+    result.report.validation_history.push_back(validation_loss);
     result.report.epochs = epoch;
     bool stop = false;
-    if (stopping.update(loss, o, learning_rate, stop)) {
+    if (stopping.update(validation_loss, o, learning_rate, stop)) {
       result.network = net;
       result.report.best_epoch = epoch;
     }
@@ -221,7 +287,7 @@ MlpTrainingResult train_gradient_mlp(
     }
   }
   result.report.validation_loss = stopping.best;
-  result.report.training_loss = loss_of(result.network, train);
+  result.report.training_loss = gradient_loss(result.network, train);
   result.report.seconds = seconds_since(start);
   return result;
 }

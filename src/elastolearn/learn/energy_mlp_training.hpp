@@ -12,6 +12,8 @@
 /// are standardised already). Rationale and numbers: docs/learning.md ("Energy network").
 #include <elastolearn/learn/mlp_training.hpp>
 
+#include <vector>
+
 namespace elastolearn::learn {
 
 /// One set of samples: inputs x (d × n, standardised), the maps D (d·m × n: column j holds D_j
@@ -25,6 +27,37 @@ struct GradientSamples {
 
 /// D_jᵀ ∇g(x_j) for every sample (m × n), in inference mode; for checks and the loss.
 MatX network_stress(const BatchNormMlp& network, const GradientSamples& samples);
+
+/// The loss ‖D_jᵀ ∇g(x_j) − t_j‖² / (m·n) over `samples`.
+double gradient_loss(const BatchNormMlp& network, const GradientSamples& samples);
+
+/// ∂loss/∂W_k and ∂loss/∂b_k for each layer k (shapes of the layer's weight and bias).
+struct MlpGradient {
+  std::vector<MatX> weights;
+  std::vector<VecX> biases;
+};
+
+/// The gradient of gradient_loss by double back-propagation, over kChunks fixed column ranges
+/// of the samples evaluated in parallel (oneTBB) and summed in range order, so the result is the
+/// same for any number of threads. Keeps its buffers between calls: one per trainer, not shared
+/// between threads.
+class GradientLoss {
+  public:
+  /// Column ranges per call: two per core of the 2-core machines the learning runs on, so a
+  /// 256-sample batch is four 64-column blocks.
+  static constexpr int kChunks = 4;
+  GradientLoss();
+  ~GradientLoss();
+  GradientLoss(const GradientLoss&) = delete;
+  GradientLoss& operator=(const GradientLoss&) = delete;
+  /// The gradient at `network` (no batch norm) over `samples` (any number ≥ 1; ranges may be
+  /// empty); valid until the next call.
+  const MlpGradient& gradient(const BatchNormMlp& network, const GradientSamples& samples);
+
+  private:
+  struct Chunk;
+  std::vector<Chunk> m_chunks;
+};
 
 /// Train g (hidden widths and activation from `options`, one output, no batch norm) on
 /// `training`, keeping the network with the best loss on `validation` (MlpTrainingReport's losses

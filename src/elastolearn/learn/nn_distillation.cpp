@@ -6,6 +6,9 @@
 #include <elastolearn/sim/amplified_scene.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -119,43 +122,69 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   const std::shared_ptr<const material::Correction> shared_teacher = teacher.clone();
   const bool bounded = std::isfinite(o.stretch_min) || std::isfinite(o.stretch_max);
 
-  for (const sim::Scene& original : scenes) {
-    sim::Scene scene = original;
+  // The simulations run side by side and keep their recorded frames; the sampling below then
+  // visits the states in scene, frame and element order, so the result does not depend on the
+  // threads.
+  struct Recorded {
+    std::vector<VecX> positions, velocities;
+    sim::SimulationReport run;
+  };
+  std::vector<Recorded> recorded_runs(scenes.size());
+  tbb::parallel_for(std::size_t(0), scenes.size(), [&](std::size_t i) {
+    sim::Scene scene = scenes[i];
     scene.material.correction = shared_teacher;
-    const std::vector<fem::TetRestData> rest = fem::precompute_rest_data(scene.mesh);
-    const Tets& tets = scene.mesh.tets();
-    // Reservoir sampling (Algorithm R) over all element states: state i replaces slot j < k with
-    // j uniform in [0, i]. Stretches and rates are computed only for the states kept.
-    const sim::FrameSink sink = [&](int frame, double, const VecX& x, const VecX& v) {
+    Recorded& r = recorded_runs[i];
+    r.run = sim::run_simulation(scene, [&](int frame, double, const VecX& x, const VecX& v) {
       if (frame % o.frame_stride != 0)
         return;
+      r.positions.push_back(x);
+      r.velocities.push_back(v);
+    });
+  });
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const sim::Scene& scene = scenes[i];
+    const std::vector<fem::TetRestData> rest = fem::precompute_rest_data(scene.mesh);
+    const Tets& tets = scene.mesh.tets();
+    Rows3 frame_stretches(tets.rows(), 3), frame_rates(tets.rows(), 3);
+    Recorded& r = recorded_runs[i];
+    for (std::size_t frame = 0; frame < r.positions.size(); ++frame) {
+      const VecX& x = r.positions[frame];
+      const VecX& v = r.velocities[frame];
+      tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, tets.rows(), 256),
+          [&](const tbb::blocked_range<Eigen::Index>& elements) {
+            for (Eigen::Index e = elements.begin(); e < elements.end(); ++e) {
+              const Eigen::Vector4i tet = tets.row(e).transpose();
+              const auto& data = rest[static_cast<std::size_t>(e)];
+              const material::PrincipalFrame pf = material::principal_frame(
+                  fem::deformation_gradient(fem::gather_tet(x, tet), data));
+              const Mat3 F_rate = fem::deformation_gradient(fem::gather_tet(v, tet), data);
+              frame_stretches.row(e) = pf.stretches.transpose();
+              frame_rates.row(e) = material::stretch_rates(pf, F_rate).transpose();
+            }
+          });
+      // Reservoir sampling (Algorithm R) over the states in the stretch interval: state i
+      // replaces slot j < k with j uniform in [0, i].
       for (Eigen::Index e = 0; e < tets.rows(); ++e) {
-        const Eigen::Vector4i tet = tets.row(e).transpose();
-        const auto& r = rest[static_cast<std::size_t>(e)];
-        std::optional<material::PrincipalFrame> pf;
-        if (bounded) { // the interval needs every state's stretches, not only the kept ones'
-          pf = material::principal_frame(fem::deformation_gradient(fem::gather_tet(x, tet), r));
-          if (pf->stretches.minCoeff() < o.stretch_min || pf->stretches.maxCoeff() > o.stretch_max)
-            continue;
-        }
+        if (bounded
+            && (frame_stretches.row(e).minCoeff() < o.stretch_min
+                || frame_stretches.row(e).maxCoeff() > o.stretch_max))
+          continue;
         Eigen::Index slot = seen++;
         if (slot >= k) {
           slot = static_cast<Eigen::Index>(uniform01(rng) * double(slot + 1));
           if (slot >= k)
             continue;
         }
-        if (!pf)
-          pf = material::principal_frame(fem::deformation_gradient(fem::gather_tet(x, tet), r));
-        const Mat3 F_rate = fem::deformation_gradient(fem::gather_tet(v, tet), r);
-        stretches.row(slot) = pf->stretches.transpose();
-        rates.row(slot) = material::stretch_rates(*pf, F_rate).transpose();
+        stretches.row(slot) = frame_stretches.row(e);
+        rates.row(slot) = frame_rates.row(e);
       }
-    };
-    const sim::SimulationReport run = sim::run_simulation(scene, sink);
-    if (run.completed)
+    }
+    r.positions = {}; // the frames are sampled
+    r.velocities = {};
+    if (r.run.completed)
       ++report.scenes_completed;
     else
-      report.messages.push_back(scene.name + ": " + run.message);
+      report.messages.push_back(scene.name + ": " + r.run.message);
   }
   report.states_seen = seen;
   const Eigen::Index recorded = std::min<Eigen::Index>(k, seen);
@@ -183,14 +212,17 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   }
   report.jittered = static_cast<int>(total - recorded);
   // Stored in descending stretch order (a jitter may swap two stretches), then the teacher.
-  for (Eigen::Index j = 0; j < total; ++j) {
-    Vec3 s, f, unused;
-    out.targets.row(j).setZero();
-    sorted_sample(out, j, s, f, unused);
-    out.stretches.row(j) = s.transpose();
-    out.stretch_rates.row(j) = f.transpose();
-    out.targets.row(j) = teacher.correction(s, f).transpose();
-  }
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, total, 1024),
+      [&](const tbb::blocked_range<Eigen::Index>& rows) {
+        for (Eigen::Index j = rows.begin(); j < rows.end(); ++j) {
+          Vec3 s, f, unused;
+          out.targets.row(j).setZero();
+          sorted_sample(out, j, s, f, unused);
+          out.stretches.row(j) = s.transpose();
+          out.stretch_rates.row(j) = f.transpose();
+          out.targets.row(j) = teacher.correction(s, f).transpose();
+        }
+      });
   if (!out.targets.allFinite())
     distillation_error("teacher", "the teacher correction returned a non-finite value");
   if (report_out)
