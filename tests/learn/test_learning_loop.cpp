@@ -364,6 +364,52 @@ TEST(LearningLoop, AConvergedForwardFitStopsAndStaysStopped) {
   EXPECT_EQ(state.history.size(), steps);
 }
 
+TEST(LearningLoop, TheForwardFitStartsWhereTheCallerChooses) {
+  // The neo-Hookean bar from a 1.75× too stiff corotated nominal: the loop's best is a learned
+  // correction. A caller that sends the forward fit back to no correction (iteration 0) is asked
+  // once, after the loop, and the forward fit's first trial is then the one a run without loop
+  // iterations takes from the nominal, bit for bit.
+  const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
+  const auto nominal = bar(material::ElasticModelType::Corotated, 1.75e6);
+  auto scene = bar_scene(nominal, false);
+  scene.frames = 40;
+  auto truth_scene = bar_scene(truth, false);
+  truth_scene.frames = 40;
+  const auto observed = observe_surface(truth_scene);
+  LearningOptions options = small_options();
+  options.max_iterations = 2;
+  options.forward_fit.max_iterations = 1;
+  const auto first_trial_rms = [](const LearningState& state) {
+    for (const IterationRecord& r : state.history)
+      if (forward_fit_of(r))
+        return forward_of(r).error().rms;
+    ADD_FAILURE() << "no forward-fit step";
+    return -1.0;
+  };
+
+  LearningState from_best;
+  ASSERT_TRUE(run_learning(scene, observed, options, from_best));
+  int asked = 0;
+  LearningCallbacks callbacks;
+  callbacks.forward_fit_start = [&](const LearningState& loop) {
+    ++asked;
+    EXPECT_TRUE(loop.finished);
+    EXPECT_EQ(loop.forward_fit_steps, 0);
+    EXPECT_GT(loop.best_iteration, 0) << "the loop learned nothing: the test has no choice";
+    return 0;
+  };
+  LearningState from_nothing;
+  ASSERT_TRUE(run_learning(scene, observed, options, from_nothing, callbacks));
+  EXPECT_EQ(asked, 1);
+
+  LearningOptions no_loop = options;
+  no_loop.max_iterations = 0;
+  LearningState forward_fit_alone;
+  ASSERT_TRUE(run_learning(scene, observed, no_loop, forward_fit_alone));
+  EXPECT_EQ(first_trial_rms(from_nothing), first_trial_rms(forward_fit_alone));
+  EXPECT_NE(first_trial_rms(from_nothing), first_trial_rms(from_best));
+}
+
 TEST(LearningLoop, TruthEqualToNominalLearnsAlmostNothing) {
   auto scene = bar_scene(bar(material::ElasticModelType::Corotated, 1e6), false);
   scene.frames = 60;

@@ -8,6 +8,7 @@
 #include <deque>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace elastolearn::learn {
@@ -277,6 +278,23 @@ bool run_forward_fit(std::span<const Motion> motions, std::span<const Reconstruc
   return !stopped || state.forward_fit_steps >= options.forward_fit.max_iterations;
 }
 
+/// Make the loop's iteration k the best, the forward fit's start (iteration 0: no correction).
+/// Throws std::logic_error for an iteration that did not complete.
+void start_forward_fit_from(int k, LearningState& state) {
+  if (k == state.best_iteration)
+    return;
+  const auto record = std::find_if(state.history.begin(), state.history.end(),
+      [&](const IterationRecord& r) { return iteration_of(r) == k; });
+  const auto tried = state.tried.find(k); // the corrections simulated: none for the nominal
+  if (record == state.history.end() || !forward_of(*record).completed()
+      || (tried == state.tried.end() && k != 0))
+    throw std::logic_error("the forward fit cannot start from iteration " + std::to_string(k)
+        + ": it did not complete");
+  state.best = tried == state.tried.end() ? nullptr : tried->second;
+  state.best_error = forward_of(*record).error().rms;
+  state.best_iteration = k;
+}
+
 } // namespace
 
 bool run_learning(const sim::Scene& scene, const observe::Observation& observed,
@@ -330,6 +348,9 @@ bool run_learning(std::span<const Motion> motions, const LearningOptions& option
     if (callbacks.checkpoint)
       callbacks.checkpoint(state);
   }
+  if (options.forward_fit.max_iterations > 0 && state.forward_fit_steps == 0
+      && callbacks.forward_fit_start)
+    start_forward_fit_from(callbacks.forward_fit_start(state), state);
   return run_forward_fit(motions, setup.meshes, options, state, callbacks);
 }
 

@@ -136,6 +136,10 @@ struct LearningCallbacks {
   std::function<void(const IterationRecord&)> iteration;
   std::function<void(const LearningState&)> checkpoint; ///< after each iteration (save)
   std::function<bool()> interrupted; ///< polled between stages
+  /// Called once the loop has ended and before the forward fit's first step: the iteration whose
+  /// correction the forward fit starts from, the loop's best (state.best_iteration) or any earlier
+  /// one that completed (0: no correction). Unset: the best.
+  std::function<int(const LearningState&)> forward_fit_start;
 };
 
 /// Run (or continue, from `state`) the loop on `motions` (a training set, at least one): each
