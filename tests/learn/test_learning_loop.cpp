@@ -80,6 +80,19 @@ struct OwnDroop {
   observe::Observation observed = observe_surface(scene);
 };
 
+/// The neo-Hookean bar (E = 1e6 Pa) drooping for 40 frames, observed at its surface, and its
+/// scene with a corotated nominal 1.75× too stiff to learn from.
+struct TooStiffDroop {
+  static sim::Scene droop(material::ElasticModelType type, double young) {
+    sim::Scene s = bar_scene(bar(type, young), false);
+    s.frames = 40;
+    return s;
+  }
+  sim::Scene scene = droop(material::ElasticModelType::Corotated, 1.75e6);
+  observe::Observation observed
+      = observe_surface(droop(material::ElasticModelType::NeoHookean, 1e6));
+};
+
 /// A loop state resumed at iteration 1: C_1 a uniaxial slope `own_slope` [Pa] (no kernels), the
 /// best so far the nominal (iteration 0) with forward error `best_error` [m].
 LearningState resumed_at_iteration_1(double own_slope, double best_error) {
@@ -341,26 +354,20 @@ TEST(LearningLoop, AConvergedForwardFitStopsAndStaysStopped) {
   // A tolerance no step can meet (each accepted step would have to lower the error by 99 %):
   // the forward fit stops after its first accepted step, and running the finished state again
   // takes no further step (as a resumed run must not).
-  const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
-  const auto nominal = bar(material::ElasticModelType::Corotated, 1.75e6);
-  auto scene = bar_scene(nominal, false);
-  scene.frames = 40;
-  auto truth_scene = bar_scene(truth, false);
-  truth_scene.frames = 40;
-  const auto observed = observe_surface(truth_scene);
+  const TooStiffDroop d;
   LearningOptions options = small_options();
   options.max_iterations = 0;
   options.forward_fit.max_iterations = 6;
   options.forward_fit.function_tolerance = 0.99;
   LearningState state;
-  ASSERT_TRUE(run_learning(scene, observed, options, state));
+  ASSERT_TRUE(run_learning(d.scene, d.observed, options, state));
   ASSERT_TRUE(state.forward_fit_converged);
   ASSERT_LT(state.forward_fit_steps, options.forward_fit.max_iterations);
   const ForwardFitRecord* last = forward_fit_of(state.history.back());
   ASSERT_TRUE(last);
   EXPECT_TRUE(last->accepted);
   const size_t steps = state.history.size();
-  ASSERT_TRUE(run_learning(scene, observed, options, state));
+  ASSERT_TRUE(run_learning(d.scene, d.observed, options, state));
   EXPECT_EQ(state.history.size(), steps);
 }
 
@@ -369,13 +376,7 @@ TEST(LearningLoop, TheForwardFitStartsWhereTheCallerChooses) {
   // correction. A caller that sends the forward fit back to no correction (iteration 0) is asked
   // once, after the loop, and the forward fit's first trial is then the one a run without loop
   // iterations takes from the nominal, bit for bit.
-  const auto truth = bar(material::ElasticModelType::NeoHookean, 1e6);
-  const auto nominal = bar(material::ElasticModelType::Corotated, 1.75e6);
-  auto scene = bar_scene(nominal, false);
-  scene.frames = 40;
-  auto truth_scene = bar_scene(truth, false);
-  truth_scene.frames = 40;
-  const auto observed = observe_surface(truth_scene);
+  const TooStiffDroop d;
   LearningOptions options = small_options();
   options.max_iterations = 2;
   options.forward_fit.max_iterations = 1;
@@ -388,7 +389,7 @@ TEST(LearningLoop, TheForwardFitStartsWhereTheCallerChooses) {
   };
 
   LearningState from_best;
-  ASSERT_TRUE(run_learning(scene, observed, options, from_best));
+  ASSERT_TRUE(run_learning(d.scene, d.observed, options, from_best));
   int asked = 0;
   LearningCallbacks callbacks;
   callbacks.forward_fit_start = [&](const LearningState& loop) {
@@ -399,13 +400,13 @@ TEST(LearningLoop, TheForwardFitStartsWhereTheCallerChooses) {
     return 0;
   };
   LearningState from_nothing;
-  ASSERT_TRUE(run_learning(scene, observed, options, from_nothing, callbacks));
+  ASSERT_TRUE(run_learning(d.scene, d.observed, options, from_nothing, callbacks));
   EXPECT_EQ(asked, 1);
 
   LearningOptions no_loop = options;
   no_loop.max_iterations = 0;
   LearningState forward_fit_alone;
-  ASSERT_TRUE(run_learning(scene, observed, no_loop, forward_fit_alone));
+  ASSERT_TRUE(run_learning(d.scene, d.observed, no_loop, forward_fit_alone));
   EXPECT_EQ(first_trial_rms(from_nothing), first_trial_rms(forward_fit_alone));
   EXPECT_NE(first_trial_rms(from_nothing), first_trial_rms(from_best));
 }
