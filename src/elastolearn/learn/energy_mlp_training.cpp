@@ -131,7 +131,8 @@ const MlpGradient& GradientLoss::gradient(const BatchNormMlp& net, const Gradien
     Chunk& w = m_chunks[std::size_t(chunk)];
     w.f.resize(layers);
     w.a_bar.resize(layers);
-    w.t_bar.resize(layers, std::vector<MatX>(std::size_t(d)));
+    if (w.t_bar.size() != layers || w.t_bar.front().size() != std::size_t(d)) // once per shape
+      w.t_bar.assign(layers, std::vector<MatX>(std::size_t(d)));
     w.gradient.weights.resize(layers);
     w.gradient.biases.resize(layers);
     auto& grad_w = w.gradient.weights;
