@@ -22,20 +22,18 @@
 ///      one passes) is the result; the fitted nominal if none, also where the
 ///      held-out data cannot resolve a candidate from it (a motion that has died out under
 ///      noise: the training data, which cannot see how a candidate forecasts, are compared and
-///      reported, not used; choose_candidate);
+///      reported, not used; candidate_choice.hpp);
 ///   5. network: a chosen correction is distilled into the network correction
 ///      (network_distillation.hpp), validated the same way, and replaces its teacher when it is
 ///      eligible, beats the fitted nominal by kSignificance, and is as good as its teacher
 ///      (network_replaces_teacher); it is several times cheaper to evaluate.
 /// The validation choice is what makes the result never worse than fitting parameters on data
 /// nobody tuned the recipe for: the fitted nominal is always a candidate.
-#include <elastolearn/learn/larger_motion_check.hpp>
+#include <elastolearn/learn/candidate_choice.hpp>
 #include <elastolearn/learn/learning_loop.hpp>
-#include <elastolearn/learn/material_stability.hpp>
 #include <elastolearn/learn/motion.hpp>
 #include <elastolearn/learn/network_distillation.hpp>
 #include <elastolearn/learn/parameter_fit.hpp>
-#include <elastolearn/learn/trajectory_error.hpp>
 #include <elastolearn/material/elastic_model_type.hpp>
 #include <elastolearn/observe/observation.hpp>
 #include <elastolearn/sim/scene.hpp>
@@ -76,74 +74,7 @@ struct NoiseLevel {
   double smoothing_residual = 0; ///< RMS change of the positions by the temporal smoothing [m]
 };
 
-/// What the validation compares.
-enum class CandidateKind { Nominal, FittedNominal, Loop, ForwardFit, Network };
-std::string to_string(CandidateKind kind);
-
-struct Candidate {
-  CandidateKind kind = CandidateKind::Nominal;
-  /// The loop's (or forward fit's) iteration, a network's teacher's; −1 for the nominals.
-  int iteration = -1;
-  /// The material's correction (null for the nominals; an RBF, or for CandidateKind::Network the
-  /// network correction); its elastic model is the fitted nominal's except for
-  /// CandidateKind::Nominal.
-  std::shared_ptr<const material::Correction> correction;
-  /// CandidateKind::Network: the index of the candidate it was distilled from, and its gain over
-  /// it in noise standard deviations (paired_significance; negative: worse than its teacher).
-  int teacher = -1;
-  double gain_over_teacher = 0;
-  bool completed = false; ///< the validation simulation completed
-  std::string failure; ///< why it did not (names the motion and the frame); empty if it did
-  ErrorSummary validation; ///< at the held-out observations [m]
-  /// Whether its material survives a larger motion: every held-out motion's scene driven
-  /// kLargerMotion times as hard (sim::amplified_scene) must simulate to its end (substeps
-  /// allowed), and the object must hold its droop under a body load as large
-  /// (check_larger_motion, droop_acceleration). A user's next motion is rarely the one recorded.
-  /// Not checked (passed) for the nominals, nor for a correction the choice did not reach: the
-  /// check costs a harder run of every motion and a static solve, so it runs on the best
-  /// candidate first and stops at the first that passes (learn_material).
-  LargerMotionCheck larger_motion;
-  /// Its material at the stretches a motion of another kind may reach (reachable_stretches of
-  /// the fitted nominal's runs of the held-out motions): a correction must be stable there. Not
-  /// checked (stable) for the nominals.
-  StabilityReport stability;
-  /// At the training observations as recorded [m], from the run of its validation (each motion
-  /// is simulated whole).
-  ErrorSummary training;
-  /// Its improvement on the reference (the fitted nominal, or the given one without a fit) in
-  /// standard deviations of what noise alone would give: z = (‖r − o‖² − ‖c − o‖²) / (2σ‖c − r‖)
-  /// over the held-out observations o, with r, c the reference's and this candidate's predictions
-  /// (the noise term of the difference, −2 nᵀ(c − r), has standard deviation 2σ‖c − r‖). 0 for
-  /// the reference itself.
-  double significance = 0;
-  /// How far the held-out data can tell it from the reference: the z it would reach there if it
-  /// were exactly right, ‖c − r‖ / (2σ) (+∞ without noise, 0 for the reference). Below
-  /// kSignificance no candidate, however good, could pass the held-out test: the held-out frames
-  /// barely move (a damped motion's tail) or the candidate barely differs there.
-  double resolution = 0;
-  /// The unknowns fitted to the training data (a correction's weights and tails; a network's
-  /// teacher's): the degrees of freedom training_significance charges. 0 for the nominals.
-  int unknowns = 0;
-  /// Its improvement on the reference over the training observations, charged for what fitting
-  /// its unknowns to their noise gains by itself (k σ² in expectation, k = unknowns):
-  /// z = (‖r − o‖² − ‖c − o‖² − k σ²) / (2σ‖c − r‖). NaN where not measured. Reported (what the
-  /// training data say where the held-out data cannot resolve a candidate), not used by the
-  /// choice: fitting the training frames better says nothing of how a candidate forecasts.
-  double training_significance = std::numeric_limits<double>::quiet_NaN();
-  /// It beats the reference beyond noise on the held-out data: they resolve it (resolution ≥
-  /// kSignificance) and it gains there (significance ≥ kSignificance). False for the reference
-  /// itself.
-  bool beats_reference = false;
-  /// Eligible for the choice: its validation completed, it survives a larger motion (or was not
-  /// checked for it) and it is stable where a motion of another kind may go.
-  bool eligible() const { return completed && larger_motion.completed && stability.stable(); }
-};
-
 /// Everything the recipe decided and measured.
-/// How many noise standard deviations a candidate must beat the fitted nominal by on the held-out
-/// data to replace it (one-sided: a 2.3 % chance that noise alone passes a candidate no better).
-inline constexpr double kSignificance = 2;
-
 struct RecipeResult {
   /// Per motion, the observations learned from: for a point-cloud capture those derived from its
   /// clouds (cloud_motion.hpp), else the motion's own.
@@ -187,57 +118,6 @@ struct RecipeResume {
 /// constant Rayleigh damping (fit-parameters needs both).
 NominalParameters nominal_parameters_of(
     const fem::MaterialModel& material, material::ElasticModelType& type);
-
-/// A paired test of candidate predictions `c` against reference predictions `r` of the
-/// observations `o` with noise σ per coordinate: z = (‖r − o‖² − ‖c − o‖²) / (2σ‖c − r‖), the
-/// gain in standard deviations of what noise alone would give (the noise term of the difference,
-/// −2 nᵀ(c − r), has standard deviation 2σ‖c − r‖). ±∞ (0 if c = r) when σ‖c − r‖ = 0.
-double paired_significance(const VecX& r, const VecX& c, const VecX& o, double sigma);
-
-/// How much larger than its teacher's a network's validation RMS may be and still count as
-/// "as good", whatever the noise: with exact data (σ → 0) the paired test calls any difference
-/// significant, and a network that reproduces its teacher to a fraction of a per cent (its
-/// distillation error) predicts the held-out data within rounding of the teacher's prediction.
-inline constexpr double kNetworkTolerance = 0.01;
-
-/// Stage 5's decision: a network candidate replaces its teacher when it is eligible, beats the
-/// reference (beats_reference, unless `has_reference` is false) and is as good as its teacher:
-/// not worse by kSignificance noise deviations, or its validation RMS within
-/// (1 + kNetworkTolerance) of the teacher's.
-bool network_replaces_teacher(
-    const Candidate& network, const Candidate& teacher, bool has_reference);
-
-/// Observations and every candidate's prediction of them, flat (frame, observed vertex, xyz; 0
-/// at lost entries; a prediction is empty where the candidate's simulation did not complete).
-struct ComparedData {
-  std::vector<VecX> predictions;
-  VecX observed;
-};
-
-/// Sets candidate i's significance, resolution, training_significance and beats_reference
-/// against the reference candidate (index `reference`), on the held-out data `validation` and,
-/// if it holds predictions of both, the training data `training`; σ the noise per coordinate.
-void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int reference,
-    const ComparedData& validation, const ComparedData& training, double sigma);
-
-/// Stage 4's choice, `reference` the index of the fitted nominal (or −1: no reference), σ the
-/// noise per coordinate. Compares every other completed candidate with the reference
-/// (compare_with_reference) and returns the index of the eligible candidate with the lowest
-/// validation RMS among the reference and the candidates that beat it on the held-out data
-/// (`training`, if it holds predictions, only sets their training_significance). With a
-/// reference, the given nominal (CandidateKind::Nominal) is compared but never chosen. −1 if no
-/// candidate is eligible.
-int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
-    const ComparedData& training, int reference, double sigma);
-
-/// Stage 4's choice with the larger-motion check run lazily: choose_candidate, and while the
-/// choice is a correction not yet checked, `check_larger_motion` sets its
-/// Candidate::larger_motion and the choice is made again (the candidate is then checked, and
-/// ineligible if it failed). Only the chosen correction and those the choice would have
-/// preferred are checked, each once. −1 if no candidate is eligible.
-int choose_checked_candidate(std::vector<Candidate>& candidates, const ComparedData& validation,
-    const ComparedData& training, int reference, double sigma,
-    const std::function<void(Candidate&)>& check_larger_motion);
 
 /// Run all stages (from `resume` on, if given: stage 2 is then not repeated). Returns with
 /// `interrupted` set if callbacks.loop.interrupted asked to stop (the last checkpoint holds the

@@ -1,6 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
 #include <elastolearn/fem/tet_element.hpp>
+#include <elastolearn/learn/element_state.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
 #include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/sim/amplified_scene.hpp>
@@ -141,33 +142,18 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
       r.velocities.push_back(v);
     });
   });
+  std::vector<ElementState> states;
   for (std::size_t i = 0; i < scenes.size(); ++i) {
     const sim::Scene& scene = scenes[i];
-    const std::vector<fem::TetRestData> rest = fem::precompute_rest_data(scene.mesh);
-    const Tets& tets = scene.mesh.tets();
-    Rows3 frame_stretches(tets.rows(), 3), frame_rates(tets.rows(), 3);
+    const ReconstructionMesh mesh(scene.mesh);
     Recorded& r = recorded_runs[i];
     for (std::size_t frame = 0; frame < r.positions.size(); ++frame) {
-      const VecX& x = r.positions[frame];
-      const VecX& v = r.velocities[frame];
-      tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, tets.rows(), 256),
-          [&](const tbb::blocked_range<Eigen::Index>& elements) {
-            for (Eigen::Index e = elements.begin(); e < elements.end(); ++e) {
-              const Eigen::Vector4i tet = tets.row(e).transpose();
-              const auto& data = rest[static_cast<std::size_t>(e)];
-              const material::PrincipalFrame pf = material::principal_frame(
-                  fem::deformation_gradient(fem::gather_tet(x, tet), data));
-              const Mat3 F_rate = fem::deformation_gradient(fem::gather_tet(v, tet), data);
-              frame_stretches.row(e) = pf.stretches.transpose();
-              frame_rates.row(e) = material::stretch_rates(pf, F_rate).transpose();
-            }
-          });
+      compute_element_states(mesh, r.positions[frame], r.velocities[frame], states);
       // Reservoir sampling (Algorithm R) over the states in the stretch interval: state i
       // replaces slot j < k with j uniform in [0, i].
-      for (Eigen::Index e = 0; e < tets.rows(); ++e) {
-        if (bounded
-            && (frame_stretches.row(e).minCoeff() < o.stretch_min
-                || frame_stretches.row(e).maxCoeff() > o.stretch_max))
+      for (const ElementState& state : states) {
+        const Vec3& sigma = state.frame.stretches;
+        if (bounded && (sigma.minCoeff() < o.stretch_min || sigma.maxCoeff() > o.stretch_max))
           continue;
         Eigen::Index slot = seen++;
         if (slot >= k) {
@@ -175,8 +161,8 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
           if (slot >= k)
             continue;
         }
-        stretches.row(slot) = frame_stretches.row(e);
-        rates.row(slot) = frame_rates.row(e);
+        stretches.row(slot) = sigma.transpose();
+        rates.row(slot) = state.stretch_rates.transpose();
       }
     }
     r.positions = {}; // the frames are sampled
