@@ -122,6 +122,17 @@ TEST(SceneFile, SolverStepHalvingsAreReadAndOutOfRangeIsAnErrorNamingTheField) {
   }
 }
 
+TEST(SceneFile, SolverStallIterationsAreReadAndANegativeCountIsAnErrorNamingTheField) {
+  ScratchDir dir;
+  EXPECT_EQ(parse(bar_scene(), dir.path()).scene.newton.stall_iterations, 20);
+  Json j = bar_scene();
+  j["solver"] = { { "stall_iterations", 0 } };
+  EXPECT_EQ(parse(j, dir.path()).scene.newton.stall_iterations, 0);
+  j["solver"]["stall_iterations"] = -1;
+  expect_input_error([&] { parse(j, dir.path()); },
+      { "scene.json: solver.stall_iterations: must be ≥ 0 (0: off)" });
+}
+
 // --- selections -------------------------------------------------------------------------------
 
 TEST(SceneFile, EverySelectionThatSelectsNoVertexIsAnErrorNamingIt) {

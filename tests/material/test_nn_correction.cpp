@@ -372,7 +372,7 @@ NnCorrection::Parameters energy_parameters(
 const std::vector<std::vector<int>> k_energy_architectures { { 8, 8 }, { 6, 6 }, { 5, 7 },
   { 6, 4, 3 }, { 12 }, {} };
 
-const std::vector<Vec3> k_energy_states { Vec3(1.12, 0.97, 0.9), Vec3(0.85, 1.2, 1.03),
+const std::vector<Vec3> k_network_energy_states { Vec3(1.12, 0.97, 0.9), Vec3(0.85, 1.2, 1.03),
   Vec3(1.0, 1.0, 1.0), Vec3(1.3, 0.7, 0.95) };
 
 } // namespace
@@ -386,7 +386,7 @@ TEST(NnEnergyCorrection, StressIsTheGradientOfTheEnergy) {
            Activation::Sigmoid, Activation::Elu }) {
     for (const auto& hidden : k_energy_architectures) {
       const NnCorrection n(energy_parameters(hidden, a));
-      for (const Vec3& s : k_energy_states) {
+      for (const Vec3& s : k_network_energy_states) {
         SCOPED_TRACE(testing::Message() << to_string(a) << ", " << hidden.size()
                                         << " hidden layers, stretches " << s.transpose());
         const Eigen::VectorXd N = n.correction(s, Vec3(0.4, -1, 2));
@@ -409,7 +409,7 @@ TEST(NnEnergyCorrection, TangentIsSymmetricAndMatchesFiniteDifferences) {
   for (Activation a : { Activation::Squareplus, Activation::Softplus, Activation::Tanh }) {
     for (const auto& hidden : k_energy_architectures) {
       const NnCorrection n(energy_parameters(hidden, a));
-      for (const Vec3& s : k_energy_states) {
+      for (const Vec3& s : k_network_energy_states) {
         SCOPED_TRACE(testing::Message() << to_string(a) << ", " << hidden.size()
                                         << " hidden layers, stretches " << s.transpose());
         Mat3 ds, dr;

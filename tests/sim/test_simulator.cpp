@@ -2,6 +2,7 @@
 #include <elastolearn/material/analytic_correction.hpp>
 #include <elastolearn/material/neohookean.hpp>
 #include <elastolearn/mesh/vertex_selection.hpp>
+#include <elastolearn/sim/newton.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 #include <elastolearn/sim/simulator.hpp>
 
@@ -132,6 +133,42 @@ TEST(Newton, ASolveTheProjectedTangentCannotFinishIsRetriedWithTheExactOne) {
   const double droop = -mean_tip_y(s.mesh, projected.positions());
   EXPECT_GT(droop, 0.05);
   EXPECT_LE((retried.positions() - projected.positions()).cwiseAbs().maxCoeff(), 1e-8 * droop);
+}
+
+TEST(Newton, ASolveThatCyclesStopsAsStalled) {
+  // g(u) = sign(u) √|u| per component: Newton's step u − g/g' = −u cycles between ±u with a
+  // constant residual, never converging. With stall_iterations = 5 the solve stops after the
+  // fifth iteration without a new lowest residual, naming the stall; with 0 it runs to
+  // max_iterations.
+  Tets tets(1, 4);
+  tets << 0, 1, 2, 3;
+  const fem::DofMap dofs(4, { 1, 2, 3 }); // vertex 0 free: three unknowns
+  fem::SystemMatrix A(tets, dofs);
+  const auto solver = sim::make_linear_solver(sim::LinearSolverType::Cholmod);
+  solver->analyze(A.matrix());
+  sim::NewtonProblem problem;
+  problem.residual = [](const VecX& u, VecX& g) {
+    g = u.unaryExpr([](double x) { return std::copysign(std::sqrt(std::abs(x)), x); });
+  };
+  problem.jacobian = [](const VecX& u, fem::SystemMatrix& J) {
+    J.set_zero();
+    J.add_diagonal(u.unaryExpr([](double x) { return 0.5 / std::sqrt(std::abs(x)); }));
+  };
+  auto solve = [&](int stall_iterations) {
+    sim::NewtonOptions options;
+    options.max_iterations = 100;
+    options.stall_iterations = stall_iterations;
+    VecX u = Vec3(0.5, -0.2, 0.3);
+    return sim::newton_solve(problem, u, A, *solver, options);
+  };
+  const sim::NewtonReport stalled = solve(5);
+  EXPECT_FALSE(stalled.converged);
+  EXPECT_EQ(stalled.iterations, 5);
+  EXPECT_NE(stalled.message.find("stalled"), std::string::npos) << stalled.message;
+  const sim::NewtonReport capped = solve(0);
+  EXPECT_FALSE(capped.converged);
+  EXPECT_EQ(capped.iterations, 100);
+  EXPECT_NE(capped.message.find("no convergence in 100"), std::string::npos) << capped.message;
 }
 
 TEST(Statics, CantileverTipDeflectionConvergesToBeamTheory) {

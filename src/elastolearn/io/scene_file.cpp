@@ -316,7 +316,7 @@ SceneFile parse_scene(
   if (root.has("solver")) {
     const JsonObject solver = root.object("solver");
     solver.reject_unknown_keys({ "linear", "newton_tolerance", "max_newton_iterations",
-        "reuse_jacobian", "max_step_halvings" });
+        "reuse_jacobian", "max_step_halvings", "stall_iterations" });
     s.linear_solver = sim::linear_solver_type_from_string(
         solver.choice("linear", { "cholmod", "cg", "eigen-ldlt" }, "cholmod"));
     s.newton.relative_tolerance = solver.positive("newton_tolerance", s.newton.relative_tolerance);
@@ -326,6 +326,9 @@ SceneFile parse_scene(
     s.newton.max_step_halvings = solver.integer("max_step_halvings", s.newton.max_step_halvings);
     if (s.newton.max_step_halvings < 0 || s.newton.max_step_halvings > 10)
       solver.fail("max_step_halvings", "must be in [0, 10]");
+    s.newton.stall_iterations = solver.integer("stall_iterations", s.newton.stall_iterations);
+    if (s.newton.stall_iterations < 0)
+      solver.fail("stall_iterations", "must be ≥ 0 (0: off)");
   }
   if (root.has("output")) {
     const JsonObject o = root.object("output");

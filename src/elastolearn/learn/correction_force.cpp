@@ -71,7 +71,7 @@ CorrectionForceJacobian::CorrectionForceJacobian(
   }
 }
 
-void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<MatX> rows,
+void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<Rows> rows,
     RbfDesign::OutputMatrix& outputs, RbfDesign::OutputGradient& gradients,
     Eigen::RowVectorXd& damping_row) const {
   const int u_elastic = m_design.elastic_unknowns();

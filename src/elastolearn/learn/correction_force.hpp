@@ -43,8 +43,10 @@ class CorrectionForceJacobian {
   const MatX& transposed(const VecX& x, const VecX& v);
 
   private:
+  /// The element blocks of a batch, row-major: each block row is added whole to a column of Jᵀ.
+  using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   /// Element e's 12 × u block into `rows`.
-  void element_rows(int e, Eigen::Ref<MatX> rows, RbfDesign::OutputMatrix& outputs,
+  void element_rows(int e, Eigen::Ref<Rows> rows, RbfDesign::OutputMatrix& outputs,
       RbfDesign::OutputGradient& gradients, Eigen::RowVectorXd& damping_row) const;
 
   const ReconstructionMesh& m_mesh;
@@ -56,7 +58,7 @@ class CorrectionForceJacobian {
   std::vector<int> m_free_dofs;
   VecX m_free_masses;
   MatX m_jt;
-  MatX m_batch; ///< 12 rows per element of one batch
+  Rows m_batch; ///< 12 rows per element of one batch
 };
 
 /// RMS force misfit of a correction against targets over the free dofs.

@@ -134,6 +134,11 @@ StressSamples distillation_samples(std::span<const sim::Scene> scenes,
   tbb::parallel_for(std::size_t(0), scenes.size(), [&](std::size_t i) {
     sim::Scene scene = scenes[i];
     scene.material.correction = shared_teacher;
+    // A sampling run only collects states: where a step fails it stops instead of rescuing the
+    // step (exact tangent, substeps). The states past a failing step are where the teacher is
+    // least trustworthy, and a stalled run's rescues cost more than the run.
+    scene.newton.retry_exact_tangent = false;
+    scene.newton.max_step_halvings = 0;
     Recorded& r = recorded_runs[i];
     r.run = sim::run_simulation(scene, [&](int frame, double, const VecX& x, const VecX& v) {
       if (frame % o.frame_stride != 0)

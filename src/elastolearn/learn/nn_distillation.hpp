@@ -67,7 +67,8 @@ struct DistillationSampleReport {
 /// −Δα₁ K_e v_e damps, and its large rate-driven targets cost the elastic part enough accuracy
 /// that the network's simulations diverged (docs/learning.md). with_teacher_damping carries it
 /// over exactly instead.
-/// A simulation that diverges contributes the frames before it (reported). Deterministic.
+/// A simulation whose step fails stops there, unrescued (no exact-tangent retry or substeps),
+/// and contributes the frames before it (reported). Deterministic.
 /// Throws InputError for bad options, no scenes, or no recorded state at all.
 StressSamples distillation_samples(std::span<const sim::Scene> scenes,
     const material::Correction& teacher, const DistillationSampleOptions& options,

@@ -68,6 +68,8 @@ RbfDesign::RbfDesign(
   if (!centres.allFinite())
     rbf_fit_error("centres", "contains a non-finite value");
   m_centres = centres;
+  if (options.energy_kernels)
+    m_energy_kernels = material::EnergyKernelBank(centres, options.epsilon);
   const int m = static_cast<int>(centres.rows());
   m_rest_kernels = VecX::Zero(m);
   // A kernel's stress at rest (equal in every direction for energy kernels, by symmetry).
@@ -232,11 +234,11 @@ void RbfDesign::clamp_gradient(const ClampState& c, const OutputMatrix& a, const
 }
 
 void RbfDesign::formula_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const {
-  if (m_options.energy_kernels)
-    for (Eigen::Index i = 0; i < m_centres.rows(); ++i)
-      out.col(i) = material::energy_kernel_gradient(
-                       stretches, m_centres.row(i).transpose(), m_options.epsilon)
-          - Vec3::Constant(m_rest_kernels[i]);
+  if (m_options.energy_kernels) {
+    const Eigen::Index m = m_centres.rows();
+    m_energy_kernels.evaluate(stretches, out.leftCols(m));
+    out.leftCols(m).rowwise() -= m_rest_kernels.transpose();
+  }
   view_columns(stretches, out);
 }
 
@@ -330,14 +332,10 @@ void RbfDesign::formula_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> o
       }
     }
   }
-  if (m_options.energy_kernels) {
-    Mat3 hessian; // ∂N_k/∂σ_j of kernel i alone: row 3j + k
-    for (Eigen::Index i = 0; i < m; ++i) {
-      out.col(i) = material::energy_kernel_gradient(
-                       stretches, m_centres.row(i).transpose(), m_options.epsilon, &hessian)
-          - Vec3::Constant(m_rest_kernels[i]);
-      gradient.col(i) = hessian.reshaped();
-    }
+  if (m_options
+          .energy_kernels) { // column i of `gradient`: ∂N_k/∂σ_j of kernel i alone (row 3j + k)
+    m_energy_kernels.evaluate(stretches, out.leftCols(m), gradient.leftCols(m));
+    out.leftCols(m).rowwise() -= m_rest_kernels.transpose();
   }
 }
 

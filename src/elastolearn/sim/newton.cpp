@@ -14,6 +14,8 @@ void NewtonOptions::validate() const {
     throw InputError("newton.absolute_tolerance", "must be >= 0");
   if (max_iterations < 1)
     throw InputError("newton.max_iterations", "must be >= 1");
+  if (stall_iterations < 0)
+    throw InputError("newton.stall_iterations", "must be >= 0 (0: off)");
   if (max_line_search < 0)
     throw InputError("newton.max_line_search", "must be >= 0");
   if (max_step_halvings < 0 || max_step_halvings > 10)
@@ -57,6 +59,8 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
   bool reuse_jacobian = false; // the first iteration always assembles
   const double target
       = std::max(options.relative_tolerance * report.initial_residual, options.absolute_tolerance);
+  double lowest = norm; // and the iteration that reached it
+  int lowest_at = 0;
   for (;;) {
     report.residual = norm;
     if (!std::isfinite(norm)) {
@@ -65,6 +69,17 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
     }
     if (norm <= target) {
       report.converged = true;
+      return report;
+    }
+    if (norm < lowest) {
+      lowest = norm;
+      lowest_at = report.iterations;
+    } else if (options.stall_iterations > 0
+        && report.iterations - lowest_at >= options.stall_iterations) {
+      report.message = "stalled: no Newton iteration of the last "
+          + std::to_string(options.stall_iterations) + " went below residual "
+          + std::to_string(lowest) + " (now " + std::to_string(norm) + ", target "
+          + std::to_string(target) + ")";
       return report;
     }
     if (report.iterations == options.max_iterations) {

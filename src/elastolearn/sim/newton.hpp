@@ -18,6 +18,12 @@ struct NewtonOptions {
   double relative_tolerance = 1e-6; ///< stop when ‖g‖ ≤ tol · ‖g₀‖ …
   double absolute_tolerance = 0; ///< … or ‖g‖ ≤ this [N] (0: chosen by the caller's scale)
   int max_iterations = 50;
+  /// A solve whose residual has not gone below its lowest value so far for this many iterations
+  /// stops as stalled (0: never): Newton then cycles instead of converging, and the caller's
+  /// rescue (exact tangent, substeps) is where a solution comes from. Converging solves lower
+  /// their residual every iteration or two, so this ends only solves that would reach
+  /// max_iterations without converging.
+  int stall_iterations = 20;
   int max_line_search = 12; ///< step halvings
   /// Jacobian reuse (a chord step): after an iteration that shrank ‖g‖ at least this many times,
   /// the next one solves with the same Jacobian and factorisation instead of re-assembling at
