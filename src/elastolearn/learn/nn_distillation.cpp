@@ -1,9 +1,7 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/core/format.hpp>
-#include <elastolearn/fem/tet_element.hpp>
 #include <elastolearn/learn/element_state.hpp>
 #include <elastolearn/learn/nn_distillation.hpp>
-#include <elastolearn/material/principal_stress.hpp>
 #include <elastolearn/sim/amplified_scene.hpp>
 #include <elastolearn/sim/run_simulation.hpp>
 

@@ -1,15 +1,12 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/material/energy_kernel_bank.hpp>
+#include <elastolearn/material/rbf_correction.hpp>
 
 #include <array>
 
 namespace elastolearn::material {
 
 namespace {
-
-/// The six permutations of three indices in energy_kernel_gradient's order.
-constexpr std::array<std::array<int, 3>, 6> k_permutations
-    = { { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } } };
 
 /// The slot of the symmetric Hessian entry (a, b): the diagonal 0–2, then (0, 1), (0, 2), (1, 2).
 constexpr int symmetric_slot(int a, int b) {
@@ -62,7 +59,7 @@ void EnergyKernelBank::evaluate_packed(
       a.setZero();
     for (auto& a : h)
       a.setZero();
-    for (const auto& pi : k_permutations) {
+    for (const auto& pi : kStretchPermutations) {
       const std::array<Lanes, 3> d
           = { stretches[pi[0]] - cx, stretches[pi[1]] - cy, stretches[pi[2]] - cz };
       const Lanes r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2;

@@ -63,14 +63,6 @@ Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3
   return g;
 }
 
-namespace {
-
-/// The six permutations of three indices: P_π σ = (σ[π₀], σ[π₁], σ[π₂]).
-constexpr std::array<std::array<int, 3>, 6> k_permutations
-    = { { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } } };
-
-} // namespace
-
 Vec3 energy_kernel_gradient(
     const Vec3& stretches, const Vec3& centre, double epsilon, Mat3* hessian) {
   // ∂φ(‖u − c‖)/∂u = (u − c)/φ with u = P_π σ, so ∂/∂σ[π_j] receives (u_j − c_j)/φ, and
@@ -79,7 +71,7 @@ Vec3 energy_kernel_gradient(
   Vec3 gradient = Vec3::Zero();
   if (hessian)
     hessian->setZero();
-  for (const auto& pi : k_permutations) {
+  for (const auto& pi : kStretchPermutations) {
     const Vec3 d(
         stretches[pi[0]] - centre[0], stretches[pi[1]] - centre[1], stretches[pi[2]] - centre[2]);
     const double phi = std::sqrt(d.squaredNorm() + eps2);
@@ -97,7 +89,7 @@ Vec3 energy_kernel_gradient(
 
 double energy_kernel(const Vec3& stretches, const Vec3& centre, double epsilon) {
   double sum = 0;
-  for (const auto& pi : k_permutations)
+  for (const auto& pi : kStretchPermutations)
     sum += rbf_kernel(
         (Vec3(stretches[pi[0]], stretches[pi[1]], stretches[pi[2]]) - centre).squaredNorm(),
         epsilon);
@@ -149,7 +141,7 @@ RbfCorrection::RbfCorrection(Parameters p)
       a->setZero(padded);
     Eigen::Index j = 0;
     for (Eigen::Index i = 0; i < m; ++i)
-      for (const auto& pi : k_permutations) {
+      for (const auto& pi : kStretchPermutations) {
         // ‖P_π σ − c‖ = ‖σ − P_π⁻¹ c‖: component π_l of the copy is c_l.
         Vec3 copy;
         for (int l = 0; l < 3; ++l)

@@ -39,6 +39,11 @@ Eigen::Vector4d quadratic_tail_basis(const Vec3& y);
 /// `d_y`, if not null, receives ∂g_i/∂y as its rows.
 Eigen::Vector2d neo_hookean_tail_basis(const Vec3& y, Eigen::Matrix<double, 2, 3>* d_y = nullptr);
 
+/// The six permutations of three indices: P_π σ = (σ[π₀], σ[π₁], σ[π₂]), in the order every
+/// energy-kernel sum runs over them.
+inline constexpr std::array<std::array<int, 3>, 6> kStretchPermutations
+    = { { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } } };
+
 /// The energy kernel of centre c: S(σ) = Σ_π φ(‖P_π σ − c‖) over the six permutations P_π of
 /// the stretches, φ = rbf_kernel. S is a smooth symmetric function of σ (for ε > 0), so its
 /// gradient is a principal stress that is continuous in F (equal components at equal stretches)
