@@ -92,8 +92,9 @@ double g_damping_regularization = -1, g_regularization = -1, g_position_weight =
        g_kernel_smoothing = -1, g_full_space_weight = -1, g_damping_prior = -1,
        g_elastic_prior = -1, g_smoothness = -1, g_forward_fit_tolerance = -1;
 bool g_no_neo_hookean_tail = false, g_damping_quadratic = false, g_linear_tail = false,
-     g_full_space = false, g_no_damping = false, g_pod_forward_only = false, g_unprojected = false,
-     g_no_backtrack = false, g_no_stability_cuts = false, g_exact_sensitivities = false;
+     g_full_space = false, g_no_damping = false, g_extrapolate_velocity = false,
+     g_pod_forward_only = false, g_unprojected = false, g_no_backtrack = false,
+     g_no_stability_cuts = false, g_exact_sensitivities = false;
 /// --smooth-clamp, --smooth-expansion: the continuation beyond the trusted stretches.
 std::optional<material::Continuation> g_continuation;
 
@@ -509,6 +510,8 @@ int main(int argc, char** argv) {
       g_forward_fit_tolerance = std::stod(argv[++i]);
     else if (a == "--no-damping")
       g_no_damping = true;
+    else if (a == "--extrapolate-velocity")
+      g_extrapolate_velocity = true;
     else if (a == "--smooth-clamp")
       g_continuation = material::Continuation::smooth_clamp;
     else if (a == "--smooth-expansion")
@@ -537,10 +540,11 @@ int main(int argc, char** argv) {
                   "[--no-stability-cuts] [--exact-sensitivities] [--damping-prior "
                   "RHO] [--elastic-prior RHO] [--seed S] "
                   "[--regularization L] [--kernel-smoothing EPS] [--damping-regularization L] "
-                  "[--smoothness L] "
+                  "[--smoothness L] [--fit P[,P...]] "
                   "[--stress-kernels] [--linear-tail] [--no-neo-hookean-tail] [--no-mass-damping] "
                   "[--damping-quadratic-tail] [--full-space] "
                   "[--pod-forward-only] [--no-damping] [--smooth-clamp] [--smooth-expansion] "
+                  "[--extrapolate-velocity] "
                   "[--position-weight W] "
                   "[--unprojected-reconstruction] [--full-space-weight MU] [CASE ...]\n"
                   "       bench_learning --random N [--seed S] [--random-case I] [--draw-only] "
@@ -551,7 +555,8 @@ int main(int argc, char** argv) {
           " (aliases: all, sparse-views = turtle sparse-13 sparse-6)\n--data: where libcgal-demo's "
           "data/meshes are (extracted there if missing)\n--random N: N random cases drawn from "
           "seed S (default: a fresh seed, printed), each learned by learn::learn_material with "
-          "its default options (the learning overrides above do not apply); --random-case I: only "
+          "the default options and the learning overrides above, as named cases are (none: the one "
+          "recipe); --random-case I: only "
           "case I of that draw; --draw-only: print the draws without simulating\n--noise PCT: "
           "Gaussian observation noise σ = PCT %% of the diagonal (named cases: default 0; random "
           "cases: instead of the drawn level, every other draw unchanged)\n--noise-pair: each "
@@ -613,6 +618,8 @@ int main(int argc, char** argv) {
   for (const auto& name : names) {
     try {
       LearningCase c = make_case(name, data, quick);
+      if (g_extrapolate_velocity) // every simulation of the case, learning's included
+        c.train.newton.extrapolate_velocity = c.test.newton.extrapolate_velocity = true;
       if (g_seeds > 1) {
         const std::uint64_t first = g_seed >= 0 ? static_cast<std::uint64_t>(g_seed) : 1;
         for (int k = 0; k < g_seeds; ++k) {

@@ -133,6 +133,16 @@ TEST(SceneFile, SolverStallIterationsAreReadAndANegativeCountIsAnErrorNamingTheF
       { "scene.json: solver.stall_iterations: must be ≥ 0 (0: off)" });
 }
 
+TEST(SceneFile, SolverExtrapolateVelocityIsReadAndANonBooleanIsAnErrorNamingTheField) {
+  ScratchDir dir;
+  EXPECT_FALSE(parse(bar_scene(), dir.path()).scene.newton.extrapolate_velocity);
+  Json j = bar_scene();
+  j["solver"] = { { "extrapolate_velocity", true } };
+  EXPECT_TRUE(parse(j, dir.path()).scene.newton.extrapolate_velocity);
+  j["solver"]["extrapolate_velocity"] = 1;
+  expect_input_error([&] { parse(j, dir.path()); }, { "scene.json: solver.extrapolate_velocity" });
+}
+
 // --- selections -------------------------------------------------------------------------------
 
 TEST(SceneFile, EverySelectionThatSelectsNoVertexIsAnErrorNamingIt) {

@@ -152,7 +152,8 @@ TEST(ParameterFit, DivergingTrialsAreRejectedNotFatal) {
   scene.newton.max_iterations = 3;
   scene.newton.relative_tolerance = 1e-10;
   scene.newton.jacobian_reuse_contraction
-      = 0; // the thresholds above were measured with full Newton
+      = 0; // the thresholds above were measured with full Newton …
+  scene.newton.extrapolate_velocity = false; // … started from the current velocities
   scene.newton.max_step_halvings = 0; // a failed step is not retried in substeps …
   scene.newton.retry_exact_tangent = false; // … nor with the exact tangent
   learn::ParameterFitOptions options;

@@ -316,7 +316,7 @@ SceneFile parse_scene(
   if (root.has("solver")) {
     const JsonObject solver = root.object("solver");
     solver.reject_unknown_keys({ "linear", "newton_tolerance", "max_newton_iterations",
-        "reuse_jacobian", "max_step_halvings", "stall_iterations" });
+        "reuse_jacobian", "max_step_halvings", "stall_iterations", "extrapolate_velocity" });
     s.linear_solver = sim::linear_solver_type_from_string(
         solver.choice("linear", { "cholmod", "cg", "eigen-ldlt" }, "cholmod"));
     s.newton.relative_tolerance = solver.positive("newton_tolerance", s.newton.relative_tolerance);
@@ -329,6 +329,8 @@ SceneFile parse_scene(
     s.newton.stall_iterations = solver.integer("stall_iterations", s.newton.stall_iterations);
     if (s.newton.stall_iterations < 0)
       solver.fail("stall_iterations", "must be ≥ 0 (0: off)");
+    s.newton.extrapolate_velocity
+        = solver.boolean("extrapolate_velocity", s.newton.extrapolate_velocity);
   }
   if (root.has("output")) {
     const JsonObject o = root.object("output");

@@ -67,7 +67,7 @@ NewtonReport newton_solve(const NewtonProblem& problem, VecX& u, fem::SystemMatr
       report.message = "residual is not finite";
       return report;
     }
-    if (norm <= target) {
+    if (norm <= target && (report.iterations > 0 || !problem.start_is_prediction)) {
       report.converged = true;
       return report;
     }

@@ -35,6 +35,13 @@ struct NewtonOptions {
   /// Time steps only (Simulator::step): a step whose Newton solve fails is retried as 2, 4, …,
   /// 2^max_step_halvings substeps before the step counts as failed. 0: no retry.
   int max_step_halvings = 3;
+  /// Time steps only (Simulator::step): Newton starts each step from the velocities extrapolated
+  /// at constant acceleration, v + (v − v_before), when the previous step had the same length,
+  /// instead of from v. In smooth motion that start is O(h²a') from the solution rather than
+  /// O(h a), so a step needs fewer iterations; the converged step is the same to the tolerance.
+  /// Off by default: learning's results hang on tolerance-level differences of its simulations
+  /// and its forward fit is paced by the sensitivities, not the steps (docs/design_notes.md).
+  bool extrapolate_velocity = false;
   /// Simulator solves (time steps, static load steps): a solve that fails with the PSD-projected
   /// tangent is retried with the exact one, before any substep: from where it stopped if it got
   /// closer to the solution, then from its start.
@@ -80,6 +87,10 @@ struct NewtonProblem {
   /// overwritten with that increment. Time stepping passes the previous step's, which smooth
   /// motion makes nearly equal; it changes no convergence criterion, only the CG start.
   VecX* first_increment = nullptr;
+  /// The start is a prediction (Simulator's extrapolated velocities): take at least one
+  /// iteration even if its residual already meets the tolerance, which an absolute tolerance
+  /// loose for a small motion can allow (the prediction alone is an explicit step).
+  bool start_is_prediction = false;
 };
 
 /// Solve g(u) = 0 starting from u. The solver's symbolic analysis must already be done on A's

@@ -66,6 +66,7 @@ void Simulator::set_state(const VecX& x, const VecX& v, double time) {
   ELASTOLEARN_CHECK(x.size() == m_x.size() && v.size() == m_v.size(), "state size mismatch");
   m_x = x;
   m_v = v;
+  forget_previous_step();
   m_time = time;
   m_start_time = time;
   m_step = 0;
@@ -133,6 +134,7 @@ NewtonReport Simulator::advance_in_substeps(double t_next, NewtonReport failed) 
     const double h = m_scene.dt / substeps;
     m_x = x_start;
     m_v = v_start;
+    forget_previous_step();
     bool converged = true;
     for (int i = 1; i <= substeps && converged; ++i) {
       const NewtonReport r = advance(i == substeps ? t_next : t_start + i * h, h);
@@ -152,6 +154,7 @@ NewtonReport Simulator::advance_in_substeps(double t_next, NewtonReport failed) 
   }
   m_x = x_start;
   m_v = v_start;
+  forget_previous_step();
   return total;
 }
 
@@ -187,7 +190,8 @@ NewtonReport Simulator::advance(double t_next, double h) {
   };
   if (m_solver->type() == LinearSolverType::ConjugateGradient)
     problem.first_increment = &m_first_increment;
-  VecX u = m_dofs.restrict(m_v);
+  VecX u;
+  problem.start_is_prediction = first_iterate(h, u);
   NewtonReport report = newton(problem, u);
   if (!report.converged)
     return report;
@@ -197,9 +201,21 @@ NewtonReport Simulator::advance(double t_next, double h) {
     report.message = "state is not finite";
     return report;
   }
+  m_v_before = m_v;
+  m_previous_step = h;
   m_x = m_x_new;
   m_v = m_v_new;
   return report;
+}
+
+bool Simulator::first_iterate(double h, VecX& u) const {
+  m_dofs.restrict_into(m_v, u);
+  if (!m_scene.newton.extrapolate_velocity || m_previous_step != h)
+    return false;
+  const auto& free = m_dofs.free_dofs();
+  for (size_t i = 0; i < free.size(); ++i)
+    u[static_cast<Eigen::Index>(i)] += m_v[free[i]] - m_v_before[free[i]];
+  return true;
 }
 
 NewtonReport Simulator::newton(const NewtonProblem& problem, VecX& u) {
@@ -302,6 +318,7 @@ NewtonReport Simulator::solve_static(int load_steps) {
   state_from(u);
   m_x = m_x_new;
   m_v.setZero();
+  forget_previous_step();
   return total;
 }
 
@@ -310,6 +327,7 @@ NewtonReport Simulator::apply_initial_condition() {
   const double t0 = ic.kind == InitialCondition::Kind::Recorded ? ic.time : 0.0;
   m_x = prescribed_positions(t0); // rest, with prescribed vertices where they are at t0
   m_v.setZero();
+  forget_previous_step();
   m_time = t0;
   m_start_time = t0;
   m_step = 0;

@@ -69,6 +69,13 @@ class Simulator {
   NewtonReport advance(double t_next, double h);
   /// step()'s retries after `failed`, the report of the whole step.
   NewtonReport advance_in_substeps(double t_next, NewtonReport failed);
+  /// Newton's first iterate for a step of length h: the free velocities extrapolated at constant
+  /// acceleration, v + (v − v_before), when the previous step ended at the current state and had
+  /// the same length (NewtonOptions::extrapolate_velocity); the current velocities otherwise.
+  /// Returns whether it extrapolated.
+  bool first_iterate(double h, VecX& u) const;
+  /// The state was set from outside a step: the next step has no previous one to extrapolate.
+  void forget_previous_step() { m_previous_step = 0; }
   /// newton_solve on the scene's system, retried with the exact (unprojected) tangent when it
   /// fails and NewtonOptions::retry_exact_tangent is set (from where it stopped, then its start).
   NewtonReport newton(const NewtonProblem& problem, VecX& u);
@@ -95,6 +102,8 @@ class Simulator {
   VecX m_x_new, m_v_new, m_force, m_dv, m_mass_dv, m_x_prescribed;
   VecX m_u_start; ///< Newton's start, kept for the exact-tangent retry
   VecX m_first_increment; ///< previous step's first Newton increment (warm start for CG)
+  VecX m_v_before; ///< velocities at the start of the previous step (first_iterate)
+  double m_previous_step = 0; ///< its length [s]; 0: none ended at the current state
 };
 
 } // namespace elastolearn::sim
