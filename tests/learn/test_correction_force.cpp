@@ -244,3 +244,23 @@ TEST(CorrectionForceJacobian, TimesTheUnknownsIsTheCorrectionForce) {
       EXPECT_GT(f.norm(), 0.0);
     }
 }
+
+TEST(CorrectionForceJacobian, FramesFromAnElasticForceAtTheStateGiveTheSameJacobian) {
+  // The forward fit hands J the principal frames its residual's force pass computed at x: J must
+  // be bit for bit the one from its own SVDs, and frames cached at another state are refused.
+  const mesh::TetMesh mesh = small_mesh();
+  const fem::DofMap dofs(mesh.num_vertices(), {});
+  const State s = random_state(mesh, 5), other = random_state(mesh, 6);
+  const RbfDesign design(rbf_correction().parameters().centres, RbfFitOptions {});
+  const ReconstructionMesh geometry(mesh, nominal(material::DampingTangent::FlipFree, nullptr));
+  fem::ElasticForce force(mesh, geometry.nominal);
+  VecX f = VecX::Zero(s.x.size());
+  force.add_force({ s.x, other.v }, f); // the frames depend on x only
+  ASSERT_TRUE(force.caches_positions(s.x));
+  CorrectionForceJacobian own(geometry, dofs, design), shared(geometry, dofs, design);
+  const MatX expected = own.transposed(s.x, s.v);
+  EXPECT_EQ(shared.transposed(s.x, s.v, force), expected);
+  EXPECT_GT(expected.norm(), 0.0);
+  EXPECT_FALSE(force.caches_positions(other.x));
+  EXPECT_THROW(shared.transposed(other.x, other.v, force), std::logic_error);
+}

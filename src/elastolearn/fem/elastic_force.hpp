@@ -68,6 +68,15 @@ class ElasticForce final : public ForceTerm {
   /// the projection, which is the default).
   void set_project_tangent(bool project) { m_project_tangent = project; }
 
+  /// Whether the element cache is that of positions x (the last add_force was at x); then
+  /// cached_frame gives each element's principal frame there without another SVD.
+  bool caches_positions(const VecX& x) const {
+    return m_cache.size() == static_cast<size_t>(m_tets.rows()) && m_cached_x.size() == x.size()
+        && m_cached_x == x;
+  }
+  /// Element e's principal frame at the last add_force's positions (see caches_positions).
+  const material::PrincipalFrame& cached_frame(int e) const { return m_cache[e].frame; }
+
   const MaterialModel& material() const { return m_material; }
   const std::vector<TetRestData>& rest_data() const { return m_rest; }
   const Tets& tets() const { return m_tets; }

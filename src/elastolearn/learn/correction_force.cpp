@@ -107,9 +107,19 @@ void CorrectionForceJacobian::element_rows(int e, Eigen::Ref<Rows> rows,
 }
 
 const MatX& CorrectionForceJacobian::transposed(const VecX& x, const VecX& v) {
+  compute_element_states(m_mesh, x, v, m_states);
+  return assemble_transposed(v);
+}
+
+const MatX& CorrectionForceJacobian::transposed(
+    const VecX& x, const VecX& v, const fem::ElasticForce& frames) {
+  compute_element_states(m_mesh, x, v, frames, m_states);
+  return assemble_transposed(v);
+}
+
+const MatX& CorrectionForceJacobian::assemble_transposed(const VecX& v) {
   const int m = m_mesh.num_tets();
   const int u_elastic = m_design.elastic_unknowns();
-  compute_element_states(m_mesh, x, v, m_states);
   m_jt.setZero();
   for (int first = 0; first < m; first += k_jacobian_batch) {
     const int count = std::min(k_jacobian_batch, m - first);

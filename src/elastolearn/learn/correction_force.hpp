@@ -41,6 +41,9 @@ class CorrectionForceJacobian {
       const ReconstructionMesh& mesh, const fem::DofMap& dofs, const RbfDesign& design);
   /// Jᵀ (unknowns × free dofs) at flat 3n positions x [m] and velocities v [m/s].
   const MatX& transposed(const VecX& x, const VecX& v);
+  /// The same, with the elements' principal frames taken from `frames`, a force of the same mesh
+  /// whose last add_force was at x (compute_element_states): the SVDs it did already.
+  const MatX& transposed(const VecX& x, const VecX& v, const fem::ElasticForce& frames);
 
   private:
   /// The element blocks of a batch, row-major: each block row is added whole to a column of Jᵀ.
@@ -48,6 +51,8 @@ class CorrectionForceJacobian {
   /// Element e's 12 × u block into `rows`.
   void element_rows(int e, Eigen::Ref<Rows> rows, RbfDesign::OutputMatrix& outputs,
       RbfDesign::OutputGradient& gradients, Eigen::RowVectorXd& damping_row) const;
+  /// Jᵀ at the element states in m_states (velocities v for Δα₀'s column).
+  const MatX& assemble_transposed(const VecX& v);
 
   const ReconstructionMesh& m_mesh;
   const RbfDesign& m_design;

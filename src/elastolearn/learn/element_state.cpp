@@ -13,17 +13,29 @@ namespace {
 
 constexpr FieldErrors element_state_error("stress_reconstruction");
 
-/// Element states of elements [begin, end) (serial; no allocation).
-void element_states_range(const ReconstructionMesh& mesh, const VecX& x, const VecX& v, int begin,
-    int end, std::vector<ElementState>& states) {
+/// Element states of elements [begin, end) (serial; no allocation), each frame the SVD of F at x
+/// or, if `frames` is not null, its cached one.
+void element_states_range(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,
+    const fem::ElasticForce* frames, int begin, int end, std::vector<ElementState>& states) {
   for (int e = begin; e < end; ++e) {
     const fem::TetRestData& rest = mesh.rest[e];
     const Eigen::Vector4i tet = mesh.tets.row(e).transpose();
     ElementState& s = states[e];
-    s.frame = material::principal_frame(fem::deformation_gradient(fem::gather_tet(x, tet), rest));
+    s.frame = frames != nullptr
+        ? frames->cached_frame(e)
+        : material::principal_frame(fem::deformation_gradient(fem::gather_tet(x, tet), rest));
     s.deformation_rate = fem::deformation_gradient(fem::gather_tet(v, tet), rest);
     s.stretch_rates = material::stretch_rates(s.frame, s.deformation_rate);
   }
+}
+
+void element_states(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,
+    const fem::ElasticForce* frames, std::vector<ElementState>& states) {
+  states.resize(mesh.num_tets());
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, mesh.num_tets(), 256), [&](const tbb::blocked_range<int>& r) {
+        element_states_range(mesh, x, v, frames, r.begin(), r.end(), states);
+      });
 }
 
 /// A stiffness scale, if any, has one entry per tet (its values fem::ElasticForce checks).
@@ -59,11 +71,14 @@ ReconstructionMesh::ReconstructionMesh(std::vector<fem::TetRestData> rest_data, 
 
 void compute_element_states(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,
     std::vector<ElementState>& states) {
-  states.resize(mesh.num_tets());
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, mesh.num_tets(), 256), [&](const tbb::blocked_range<int>& r) {
-        element_states_range(mesh, x, v, r.begin(), r.end(), states);
-      });
+  element_states(mesh, x, v, nullptr, states);
+}
+
+void compute_element_states(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,
+    const fem::ElasticForce& frames, std::vector<ElementState>& states) {
+  ELASTOLEARN_CHECK(frames.tets().rows() == mesh.tets.rows() && frames.caches_positions(x),
+      "the element force's cached frames are not those of this mesh at these positions");
+  element_states(mesh, x, v, &frames, states);
 }
 
 void StretchSampleOptions::validate() const {

@@ -48,6 +48,12 @@ struct ElementState {
 /// resized to m (no allocation once sized). Parallel over elements (oneTBB).
 void compute_element_states(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,
     std::vector<ElementState>& states);
+/// The same states with each element's principal frame taken from `frames`, an element force of
+/// the same mesh (same tets, same order) whose last add_force was at x
+/// (fem::ElasticForce::caches_positions): the SVD it already did, bit for bit. Throws
+/// std::logic_error if its cache is not at x or it has another number of tets.
+void compute_element_states(const ReconstructionMesh& mesh, const VecX& x, const VecX& v,
+    const fem::ElasticForce& frames, std::vector<ElementState>& states);
 
 /// Which principal stretches collect_stretches returns.
 struct StretchSampleOptions {

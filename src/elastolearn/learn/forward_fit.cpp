@@ -111,7 +111,8 @@ ForwardSensitivityPass untimed_pass(const sim::Scene& scene, const observe::Obse
     physics.residual(frames[0], frames[0], frames[0], 0.0, residual);
     physics.jacobians(system, damping); // K + D/h and D at v = 0
     const fem::SparseMatrix k0 = system.matrix() - damping.matrix() / h;
-    rhs = jacobian->transposed(frames[0], VecX::Zero(frames[0].size())).transpose();
+    rhs = jacobian->transposed(frames[0], VecX::Zero(frames[0].size()), physics.elastic_force())
+              .transpose();
     if (!solver->factorize(k0) || !solver->solve(rhs, s_previous, 0.0)) {
       pass.message = "the initial stiffness is not positive definite";
       return pass;
@@ -160,7 +161,8 @@ ForwardSensitivityPass untimed_pass(const sim::Scene& scene, const observe::Obse
         return pass;
       }
       const VecX velocity = (frames[t] - frames[t - 1]) / h;
-      rhs = jacobian->transposed(frames[t], velocity).transpose();
+      // The residual's force pass left the elements' SVDs at x_t: J reuses them.
+      rhs = jacobian->transposed(frames[t], velocity, physics.elastic_force()).transpose();
       rhs.noalias() += (2.0 / (h * h)) * masses.asDiagonal() * s_previous;
       rhs.noalias() += (damping.matrix() * s_previous) / h;
       rhs.noalias() -= (1.0 / (h * h)) * masses.asDiagonal() * s_before;

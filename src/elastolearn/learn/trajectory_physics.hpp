@@ -41,6 +41,9 @@ class TrajectoryPhysics {
   /// A system matrix with this problem's pattern, for `jacobians`.
   fem::SystemMatrix make_matrix() const { return fem::SystemMatrix(m_scene.mesh.tets(), m_dofs); }
 
+  /// The elastic force, whose element cache is the state of the last `residual`
+  /// (fem::ElasticForce::cached_frame: its principal frames there).
+  const fem::ElasticForce& elastic_force() const { return *m_elastic; }
   /// Use the exact tangent instead of the PSD projection (derivative tests).
   void set_project_tangent(bool project) { m_elastic->set_project_tangent(project); }
 
