@@ -109,8 +109,7 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
 }
 
 bool ElasticForce::cache_matches(const ForceState& state) const {
-  return m_cache.size() == static_cast<size_t>(m_tets.rows()) && m_cached_x.size() == state.x.size()
-      && m_cached_v.size() == state.v.size() && m_cached_x == state.x && m_cached_v == state.v;
+  return caches_positions(state.x) && m_cached_v.size() == state.v.size() && m_cached_v == state.v;
 }
 
 void ElasticForce::add_jacobian(const ForceState& state, double c_x, double c_v, SystemMatrix& A) {

@@ -332,8 +332,8 @@ void RbfDesign::formula_matrix(const Vec3& stretches, Eigen::Ref<OutputMatrix> o
       }
     }
   }
-  if (m_options
-          .energy_kernels) { // column i of `gradient`: ∂N_k/∂σ_j of kernel i alone (row 3j + k)
+  // Column i of `gradient`: ∂N_k/∂σ_j of kernel i alone (row 3j + k).
+  if (m_options.energy_kernels) {
     m_energy_kernels.evaluate(stretches, out.leftCols(m), gradient.leftCols(m));
     out.leftCols(m).rowwise() -= m_rest_kernels.transpose();
   }

@@ -160,8 +160,8 @@ class RbfDesign {
   /// each overload of output_matrix fills itself) and the tails.
   void view_columns(const Vec3& stretches, Eigen::Ref<OutputMatrix> out) const;
   material::RbfCorrection::Centres m_centres;
-  material::EnergyKernelBank
-      m_energy_kernels; ///< the centres' energy kernels (energy_kernels only)
+  /// The centres' energy kernels (energy_kernels only).
+  material::EnergyKernelBank m_energy_kernels;
   RbfFitOptions m_options;
   VecX m_rest_kernels; ///< r_i = φ_i(1, 1, 1) under stress_free_rest, else 0
   /// −P K_c P of smoothness_penalty, scaled to unit trace (zero if its trace is 0), elastic and

@@ -201,8 +201,10 @@ NewtonReport Simulator::advance(double t_next, double h) {
     report.message = "state is not finite";
     return report;
   }
-  m_v_before = m_v;
-  m_previous_step = h;
+  if (m_scene.newton.extrapolate_velocity) { // what first_iterate extrapolates from
+    m_v_before = m_v;
+    m_previous_step = h;
+  }
   m_x = m_x_new;
   m_v = m_v_new;
   return report;
