@@ -114,12 +114,12 @@ void print_iteration(const learn::IterationRecord& record, double size, const ch
   else
     std::printf("%siteration %d:", indent, learn::iteration_of(record));
   if (const auto* step = learn::forward_fit_of(record))
-    std::printf(" (forward fit: %s, %d kernels, %.1f s)\n",
+    std::printf(" (forward fit: %s, %d kernels, %.1f s%s%s)\n",
         f.status() == learn::ForwardStatus::unstable ? "trial unstable, rejected unsimulated"
             : !f.completed()                         ? "trial DIVERGED, rejected"
             : step->accepted                         ? "accepted"
                                                      : "rejected",
-        step->centres, f.seconds());
+        step->centres, f.seconds(), f.completed() ? "" : ": ", f.message().c_str());
   else if (const auto* t = learn::stages_of(record))
     std::printf(
         "; %d modes, %d kernels, control force %.3e N, misfit %.2e / %.2e N, %d cuts, step kept "

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -347,9 +348,14 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
       if (!stability.stable()) {
         trial = {};
         trial.unstable = true;
-        trial.message = "not simulated: the trial's material is unstable at "
-            + std::to_string(stability.unstable_samples) + " of "
-            + std::to_string(stability.samples) + " stretch samples";
+        const Vec3& worst = stability.worst_stretches;
+        char text[256];
+        std::snprintf(text, sizeof text,
+            "not simulated: the trial's material is unstable at %ld of %ld stretch samples "
+            "(stiffness %.3g × the nominal's at σ = (%.4f, %.4f, %.4f))",
+            stability.unstable_samples, stability.samples, stability.min_relative_eigenvalue,
+            worst(0), worst(1), worst(2));
+        trial.message = text;
         result.rms_history.push_back(-1.0);
         return TrialEvaluation { .completed = false };
       }
