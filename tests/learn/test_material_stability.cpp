@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -95,6 +96,14 @@ TEST(MaterialStability, FindsAShearInstability) {
   EXPECT_FALSE(r.stable());
   EXPECT_EQ(r.unstable_samples, grid.rows()); // a Lamé change acts everywhere alike
   EXPECT_NEAR(r.min_relative_eigenvalue, -0.5, 1e-9);
+  // The message names the count and the least stable sample.
+  const std::string text = describe_unstable(r, "samples");
+  EXPECT_EQ(
+      text.rfind("unstable at " + std::to_string(grid.rows()) + " of " + std::to_string(grid.rows())
+              + " samples (stiffness -0.5 × the nominal's at σ = (",
+          0),
+      0u)
+      << text;
 }
 
 TEST(MaterialStability, FindsALocalSofteningWhereItActs) {

@@ -13,7 +13,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -348,14 +347,8 @@ ForwardFitResult fit_to_observations(std::span<const Motion> motions,
       if (!stability.stable()) {
         trial = {};
         trial.unstable = true;
-        const Vec3& worst = stability.worst_stretches;
-        char text[256];
-        std::snprintf(text, sizeof text,
-            "not simulated: the trial's material is unstable at %ld of %ld stretch samples "
-            "(stiffness %.3g × the nominal's at σ = (%.4f, %.4f, %.4f))",
-            stability.unstable_samples, stability.samples, stability.min_relative_eigenvalue,
-            worst(0), worst(1), worst(2));
-        trial.message = text;
+        trial.message = "not simulated: the trial's material is "
+            + describe_unstable(stability, "stretch samples");
         result.rms_history.push_back(-1.0);
         return TrialEvaluation { .completed = false };
       }

@@ -300,18 +300,12 @@ std::string describe_larger_motion(const LargerMotionCheck& larger) {
   return "; failed in " + larger.message + ": not eligible";
 }
 
-/// "; unstable at N of M stretches a motion of another kind may reach (...)" or "".
+/// "; unstable at N of M stretches a motion of another kind may reach (...): not eligible" or "".
 std::string describe_instability(const StabilityReport& stability) {
   if (stability.stable())
     return {};
-  const Vec3& s = stability.worst_stretches;
-  char text[256];
-  std::snprintf(text, sizeof text,
-      "; unstable at %ld of %ld stretches a motion of another kind may reach (stiffness %.3g × "
-      "the nominal's at σ = (%.4f, %.4f, %.4f)): not eligible",
-      stability.unstable_samples, stability.samples, stability.min_relative_eigenvalue, s(0), s(1),
-      s(2));
-  return text;
+  return "; " + describe_unstable(stability, "stretches a motion of another kind may reach")
+      + ": not eligible";
 }
 
 void say(const RecipeCallbacks& callbacks, const std::string& line) {

@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <string>
 #include <vector>
 
 namespace elastolearn::learn {
@@ -79,6 +81,16 @@ StabilityReport material_stability(const material::ElasticModel& nominal,
   r.min_relative_eigenvalue = r.samples > 0 ? total.worst : 0;
   r.worst_stretches = total.at;
   return r;
+}
+
+std::string describe_unstable(const StabilityReport& report, const std::string& what) {
+  const Vec3& s = report.worst_stretches;
+  char numbers[160];
+  std::snprintf(numbers, sizeof numbers,
+      " (stiffness %.3g × the nominal's at σ = (%.4f, %.4f, %.4f))", report.min_relative_eigenvalue,
+      s(0), s(1), s(2));
+  return "unstable at " + std::to_string(report.unstable_samples) + " of "
+      + std::to_string(report.samples) + " " + what + numbers;
 }
 
 MatX amplified_stretches(

@@ -12,6 +12,7 @@
 #include <elastolearn/material/elastic_model.hpp>
 
 #include <span>
+#include <string>
 
 namespace elastolearn::learn {
 
@@ -36,6 +37,10 @@ double relative_stability(const material::ElasticModel& nominal,
 /// (N × 3 principal stretches, e.g. collect_stretches of a trajectory). Parallel over samples.
 StabilityReport material_stability(const material::ElasticModel& nominal,
     const material::Correction* correction, ConstRef<MatX> stretches);
+
+/// "unstable at N of M <what> (stiffness s × the nominal's at σ = (σ₁, σ₂, σ₃))": a report's
+/// count and its least stable sample, for messages.
+std::string describe_unstable(const StabilityReport& report, const std::string& what);
 
 /// Sample stretches for the check: every row of `stretches` (sorted principal stretches of a
 /// motion) raised to each power a in `amplifications`, σᵃ: the same deformations amplified in
