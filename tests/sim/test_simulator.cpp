@@ -250,6 +250,27 @@ TEST(Statics, CantileverTipDeflectionConvergesToBeamTheory) {
   EXPECT_LT(previous_error, 0.05);
 }
 
+TEST(Statics, ASceneThatStepsWithCgFindsItsEquilibriumByADirectFactorisation) {
+  // A slender cantilever (L/a = 100) of 200 × 1 × 1 cubes: its stiffness matrix, without the
+  // mass term that keeps dynamics well conditioned, spans the bending and axial stiffness
+  // (condition ~ (L/a)² times the mesh's), beyond what Jacobi-CG solves to Newton's tolerances in
+  // its iteration cap. A scene that chose CG for its steps must still find its static equilibrium
+  // under gravity, and the same one as with CHOLMOD.
+  auto equilibrium = [](sim::LinearSolverType type) {
+    auto s = test::bar_scene(
+        { .size = { 2, 0.02, 0.02 }, .cells = { 200, 1, 1 }, .young = 1e10, .poisson = 0.3 });
+    s.linear_solver = type;
+    sim::Simulator sim(s);
+    const auto report = sim.solve_static(1);
+    EXPECT_TRUE(report.converged) << sim::to_string(type) << ": " << report.message;
+    return VecX(sim.positions() - flatten(s.mesh.rest_positions()));
+  };
+  const VecX direct = equilibrium(sim::LinearSolverType::Cholmod);
+  const VecX cg = equilibrium(sim::LinearSolverType::ConjugateGradient);
+  ASSERT_GT(direct.norm(), 1e-3);
+  EXPECT_LT((cg - direct).norm(), 1e-8 * direct.norm());
+}
+
 TEST(Dynamics, DampedModeDecaysAtRayleighRate) {
   // Linear regime: a clamped bar released from a small tip load vibrates in its first bending
   // mode; for modal Rayleigh damping the mode obeys ẍ + c ẋ + ω² x = 0 with c = α₀ + α₁ ω².

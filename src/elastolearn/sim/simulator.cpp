@@ -192,7 +192,7 @@ NewtonReport Simulator::advance(double t_next, double h) {
     problem.first_increment = &m_first_increment;
   VecX u;
   problem.start_is_prediction = first_iterate(h, u);
-  NewtonReport report = newton(problem, u);
+  NewtonReport report = newton(problem, u, *m_solver);
   if (!report.converged)
     return report;
   state_from(u);
@@ -220,11 +220,11 @@ bool Simulator::first_iterate(double h, VecX& u) const {
   return true;
 }
 
-NewtonReport Simulator::newton(const NewtonProblem& problem, VecX& u) {
+NewtonReport Simulator::newton(const NewtonProblem& problem, VecX& u, LinearSolver& solver) {
   if (!m_scene.newton.retry_exact_tangent)
-    return newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+    return newton_solve(problem, u, m_system, solver, m_scene.newton);
   m_u_start = u;
-  NewtonReport projected = newton_solve(problem, u, m_system, *m_solver, m_scene.newton);
+  NewtonReport projected = newton_solve(problem, u, m_system, solver, m_scene.newton);
   if (projected.converged)
     return projected;
   // Newton's matrix projects every element's tangent to PSD, so it differs from the true
@@ -241,10 +241,10 @@ NewtonReport Simulator::newton(const NewtonProblem& problem, VecX& u) {
   NewtonReport exact;
   const bool progressed = projected.residual < projected.initial_residual && u.allFinite();
   if (progressed)
-    exact = newton_solve(problem, u, m_system, *m_solver, retry);
+    exact = newton_solve(problem, u, m_system, solver, retry);
   if (!exact.converged) {
     u = m_u_start;
-    NewtonReport from_start = newton_solve(problem, u, m_system, *m_solver, retry);
+    NewtonReport from_start = newton_solve(problem, u, m_system, solver, retry);
     if (progressed) {
       from_start.add_work(exact);
       if (!from_start.converged)
@@ -288,6 +288,10 @@ NewtonReport Simulator::solve_static(int load_steps) {
     state_from(u);
     sum_jacobians(m_x_new, zero, m_time, 1.0, 0.0);
   };
+  // The energy line search only without a correction: a learned one's continuation beyond its
+  // trusted stretches is an exact energy only where every stretch is beyond the same end
+  // (material/trusted_stretches.hpp), and Armijo steps on an energy whose gradient is not the
+  // force stall (the learned test of a random benchmark case did, with its energy kernels).
   if (!m_scene.material.correction && m_extra_terms.empty())
     problem.energy = [&](const VecX& u) {
       state_from(u);
@@ -295,12 +299,23 @@ NewtonReport Simulator::solve_static(int load_steps) {
       m_loads->add_force({ m_x_new, zero, m_time }, m_force); // constant loads: potential −f·x
       return m_elastic->elastic_energy(m_x_new) - m_force.dot(m_x_new);
     };
+  // Statics has no mass term: its matrix is the stiffness alone, conditioned as badly as the mesh
+  // and the material make it (eigenvalues over seven decades on a random benchmark case), where
+  // Jacobi-CG, chosen for dynamics whose M/h² dominates, need not converge. A direct
+  // factorisation serves it whatever the scene's dynamics solver; it is analysed per static solve,
+  // which a run does once.
+  std::unique_ptr<LinearSolver> direct;
+  if (m_solver->type() == LinearSolverType::ConjugateGradient) {
+    direct = make_linear_solver(LinearSolverType::Cholmod);
+    direct->analyze(m_system.matrix());
+  }
+  LinearSolver& solver = direct ? *direct : *m_solver;
   VecX u = m_dofs.restrict(m_x);
   NewtonReport total;
   total.converged = true;
   for (int k = 1; k <= load_steps; ++k) {
     m_loads->set_scale(double(k) / load_steps);
-    NewtonReport r = newton(problem, u);
+    NewtonReport r = newton(problem, u, solver);
     total.add_work(r);
     total.residual = r.residual;
     if (k == 1)

@@ -76,9 +76,10 @@ class Simulator {
   bool first_iterate(double h, VecX& u) const;
   /// The state was set from outside a step: the next step has no previous one to extrapolate.
   void forget_previous_step() { m_previous_step = 0; }
-  /// newton_solve on the scene's system, retried with the exact (unprojected) tangent when it
-  /// fails and NewtonOptions::retry_exact_tangent is set (from where it stopped, then its start).
-  NewtonReport newton(const NewtonProblem& problem, VecX& u);
+  /// newton_solve on the scene's system with `solver`, retried with the exact (unprojected)
+  /// tangent when it fails and NewtonOptions::retry_exact_tangent is set (from where it stopped,
+  /// then its start).
+  NewtonReport newton(const NewtonProblem& problem, VecX& u, LinearSolver& solver);
   void sum_forces(const VecX& x, const VecX& v, double t, VecX& f);
   void sum_jacobians(const VecX& x, const VecX& v, double t, double c_x, double c_v);
   void apply_mass(const VecX& dv, VecX& out) const; ///< out = M dv (full 3n)
