@@ -135,18 +135,19 @@ void run_fit(const FitOptions& o) {
     { "initial_rms_error_m", report.initial_rms }, { "initial_max_error_m", report.initial_max },
     { "final_rms_error_m", report.final_rms }, { "final_max_error_m", report.final_max },
     { "iterations", report.iterations }, { "simulations", report.simulations },
-    { "diverged_simulations", report.diverged }, { "seconds", report.seconds },
-    { "stop", learn::to_string(report.stop) }, { "message", report.message },
-    { "history", history } };
+    { "diverged_simulations", report.diverged }, { "unheld_initial_loads", report.unheld_loads },
+    { "seconds", report.seconds }, { "stop", learn::to_string(report.stop) },
+    { "message", report.message }, { "history", history } };
   io::write_material_file(o.output, fitted);
 
   std::printf("%s: %s\n", learn::to_string(report.stop).c_str(), report.message.c_str());
   std::printf(
       "observation error rms %.4g %% -> %.4g %%, max %.4g %% -> %.4g %% of the size (%.4g m); "
-      "%d iterations, %d simulations (%d diverged), %.1f s\n",
+      "%d iterations, %d simulations (%d failed, %d of them in the initial load's static "
+      "solve), %.1f s\n",
       100 * report.initial_rms / diagonal, 100 * report.final_rms / diagonal,
       100 * report.initial_max / diagonal, 100 * report.final_max / diagonal, diagonal,
-      report.iterations, report.simulations, report.diverged, report.seconds);
+      report.iterations, report.simulations, report.diverged, report.unheld_loads, report.seconds);
   std::printf("fitted: E %.6g Pa, nu %.5g, alpha0 %.5g 1/s, alpha1 %.5g s\n", report.fitted.young,
       report.fitted.poisson, report.fitted.alpha0, report.fitted.alpha1);
   std::printf("material: %s\n", o.output.c_str());

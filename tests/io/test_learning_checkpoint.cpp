@@ -129,6 +129,8 @@ TEST(LearningCheckpoint, RefusesACheckpointOfOtherInputs) {
   learn::ParameterFitReport fit;
   fit.fitted = { 1.25e6, 0.41, 0.5, 0.02 };
   fit.final_rms = 1.5e-4;
+  fit.diverged = 3;
+  fit.unheld_loads = 2;
   fit.stop = learn::FitStop::Converged;
   write_learning_checkpoint(f.file, f.inputs, { fit, state });
   const learn::RecipeResume resume = read_learning_checkpoint(f.file, f.inputs);
@@ -136,6 +138,8 @@ TEST(LearningCheckpoint, RefusesACheckpointOfOtherInputs) {
   EXPECT_EQ(resume.parameter_fit.fitted.young, 1.25e6);
   EXPECT_EQ(resume.parameter_fit.fitted.alpha1, 0.02);
   EXPECT_EQ(resume.parameter_fit.final_rms, 1.5e-4);
+  EXPECT_EQ(resume.parameter_fit.diverged, 3);
+  EXPECT_EQ(resume.parameter_fit.unheld_loads, 2);
   EXPECT_EQ(resume.parameter_fit.stop, learn::FitStop::Converged);
   EXPECT_EQ(read.next_iteration, 3);
   EXPECT_EQ(read.failed_steps_in_a_row, 2);

@@ -278,8 +278,9 @@ nlohmann::json parameter_fit_json(const learn::ParameterFitReport& f) {
   nlohmann::json j = { { "initial", to_json(f.initial) }, { "fitted", to_json(f.fitted) },
     { "initial_rms", f.initial_rms }, { "initial_max", f.initial_max },
     { "final_rms", f.final_rms }, { "final_max", f.final_max }, { "iterations", f.iterations },
-    { "simulations", f.simulations }, { "diverged", f.diverged }, { "frames", f.frames },
-    { "seconds", f.seconds }, { "stop", learn::to_string(f.stop) }, { "message", f.message } };
+    { "simulations", f.simulations }, { "diverged", f.diverged },
+    { "unheld_loads", f.unheld_loads }, { "frames", f.frames }, { "seconds", f.seconds },
+    { "stop", learn::to_string(f.stop) }, { "message", f.message } };
   if (f.tracked_with)
     j["tracked_with"] = to_json(*f.tracked_with);
   return j;
@@ -300,6 +301,8 @@ learn::ParameterFitReport read_parameter_fit(const JsonObject& o) {
   f.iterations = o.integer("iterations");
   f.simulations = o.integer("simulations");
   f.diverged = o.integer("diverged");
+  if (o.has("unheld_loads")) // checkpoints written before the count have none
+    f.unheld_loads = o.integer("unheld_loads");
   f.frames = o.integer("frames");
   f.seconds = o.number("seconds");
   const std::string stop = o.string("stop");

@@ -81,6 +81,9 @@ struct ParameterTransform {
 /// Forward simulations of every motion compared with its observation.
 struct Evaluation {
   bool completed = false;
+  /// Not completed because the initial static solve failed: no equilibrium was found under the
+  /// motion's initial load with these parameters (ParameterFitReport::unheld_loads).
+  bool load_not_held = false;
   std::string message; ///< the simulation's reason when not completed
   /// x_sim − x_obs at the observed vertices, motion after motion, each frame-major,
   /// Σ (frames+1)·k·3
@@ -128,6 +131,7 @@ Evaluation evaluate(std::span<const FitMotion> motions, material::ElasticModelTy
     };
     const sim::SimulationReport report = sim::run_simulation(scene, sink);
     if (!report.completed) {
+      e.load_not_held = !report.initial.converged;
       e.message = report.message;
       return e;
     }
@@ -366,10 +370,14 @@ ParameterFitReport fit_parameters(std::span<const Motion> data, material::Elasti
     return report;
   };
 
+  const auto count_failure = [&](const Evaluation& e) {
+    ++report.diverged;
+    report.unheld_loads += e.load_not_held ? 1 : 0;
+  };
   Evaluation current = evaluate(motions, type, start);
   ++report.simulations;
   if (!current.completed) {
-    report.diverged = 1;
+    count_failure(current);
     report.seconds = seconds_since(t0);
     report.stop = interrupt_requested() ? FitStop::Interrupted : FitStop::StartDiverged;
     report.message = "the simulation with the start parameters failed: " + current.message;
@@ -405,7 +413,7 @@ ParameterFitReport fit_parameters(std::span<const Motion> data, material::Elasti
     for (size_t i = 0; i < factors.size(); ++i) {
       ++report.simulations;
       if (!scanned[i].completed)
-        ++report.diverged;
+        count_failure(scanned[i]);
       else if (scanned[i].cost < (best < factors.size() ? scanned[best].cost : current.cost))
         best = i;
     }
@@ -447,7 +455,8 @@ ParameterFitReport fit_parameters(std::span<const Motion> data, material::Elasti
 
     // Forward-difference Jacobian: one simulation per parameter (backwards if forwards diverges).
     MatX J = MatX::Zero(current.residual.size(), p);
-    std::vector<int> runs(static_cast<size_t>(p), 0), failures(static_cast<size_t>(p), 0);
+    std::vector<int> runs(static_cast<size_t>(p), 0), failures(static_cast<size_t>(p), 0),
+        unheld(static_cast<size_t>(p), 0);
     const auto column = [&](int i) {
       for (const double step : { h, -h }) {
         NominalParameters perturbed = report.fitted;
@@ -459,6 +468,7 @@ ParameterFitReport fit_parameters(std::span<const Motion> data, material::Elasti
           return;
         }
         ++failures[static_cast<size_t>(i)];
+        unheld[static_cast<size_t>(i)] += e.load_not_held ? 1 : 0;
         if (interrupt_requested())
           return;
       }
@@ -472,6 +482,7 @@ ParameterFitReport fit_parameters(std::span<const Motion> data, material::Elasti
     for (int i = 0; i < p; ++i) {
       report.simulations += runs[static_cast<size_t>(i)];
       report.diverged += failures[static_cast<size_t>(i)];
+      report.unheld_loads += unheld[static_cast<size_t>(i)];
     }
     if (interrupt_requested()) {
       interrupted();
@@ -498,7 +509,7 @@ ParameterFitReport fit_parameters(std::span<const Motion> data, material::Elasti
       return TrialEvaluation { .stop = true };
     }
     if (!trial.completed)
-      ++report.diverged;
+      count_failure(trial);
     last_failure = trial.completed ? "" : trial.message;
     return TrialEvaluation { .completed = trial.completed, .cost = trial.cost };
   };

@@ -114,6 +114,12 @@ struct ParameterFitReport {
   int iterations = 0; ///< Jacobian evaluations
   int simulations = 0; ///< forward simulations run (including finite differences)
   int diverged = 0; ///< of those, simulations that failed (rejected or retried)
+  /// Of the failed simulations, those whose initial static solve failed: parameters under which
+  /// no equilibrium was found for a motion's initial load (InitialCondition::StaticLoad), as
+  /// with E-scan probes far softer than the object, which the load collapses (elements invert).
+  /// The object held that load in its first observed frame: the data rule such parameters out;
+  /// no motion was simulated with them.
+  int unheld_loads = 0;
   int frames = 0; ///< simulated steps per simulation
   double seconds = 0; ///< total wall time
   FitStop stop = FitStop::MaxIterations;
