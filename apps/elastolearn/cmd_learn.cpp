@@ -236,7 +236,7 @@ void run_learn(const LearnOptions& o) {
           + elastolearn::to_text(
               100 * (c.validation.rms / result.candidates[c.teacher].validation.rms - 1))
           + " % worse than its teacher: the RBF is kept)";
-    else if (c.completed && !reference && c.resolution < learn::kSignificance)
+    else if (c.completed && !reference && c.resolution < c.required_significance)
       note = "   (the held-out data cannot tell it from the fitted nominal; on the training data "
           + (std::isnan(c.training_significance)
                   ? std::string("not compared")
@@ -245,7 +245,7 @@ void run_learn(const LearnOptions& o) {
           + ": hold out frames that still move, e.g. a second motion, to let them decide)";
     else if (c.completed && !reference && c.significance <= 0)
       note = "   (no better than the fitted nominal)";
-    else if (c.completed && !reference && c.significance < learn::kSignificance)
+    else if (c.completed && !reference && c.significance < c.required_significance)
       note = "   (better than the fitted nominal by " + elastolearn::to_text(c.significance)
           + " noise deviations: not significant)";
     if (c.completed)

@@ -137,6 +137,37 @@ TEST(LearningRecipe, ACandidateReplacesTheFittedNominalOnlyBeyondNoise) {
   }
 }
 
+TEST(LearningRecipe, TheSignificanceThresholdGrowsWithTheCandidatesCompared) {
+  // Φ⁻¹(1 − Φ(−2)/n), reference values from Python's statistics.NormalDist.
+  EXPECT_NEAR(significance_threshold(1), 2.0, 1e-9);
+  EXPECT_NEAR(significance_threshold(3), 2.4283725526104103, 1e-9);
+  EXPECT_NEAR(significance_threshold(12), 2.8949914452998486, 1e-9);
+  EXPECT_NEAR(significance_threshold(0), 2.0, 1e-9);
+
+  // A correction 2.5 noise deviations better than the fitted nominal on the held-out data (σ = 1,
+  // r = (5, 0, 0), c = 0 = o: gain 25, spread 2·5) replaces it when it is the only correction
+  // compared, not when eleven others (each worse than the nominal) were compared too: the best
+  // of twelve reaches 2.5 by chance alone far more often than one does.
+  const VecX observed = VecX::Zero(3), fitted = Vec3(5, 0, 0), good = VecX::Zero(3);
+  auto with = [&](int others) {
+    std::vector<VecX> p { fitted, good };
+    for (int k = 0; k < others; ++k)
+      p.push_back(Vec3(5, k + 1, 0));
+    std::vector<Candidate> c(p.size());
+    for (size_t i = 0; i < p.size(); ++i) {
+      c[i].kind = i == 0 ? CandidateKind::FittedNominal : CandidateKind::Loop;
+      c[i].completed = true;
+      c[i].validation.rms = (p[i] - observed).norm();
+    }
+    const int chosen = choose_candidate(c, { p, observed }, {}, 0, 1.0);
+    EXPECT_NEAR(c[1].significance, 2.5, 1e-12);
+    EXPECT_NEAR(c[1].required_significance, significance_threshold(1 + others), 1e-12);
+    return chosen;
+  };
+  EXPECT_EQ(with(0), 1);
+  EXPECT_EQ(with(11), 0);
+}
+
 TEST(LearningRecipe, TheLargerMotionIsCheckedFromTheBestCandidateDownUntilOnePasses) {
   // Noise-free held-out data; the fitted nominal is off by 1 mm, four corrections by 0.1, 0.2,
   // 0.3 and 0.4 mm. The two best fail the larger motion: the third is chosen, and the fourth,

@@ -67,6 +67,8 @@ nlohmann::json recipe_result_to_json(const learn::RecipeResult& r) {
         { "resolution", finite_or_null(c.resolution) }, { "unknowns", c.unknowns },
         // null: not measured, or infinite (noise σ = 0)
         { "training_significance", finite_or_null(c.training_significance) },
+        // the z it had to reach to beat the reference (0: not compared with one)
+        { "required_significance", c.required_significance },
         { "beats_reference", c.beats_reference } });
     if (!c.completed)
       candidates.back()["failure"] = c.failure;

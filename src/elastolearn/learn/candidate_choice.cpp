@@ -37,12 +37,24 @@ double in_noise_deviations(double gain, const VecX& r, const VecX& c, double sig
 
 } // namespace
 
+double significance_threshold(int compared) {
+  // Φ⁻¹(1 − p) by bisection on Φ(−z) = ½ erfc(z/√2), decreasing in z: 60 halvings of [0, 40]
+  // leave 4e-17, below what the z's own rounding resolves.
+  const double p = 0.5 * std::erfc(kSignificance / std::sqrt(2.0)) / std::max(compared, 1);
+  double lo = 0, hi = 40;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (0.5 * std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 double paired_significance(const VecX& r, const VecX& c, const VecX& o, double sigma) {
   return in_noise_deviations((r - o).squaredNorm() - (c - o).squaredNorm(), r, c, sigma);
 }
 
 void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int reference,
-    const ComparedData& validation, const ComparedData& training, double sigma) {
+    const ComparedData& validation, const ComparedData& training, double sigma, double threshold) {
   Candidate& c = candidates[i];
   const auto r = static_cast<size_t>(reference);
   const VecX &rv = validation.predictions[r], &cv = validation.predictions[i];
@@ -58,7 +70,8 @@ void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int re
         (rt - o).squaredNorm() - (ct - o).squaredNorm() - charge, rt, ct, sigma);
   }
   // The held-out data alone decide: the training frames cannot see how a candidate forecasts.
-  c.beats_reference = c.resolution >= kSignificance && c.significance >= kSignificance;
+  c.required_significance = threshold;
+  c.beats_reference = c.resolution >= threshold && c.significance >= threshold;
 }
 
 bool network_replaces_teacher(
@@ -75,13 +88,18 @@ int choose_candidate(std::vector<Candidate>& candidates, const ComparedData& val
   const Candidate* ref = reference >= 0 ? &candidates[static_cast<size_t>(reference)] : nullptr;
   if (ref && !ref->completed)
     ref = nullptr;
+  int corrections = 0; // what may replace the reference, and so what noise may pass
+  for (size_t i = 0; i < candidates.size(); ++i)
+    corrections += candidates[i].completed && static_cast<int>(i) != reference
+        && candidates[i].kind != CandidateKind::Nominal;
+  const double threshold = significance_threshold(corrections);
   for (size_t i = 0; i < candidates.size(); ++i) {
     Candidate& c = candidates[i];
     if (!c.completed)
       continue;
     const bool is_reference = !ref || static_cast<int>(i) == reference;
     if (!is_reference)
-      compare_with_reference(candidates, i, reference, validation, training, sigma);
+      compare_with_reference(candidates, i, reference, validation, training, sigma, threshold);
     // The given nominal beside a fitted one is reported, not chosen: it is a guess the data did
     // not inform, and the result is promised never worse than the fit. It can beat the fit on
     // the held-out tail where the tail is unlike the motion (a decayed tail, whose small

@@ -72,9 +72,12 @@ struct Candidate {
   /// training data say where the held-out data cannot resolve a candidate), not used by the
   /// choice: fitting the training frames better says nothing of how a candidate forecasts.
   double training_significance = std::numeric_limits<double>::quiet_NaN();
+  /// The z it had to reach on the held-out data to beat the reference:
+  /// significance_threshold(n) for the n corrections compared with it.
+  double required_significance = 0;
   /// It beats the reference beyond noise on the held-out data: they resolve it (resolution ≥
-  /// kSignificance) and it gains there (significance ≥ kSignificance). False for the reference
-  /// itself.
+  /// required_significance) and it gains there (significance ≥ required_significance). False
+  /// for the reference itself.
   bool beats_reference = false;
   /// Eligible for the choice: its validation completed, it survives a larger motion (or was not
   /// checked for it) and it is stable where a motion of another kind may go.
@@ -82,8 +85,18 @@ struct Candidate {
 };
 
 /// How many noise standard deviations a candidate must beat the fitted nominal by on the held-out
-/// data to replace it (one-sided: a 2.3 % chance that noise alone passes a candidate no better).
+/// data to replace it when it is the only one compared (one-sided: a 2.3 % chance that noise
+/// alone passes a candidate no better).
 inline constexpr double kSignificance = 2;
+
+/// The z each of `compared` corrections must reach on the held-out data to beat the reference:
+/// kSignificance's one-sided chance Φ(−kSignificance) split among them (Bonferroni),
+/// Φ⁻¹(1 − Φ(−kSignificance)/compared), so that noise alone passes one of them no more often
+/// however many the learning proposes (2 for one, 2.43 for 3, 2.89 for 12, 3.05 for 20).
+/// Without it, of a dozen independent candidates no better than the fit one passes by chance
+/// a quarter of the time, and a correction chosen that way can test far worse on a larger
+/// motion.
+double significance_threshold(int compared);
 
 /// A paired test of candidate predictions `c` against reference predictions `r` of the
 /// observations `o` with noise σ per coordinate: z = (‖r − o‖² − ‖c − o‖²) / (2σ‖c − r‖), the
@@ -111,15 +124,17 @@ struct ComparedData {
   VecX observed;
 };
 
-/// Sets candidate i's significance, resolution, training_significance and beats_reference
-/// against the reference candidate (index `reference`), on the held-out data `validation` and,
-/// if it holds predictions of both, the training data `training`; σ the noise per coordinate.
+/// Sets candidate i's significance, resolution, training_significance, required_significance
+/// (= `threshold`) and beats_reference against the reference candidate (index `reference`), on
+/// the held-out data `validation` and, if it holds predictions of both, the training data
+/// `training`; σ the noise per coordinate.
 void compare_with_reference(std::vector<Candidate>& candidates, size_t i, int reference,
-    const ComparedData& validation, const ComparedData& training, double sigma);
+    const ComparedData& validation, const ComparedData& training, double sigma, double threshold);
 
 /// Stage 4's choice, `reference` the index of the fitted nominal (or −1: no reference), σ the
 /// noise per coordinate. Compares every other completed candidate with the reference
-/// (compare_with_reference) and returns the index of the eligible candidate with the lowest
+/// (compare_with_reference, at significance_threshold of the number of completed corrections)
+/// and returns the index of the eligible candidate with the lowest
 /// validation RMS among the reference and the candidates that beat it on the held-out data
 /// (`training`, if it holds predictions, only sets their training_significance). With a
 /// reference, the given nominal (CandidateKind::Nominal) is compared but never chosen. −1 if no

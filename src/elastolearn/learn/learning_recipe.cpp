@@ -675,7 +675,8 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
       const bool has_reference = result.candidates[static_cast<size_t>(reference)].completed;
       if (has_reference)
         compare_with_reference(result.candidates, result.candidates.size() - 1, reference, held_out,
-            trained, result.noise.sigma);
+            trained, result.noise.sigma,
+            result.candidates[static_cast<size_t>(t)].required_significance);
       network.gain_over_teacher = paired_significance(held_out.predictions[static_cast<size_t>(t)],
           held_out.predictions.back(), held_out.observed, result.noise.sigma);
       const auto replaces = [&] {

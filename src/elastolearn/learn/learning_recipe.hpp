@@ -17,16 +17,16 @@
 ///      and the forward fit's last accepted step with the earlier ones on its plateau, within 1 %
 ///      of its training error) simulates the held-out data; among those that are stable where
 ///      another motion may go and beat the fitted nominal by more than noise could
-///      (z ≥ kSignificance), the one with the smallest RMS error there whose material survives a
-///      larger motion and a droop (kLargerMotion; checked in that order, the best first, until
-///      one passes) is the result; the fitted nominal if none, also where the
-///      held-out data cannot resolve a candidate from it (a motion that has died out under
-///      noise: the training data, which cannot see how a candidate forecasts, are compared and
-///      reported, not used; candidate_choice.hpp);
+///      (z ≥ significance_threshold of the number compared), the one with the smallest RMS error
+///      there whose material survives a larger motion and a droop (kLargerMotion; checked in that
+///      order, the best first, until one passes) is the result; the fitted nominal if none, also
+///      where the held-out data cannot resolve a candidate from it (a motion that has died out
+///      under noise: the training data, which cannot see how a candidate forecasts, are compared
+///      and reported, not used; candidate_choice.hpp);
 ///   5. network: a chosen correction is distilled into the network correction
 ///      (network_distillation.hpp), validated the same way, and replaces its teacher when it is
-///      eligible, beats the fitted nominal by kSignificance, and is as good as its teacher
-///      (network_replaces_teacher); it is several times cheaper to evaluate.
+///      eligible, beats the fitted nominal by its teacher's threshold, and is as good as its
+///      teacher (network_replaces_teacher); it is several times cheaper to evaluate.
 /// The validation choice is what makes the result never worse than fitting parameters on data
 /// nobody tuned the recipe for: the fitted nominal is always a candidate.
 #include <elastolearn/learn/candidate_choice.hpp>
