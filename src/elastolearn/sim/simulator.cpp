@@ -267,6 +267,17 @@ VecX Simulator::total_force(const VecX& x, const VecX& v, double t) {
   return f;
 }
 
+LinearSolver& Simulator::static_solver() {
+  if (m_solver->type() != LinearSolverType::ConjugateGradient)
+    return *m_solver;
+  // Analysed once, on the first static solve: static cloud tracking solves one per frame.
+  if (!m_static_solver) {
+    m_static_solver = make_linear_solver(LinearSolverType::Cholmod);
+    m_static_solver->analyze(m_system.matrix());
+  }
+  return *m_static_solver;
+}
+
 NewtonReport Simulator::solve_static(int load_steps) {
   ELASTOLEARN_CHECK(load_steps >= 1, "load_steps must be positive");
   const VecX x0 = m_x;
@@ -299,17 +310,7 @@ NewtonReport Simulator::solve_static(int load_steps) {
       m_loads->add_force({ m_x_new, zero, m_time }, m_force); // constant loads: potential −f·x
       return m_elastic->elastic_energy(m_x_new) - m_force.dot(m_x_new);
     };
-  // Statics has no mass term: its matrix is the stiffness alone, conditioned as badly as the mesh
-  // and the material make it (eigenvalues over seven decades on a random benchmark case), where
-  // Jacobi-CG, chosen for dynamics whose M/h² dominates, need not converge. A direct
-  // factorisation serves it whatever the scene's dynamics solver; it is analysed per static solve,
-  // which a run does once.
-  std::unique_ptr<LinearSolver> direct;
-  if (m_solver->type() == LinearSolverType::ConjugateGradient) {
-    direct = make_linear_solver(LinearSolverType::Cholmod);
-    direct->analyze(m_system.matrix());
-  }
-  LinearSolver& solver = direct ? *direct : *m_solver;
+  LinearSolver& solver = static_solver();
   VecX u = m_dofs.restrict(m_x);
   NewtonReport total;
   total.converged = true;

@@ -80,6 +80,11 @@ class Simulator {
   /// tangent when it fails and NewtonOptions::retry_exact_tangent is set (from where it stopped,
   /// then its start).
   NewtonReport newton(const NewtonProblem& problem, VecX& u, LinearSolver& solver);
+  /// The solver of static solves: the scene's, unless that is Jacobi-CG. Statics has no mass
+  /// term: its matrix is the stiffness alone, conditioned as badly as the mesh and the material
+  /// make it (eigenvalues over seven decades on a random benchmark case), where CG, chosen for
+  /// dynamics whose M/h² dominates, need not converge; a CHOLMOD factorisation serves it then.
+  LinearSolver& static_solver();
   void sum_forces(const VecX& x, const VecX& v, double t, VecX& f);
   void sum_jacobians(const VecX& x, const VecX& v, double t, double c_x, double c_v);
   void apply_mass(const VecX& dv, VecX& out) const; ///< out = M dv (full 3n)
@@ -91,6 +96,7 @@ class Simulator {
   std::unique_ptr<ExternalLoads> m_loads;
   std::vector<fem::ForceTerm*> m_extra_terms;
   std::unique_ptr<LinearSolver> m_solver;
+  std::unique_ptr<LinearSolver> m_static_solver; ///< static_solver()'s own, when m_solver is CG
   VecX m_dof_masses; ///< lumped, full 3n
   VecX m_reduced_masses; ///< lumped, free dofs
   fem::SparseMatrix m_consistent; ///< full 3n×3n consistent mass (empty when lumped)
