@@ -22,23 +22,34 @@ double largest_displacement(const VecX& x, const VecX& rest, Vec3* direction = n
   return largest;
 }
 
-/// The static equilibrium of the scene's object under the body acceleration `a` alone; where it
-/// is found and `droop` is non-null, *droop = its largest displacement from `rest`.
+/// The static equilibrium of the scene's object under the body acceleration `a` alone, in one
+/// increment from `start` if it is given and that converges, else in the scene's load steps from
+/// rest; where it is found, *equilibrium (if non-null) = its positions.
 sim::NewtonReport hold_droop(
-    sim::Scene scene, const Vec3& a, const VecX& rest = {}, double* droop = nullptr) {
+    sim::Scene scene, const Vec3& a, const VecX& start = {}, VecX* equilibrium = nullptr) {
   scene.initial = {};
   scene.initial.kind = sim::InitialCondition::Kind::StaticLoad;
   scene.gravity = a;
+  if (start.size() > 0) {
+    sim::Simulator simulator(scene);
+    simulator.set_state(start, VecX::Zero(start.size()), 0.0);
+    const sim::NewtonReport held = simulator.solve_static(1);
+    if (held.converged) {
+      if (equilibrium)
+        *equilibrium = simulator.positions();
+      return held;
+    }
+  }
   sim::Simulator simulator(scene);
   const sim::NewtonReport held = simulator.apply_initial_condition();
-  if (held.converged && droop)
-    *droop = largest_displacement(simulator.positions(), rest);
+  if (held.converged && equilibrium)
+    *equilibrium = simulator.positions();
   return held;
 }
 
 } // namespace
 
-Vec3 droop_acceleration(const sim::Scene& scene, const std::vector<VecX>& run) {
+Droop reference_droop(const sim::Scene& scene, const std::vector<VecX>& run) {
   const VecX rest = flatten(scene.mesh.rest_positions());
   double moved = 0;
   Vec3 direction = Vec3::Zero();
@@ -51,21 +62,28 @@ Vec3 droop_acceleration(const sim::Scene& scene, const std::vector<VecX>& run) {
     }
   }
   if (!(moved > 0))
-    return Vec3::Zero();
+    return {};
   // The linear response to a small trial load (0.1 m/s², a hundredth of a weight), scaled.
   const Vec3 trial = 0.1 * direction;
-  double trial_droop = 0;
-  if (!hold_droop(scene, trial, rest, &trial_droop).converged || !(trial_droop > 0))
-    return Vec3::Zero();
+  VecX held;
+  if (!hold_droop(scene, trial, {}, &held).converged)
+    return {};
+  const double trial_droop = largest_displacement(held, rest);
+  if (!(trial_droop > 0))
+    return {};
   Vec3 a = trial * (kLargerMotion * moved / trial_droop);
   for (int halvings = 0; halvings < 4; ++halvings, a *= 0.5)
-    if (hold_droop(scene, a).converged)
-      return a;
-  return Vec3::Zero();
+    if (hold_droop(scene, a, {}, &held).converged)
+      return { a, held };
+  return {};
+}
+
+Vec3 droop_acceleration(const sim::Scene& scene, const std::vector<VecX>& run) {
+  return reference_droop(scene, run).acceleration;
 }
 
 LargerMotionCheck check_larger_motion(
-    const sim::Scene& scene, const std::string& name, const Vec3& droop) {
+    const sim::Scene& scene, const std::string& name, const Vec3& droop, const VecX& start) {
   LargerMotionCheck out;
   out.checked = true;
   const sim::ForwardRun run = sim::simulate_positions(sim::amplified_scene(scene, kLargerMotion));
@@ -77,7 +95,7 @@ LargerMotionCheck check_larger_motion(
   }
   if (droop.isZero(0))
     return out;
-  const sim::NewtonReport held = hold_droop(scene, droop);
+  const sim::NewtonReport held = hold_droop(scene, droop, start);
   if (!held.converged) {
     out.completed = false;
     out.message = "the droop of " + name + " under a body load of " + to_text(droop.norm())

@@ -224,15 +224,15 @@ ReferenceReach reference_reach(const Split& split, const fem::MaterialModel& ref
   return reach;
 }
 
-/// Per held-out motion, droop_acceleration of the reference's run (`reach.runs`; none where the
+/// Per held-out motion, reference_droop of the reference's run (`reach.runs`; none where the
 /// reference diverged).
-std::vector<Vec3> droop_accelerations(
+std::vector<Droop> reference_droops(
     const Split& split, const fem::MaterialModel& reference, const ReferenceReach& reach) {
-  std::vector<Vec3> droops;
+  std::vector<Droop> droops;
   for (size_t i = 0; i < reach.runs.size(); ++i) {
     sim::Scene scene = split.validation[i].motion.scene;
     scene.material = reference;
-    droops.push_back(droop_acceleration(scene, reach.runs[i]));
+    droops.push_back(reference_droop(scene, reach.runs[i]));
   }
   return droops;
 }
@@ -276,15 +276,17 @@ CandidatePredictions validate_candidate(
 }
 
 /// The larger-motion check of a correction candidate (Candidate::larger_motion) on every
-/// held-out motion, `droops` the droop loads per motion (none past its end).
+/// held-out motion, `droops` the droop loads and the reference's equilibria under them per motion
+/// (none past its end).
 void check_candidate_larger_motion(Candidate& c, const Split& split,
-    const fem::MaterialModel& nominal, const std::vector<Vec3>& droops) {
+    const fem::MaterialModel& nominal, const std::vector<Droop>& droops) {
   for (size_t i = 0; i < split.validation.size(); ++i) {
     const HeldOut& piece = split.validation[i];
     // The first substepped frame of the first motion that needed substeps is kept.
     const int substepped = c.larger_motion.first_substepped_frame;
+    const Droop droop = i < droops.size() ? droops[i] : Droop {};
     c.larger_motion = check_larger_motion(with_candidate(piece, nominal, c), piece.motion.name,
-        i < droops.size() ? droops[i] : Vec3::Zero());
+        droop.acceleration, droop.reference_equilibrium);
     if (substepped > 0)
       c.larger_motion.first_substepped_frame = substepped;
     if (!c.larger_motion.completed)
@@ -545,10 +547,10 @@ RecipeResult learn_material(std::span<const Motion> motions, const RecipeOptions
   // The larger-motion check costs a simulation of every motion driven harder and a static solve,
   // so it runs only on a correction the choice would take (and the droop loads are computed for
   // the first such): the candidates that rank below the chosen one are not checked.
-  std::optional<std::vector<Vec3>> droops;
+  std::optional<std::vector<Droop>> droops;
   const auto check = [&](Candidate& c) {
     if (!droops)
-      droops = droop_accelerations(split, reference_material, reach);
+      droops = reference_droops(split, reference_material, reach);
     check_candidate_larger_motion(c, split, nominal_of(c.kind), *droops);
     say(callbacks,
         label_of(c)
