@@ -33,6 +33,14 @@ sim::Scene with_cubic(sim::Scene scene, double a) {
   return scene;
 }
 
+/// The scene held statically under the body acceleration `a` alone, from rest.
+sim::Scene held_under(sim::Scene scene, const Vec3& a) {
+  scene.initial = {};
+  scene.initial.kind = sim::InitialCondition::Kind::StaticLoad;
+  scene.gravity = a;
+  return scene;
+}
+
 /// Largest |σ − 1| of the scene's larger motion.
 double larger_motion_strain(const sim::Scene& scene) {
   const sim::ForwardRun run = sim::simulate_positions(sim::amplified_scene(scene, kLargerMotion));
@@ -110,11 +118,7 @@ TEST(LargerMotionCheck, TheDroopStartsFromTheReferencesEquilibrium) {
   scene.gravity.setZero();
   scene.frames = 5;
   const Vec3 load(0, -3 * 9.81, 0);
-  sim::Scene reference = scene;
-  reference.initial = {};
-  reference.initial.kind = sim::InitialCondition::Kind::StaticLoad;
-  reference.gravity = load;
-  sim::Simulator simulator(reference);
+  sim::Simulator simulator(held_under(scene, load));
   ASSERT_TRUE(simulator.apply_initial_condition().converged);
   const VecX start = simulator.positions();
 
@@ -145,17 +149,13 @@ TEST(LargerMotionCheck, TheDroopLoadMakesTheReferenceDroopAsFarAsTheLargerMotion
   for (const VecX& x : run.positions)
     moved = std::max(moved, largest_displacement(x, rest));
   ASSERT_GT(moved, 0.005);
-  const Vec3 a = droop_acceleration(scene, run.positions);
+  const Vec3 a = reference_droop(scene, run.positions).acceleration;
   ASSERT_GT(a.norm(), 0);
   EXPECT_GT(std::abs(a.y()), 0.8 * a.norm()); // mostly across the bar, as the swing moves it
-  sim::Scene held = scene;
-  held.initial = {};
-  held.initial.kind = sim::InitialCondition::Kind::StaticLoad;
-  held.gravity = a;
-  sim::Simulator simulator(held);
+  sim::Simulator simulator(held_under(scene, a));
   ASSERT_TRUE(simulator.apply_initial_condition().converged);
   const double drooped = largest_displacement(simulator.positions(), rest);
   EXPECT_NEAR(drooped, kLargerMotion * moved, 0.1 * kLargerMotion * moved);
   // No motion, no droop.
-  EXPECT_EQ(droop_acceleration(scene, { rest, rest }), Vec3::Zero());
+  EXPECT_EQ(reference_droop(scene, { rest, rest }).acceleration, Vec3::Zero());
 }

@@ -40,7 +40,7 @@ struct Candidate {
   /// Whether its material survives a larger motion: every held-out motion's scene driven
   /// kLargerMotion times as hard (sim::amplified_scene) must simulate to its end (substeps
   /// allowed), and the object must hold its droop under a body load as large
-  /// (check_larger_motion, droop_acceleration). A user's next motion is rarely the one recorded.
+  /// (check_larger_motion, reference_droop). A user's next motion is rarely the one recorded.
   /// Not checked (passed) for the nominals, nor for a correction the choice did not reach: the
   /// check costs a harder run of every motion and a static solve, so it runs on the best
   /// candidate first and stops at the first that passes (learn_material).

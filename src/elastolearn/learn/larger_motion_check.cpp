@@ -78,10 +78,6 @@ Droop reference_droop(const sim::Scene& scene, const std::vector<VecX>& run) {
   return {};
 }
 
-Vec3 droop_acceleration(const sim::Scene& scene, const std::vector<VecX>& run) {
-  return reference_droop(scene, run).acceleration;
-}
-
 LargerMotionCheck check_larger_motion(
     const sim::Scene& scene, const std::string& name, const Vec3& droop, const VecX& start) {
   LargerMotionCheck out;

@@ -27,38 +27,33 @@ struct LargerMotionCheck {
   int first_substepped_frame = 0;
 };
 
-/// The droop's body load [m/s²] for a recorded motion, from `run`, the reference material's
-/// (the fitted nominal's) run of `scene` (whose material is that reference): a uniform
-/// acceleration, like a weight, along the direction the most displaced vertex of `run` moved,
-/// as large as makes the reference droop statically kLargerMotion times that displacement
-/// (scaled from its linear response, then halved until the reference holds it). Zero where the
-/// run does not move or the reference holds no droop.
-Vec3 droop_acceleration(const sim::Scene& scene, const std::vector<VecX>& run);
-
-/// droop_acceleration's load and the reference's static equilibrium under it.
+/// A droop: its body load and the reference's static equilibrium under it.
 struct Droop {
   Vec3 acceleration = Vec3::Zero(); ///< [m/s²]; zero: no droop
   VecX reference_equilibrium; ///< flat 3n [m] (empty where the acceleration is zero)
 };
 
-/// droop_acceleration with the equilibrium the reference holds under it.
+/// The droop for a recorded motion, from `run`, the reference material's
+/// (the fitted nominal's) run of `scene` (whose material is that reference): a uniform
+/// acceleration, like a weight, along the direction the most displaced vertex of `run` moved,
+/// as large as makes the reference droop statically kLargerMotion times that displacement
+/// (scaled from its linear response, then halved until the reference holds it). Zero where the
+/// run does not move or the reference holds no droop; with the equilibrium the reference holds.
 Droop reference_droop(const sim::Scene& scene, const std::vector<VecX>& run);
 
 /// The check on `scene` (its material: the nominal with the correction to check). The motion
 /// driven kLargerMotion times as hard (sim::amplified_scene) must run to its end, and the
 /// object must hold its droop: the static equilibrium under the body acceleration `droop` alone
-/// (droop_acceleration; none where zero), its prescribed vertices where they start, must be
+/// (reference_droop; none where zero), its prescribed vertices where they start, must be
 /// found: in one increment from `start` (the reference's equilibrium under the same load, close
-/// to a correction's), and else in the scene's load steps from rest. Load steps from rest can
-/// stall where the correction's equilibrium exists: every learned candidate of the full turtle
-/// stalled at 0.70–0.80 of its droop's load in any increments down to 1/40, and held it from the
-/// fitted nominal's equilibrium. A correction learned from one kind of motion is constrained only
-/// along the deformations that motion visits: one learned from a bar's twist can be far too soft in
-/// bending, and finds no equilibrium under a load that bends the bar as far as the twist did.
-/// Where the material must be stable is checked on stretches, not here (Candidate::stability):
-/// a larger droop of a soft shape strains thin parts far beyond any data (s₁ 2.6 on the quick
-/// turtle, trained to 1.32), where no learned correction is trusted. `name` names the motion in
-/// the message.
+/// to a correction's), and else in the scene's load steps from rest, where Newton can stall
+/// short of an equilibrium that exists (docs/benchmarks_learning.md, "The full turtle kept its
+/// fit"). A correction learned from one kind of motion is constrained only along the deformations
+/// that motion visits: one learned from a bar's twist can be far too soft in bending, and finds no
+/// equilibrium under a load that bends the bar as far as the twist did. Where the material must be
+/// stable is checked on stretches, not here (Candidate::stability): a larger droop of a soft shape
+/// strains thin parts far beyond any data (s₁ 2.6 on the quick turtle, trained to 1.32), where no
+/// learned correction is trusted. `name` names the motion in the message.
 LargerMotionCheck check_larger_motion(const sim::Scene& scene, const std::string& name,
     const Vec3& droop = Vec3::Zero(), const VecX& start = {});
 

@@ -280,11 +280,12 @@ CandidatePredictions validate_candidate(
 /// (none past its end).
 void check_candidate_larger_motion(Candidate& c, const Split& split,
     const fem::MaterialModel& nominal, const std::vector<Droop>& droops) {
+  const Droop none;
   for (size_t i = 0; i < split.validation.size(); ++i) {
     const HeldOut& piece = split.validation[i];
     // The first substepped frame of the first motion that needed substeps is kept.
     const int substepped = c.larger_motion.first_substepped_frame;
-    const Droop droop = i < droops.size() ? droops[i] : Droop {};
+    const Droop& droop = i < droops.size() ? droops[i] : none;
     c.larger_motion = check_larger_motion(with_candidate(piece, nominal, c), piece.motion.name,
         droop.acceleration, droop.reference_equilibrium);
     if (substepped > 0)
