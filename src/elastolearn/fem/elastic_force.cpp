@@ -18,6 +18,15 @@ material::PrincipalTangent weighted_sum(
   return { a * A.block + b * B.block, a * A.twist + b * B.twist, a * A.flip + b * B.flip };
 }
 
+/// The tangent without its non-dissipative part: the stretch block's symmetric part (the only one
+/// that does work against a strain rate) and the twist and flip eigenvalues clamped at zero, the
+/// block's antisymmetric part kept. Unchanged wherever the tangent already dissipates.
+material::PrincipalTangent dissipative(const material::PrincipalTangent& t) {
+  const Mat3 symmetric = 0.5 * (t.block + t.block.transpose());
+  return { t.block - symmetric + material::symmetric_psd(symmetric), t.twist.cwiseMax(0.0),
+    t.flip.cwiseMax(0.0) };
+}
+
 } // namespace
 
 ElasticForce::ElasticForce(const mesh::TetMesh& mesh, MaterialModel material, MassType mass)
@@ -80,15 +89,23 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
         F_rate = deformation_gradient(ve, rest);
       const Vec3 rates = need_rates ? material::stretch_rates(c.frame, F_rate) : Vec3::Zero();
       // The element's stress and stiffness damping (material::element_stress states which
-      // stiffness α₁ and Δα₁ damp); the damping tangent is unprojected: the PSD projection is
-      // Newton's device (add_jacobian), and the damping force must stay linear in the correction.
+      // stiffness α₁ and Δα₁ damp). The flip-free damping tangent is taken at its PSD part, so
+      // that the damping dissipates whatever the stiffness: where a corrected tangent is
+      // indefinite, α₁ K v would feed energy in, by α₁/h times that stiffness in a step's
+      // equations, and Newton finds no solution near the step's start. Where the tangent is PSD
+      // (every monotone material in its stable range) this changes nothing, and the learning's
+      // correction forces, linear in the correction, use it unprojected. The exact tangent stays
+      // unprojected: it is standard Rayleigh damping, to match other codes.
       const material::ElementStress stress
           = material::element_stress(element, c.frame.stretches, rates);
       c.stress = stress.corrected();
       c.alpha0 = stress.mass_damping;
       c.has_damping = stress.has_damping();
-      if (c.has_damping)
+      if (c.has_damping) {
         c.damping = material::damping_tangent(c.frame, stress.damped(), m_damping_tangent);
+        if (m_damping_tangent == material::DampingTangent::FlipFree)
+          c.damping = dissipative(c.damping);
+      }
       const Mat3 P = material::element_first_piola(
           c.frame, c.stress.stress, c.has_damping ? &c.damping : nullptr, F_rate);
       Eigen::Map<Eigen::Matrix<double, 3, 4>> force(m_force_buffer.data() + 12 * e);
