@@ -89,13 +89,11 @@ void ElasticForce::add_force(const ForceState& state, VecX& f) {
         F_rate = deformation_gradient(ve, rest);
       const Vec3 rates = need_rates ? material::stretch_rates(c.frame, F_rate) : Vec3::Zero();
       // The element's stress and stiffness damping (material::element_stress states which
-      // stiffness α₁ and Δα₁ damp). The flip-free damping tangent is taken at its PSD part, so
-      // that the damping dissipates whatever the stiffness: where a corrected tangent is
-      // indefinite, α₁ K v would feed energy in, by α₁/h times that stiffness in a step's
-      // equations, and Newton finds no solution near the step's start. Where the tangent is PSD
-      // (every monotone material in its stable range) this changes nothing, and the learning's
-      // correction forces, linear in the correction, use it unprojected. The exact tangent stays
-      // unprojected: it is standard Rayleigh damping, to match other codes.
+      // stiffness α₁ and Δα₁ damp). The flip-free damping tangent is applied at its dissipative
+      // part: where a corrected tangent is indefinite, α₁ K v would feed energy in
+      // (docs/materials.md, "Damping"); elsewhere nothing changes. The learning's correction
+      // forces use it unprojected, linear in the correction; the exact tangent stays as it is,
+      // to match other codes.
       const material::ElementStress stress
           = material::element_stress(element, c.frame.stretches, rates);
       c.stress = stress.corrected();

@@ -37,8 +37,8 @@ struct MaterialModel {
 /// model's, from the element's largest stretch, M_e the element's lumped or consistent mass (the
 /// scene's) and dP_d/dF = α₁ K^d(s_e P̂ + N(σ, 0)) + Δα₁ K^d(s_e P̂), K^d the damping tangent the
 /// damping model names (material::DampingTangent), evaluated at the end-of-step state, the
-/// flip-free one at its PSD part (so that the damping dissipates) and the exact one as it is: the
-/// nominal α₁ damps the *corrected* stiffness, the learned Δα₁ =
+/// flip-free one at its dissipative part (so that the damping dissipates) and the exact one as it
+/// is: the nominal α₁ damps the *corrected* stiffness, the learned Δα₁ =
 /// Correction::stiffness_damping(F̂) (paper Eq. 13; α₁ + Δα₁ kept ≥ 0) the nominal one, so that
 /// the damping force stays linear in the correction's unknowns (learn::correction_force and
 /// learn::CorrectionForceJacobian apply the correction's part of the same kernel).

@@ -18,8 +18,9 @@ struct RayleighCoefficients {
 /// Which stiffness K(x) the α₁ term scales (docs/materials.md, "Damping"):
 /// - FlipFree: the exact tangent of the element's stress at x without its flip eigenvalues
 ///   (P̂ᵢ + P̂ⱼ)/(σᵢ + σⱼ), which leaves the rigid rotation of a stressed element undamped, taken
-///   at its PSD part by the simulator (fem::ElasticForce) so that the damping dissipates for
-///   every material; unchanged for monotone materials, whose tangent is PSD. elastolearn's
+///   at its dissipative part by the simulator (fem::ElasticForce: the symmetric part of its
+///   stretch block and its twists clamped at zero) so that the damping dissipates for every
+///   material; unchanged for monotone materials, whose tangent is PSD. elastolearn's
 ///   default. material::damping_tangent returns it unprojected (linear in the stress), as the
 ///   learning's correction forces use it.
 /// - Exact: the full exact tangent stiffness K(x) = −∂f/∂x at the end-of-step state,
