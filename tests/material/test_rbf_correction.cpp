@@ -361,6 +361,33 @@ TEST(RbfCorrectionEnergy, EqualStretchesGiveEqualStresses) {
   EXPECT_NEAR(rest[0], rest[2], 1e-9 * (rest.norm() + 1));
 }
 
+TEST(RbfCorrectionEnergy, WithoutSmoothingACopyOnTheStretchesAddsNothing) {
+  // ε = 0 and σ a permutation of a centre: that copy's φ = 0 and its subgradient 0, as the scalar
+  // kernel's. The kernels' part is N minus the same correction without kernel weights.
+  RbfCorrection::Parameters p = test_parameters(0.0);
+  p.energy_kernels = true;
+  p.quadratic[1] = 2 * p.quadratic[2];
+  RbfCorrection::Parameters tails_only = p;
+  tails_only.weights.setZero();
+  const RbfCorrection n(p), tails(std::move(tails_only));
+  for (const Vec3& s : { Vec3(1.2, 1.0, 0.9), Vec3(1.0, 0.9, 1.2), Vec3(1.0, 1.0, 1.0) }) {
+    SCOPED_TRACE(testing::Message() << "stretches " << s.transpose());
+    Vec3 want = Vec3::Zero();
+    Mat3 want_tangent = Mat3::Zero();
+    for (Eigen::Index i = 0; i < p.centres.rows(); ++i) {
+      Mat3 h;
+      want += p.weights[i] * energy_kernel_gradient(s, p.centres.row(i).transpose(), 0.0, &h);
+      want_tangent += p.weights[i] * h;
+    }
+    Mat3 ds, dr, tails_ds;
+    const Vec3 got = n.correction_with_gradient(s, Vec3::Zero(), ds, dr)
+        - tails.correction_with_gradient(s, Vec3::Zero(), tails_ds, dr);
+    ASSERT_TRUE(got.allFinite() && ds.allFinite());
+    EXPECT_LE((got - want).norm(), 1e-12 * want.norm());
+    EXPECT_LE((ds - tails_ds - want_tangent).norm(), 1e-12 * want_tangent.norm());
+  }
+}
+
 TEST(RbfCorrectionEnergy, StressKernelsAreNotAnEnergy) {
   // What the energy kernels fix: the stress kernels' tangent is not symmetric in general.
   const RbfCorrection n(test_parameters(0.03));

@@ -51,6 +51,7 @@ void EnergyKernelBank::evaluate_packed(
   // the forward fit's hottest loop).
   using Lanes = Eigen::Array4d;
   const double eps2 = m_epsilon * m_epsilon;
+  const bool smoothed = eps2 > 0;
   for (Eigen::Index first = 0; first < m_size; first += 4) {
     const Lanes cx = m_x.segment<4>(first), cy = m_y.segment<4>(first), cz = m_z.segment<4>(first);
     std::array<Lanes, 3> g;
@@ -63,8 +64,7 @@ void EnergyKernelBank::evaluate_packed(
       const std::array<Lanes, 3> d
           = { stretches[pi[0]] - cx, stretches[pi[1]] - cy, stretches[pi[2]] - cz };
       const Lanes r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2;
-      // ε = 0 at a centre: the subgradient 0, as energy_kernel_gradient.
-      const Lanes inv_phi = (r2 > 0).select(r2.sqrt().inverse(), 0.0);
+      const Lanes inv_phi = inverse_kernels(r2, smoothed); // 0 where ε = 0 at a centre
       for (int j = 0; j < 3; ++j)
         g[pi[j]] += d[j] * inv_phi;
       if constexpr (WithHessians) {

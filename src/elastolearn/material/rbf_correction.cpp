@@ -135,26 +135,8 @@ RbfCorrection::RbfCorrection(Parameters p)
   if (m_p.energy_kernels && !is_energy_quadratic_tail(m_p.quadratic))
     rbf_correction_error("quadratic",
         "is not the gradient of an energy (energy kernels need quadratic[1] = 2 quadratic[2])");
-  if (m_p.energy_kernels) {
-    const Eigen::Index n = 6 * m, padded = (n + 3) / 4 * 4;
-    for (auto* a : { &m_energy_x, &m_energy_y, &m_energy_z, &m_energy_w })
-      a->setZero(padded);
-    Eigen::Index j = 0;
-    for (Eigen::Index i = 0; i < m; ++i)
-      for (const auto& pi : kStretchPermutations) {
-        // ‖P_π σ − c‖ = ‖σ − P_π⁻¹ c‖: component π_l of the copy is c_l.
-        Vec3 copy;
-        for (int l = 0; l < 3; ++l)
-          copy[pi[l]] = m_p.centres(i, l);
-        m_energy_x[j] = copy[0];
-        m_energy_y[j] = copy[1];
-        m_energy_z[j] = copy[2];
-        m_energy_w[j++] = m_p.weights[i];
-      }
-    // Padding: far-away copies with zero weight (a finite distance keeps 1/φ finite).
-    for (; j < padded; ++j)
-      m_energy_x[j] = m_energy_y[j] = m_energy_z[j] = 1e3;
-  }
+  if (m_p.energy_kernels)
+    m_energy_kernels = EnergyKernelCopies(m_p.centres, m_p.weights, m_p.epsilon);
   if (m_p.damping_weights.size() > 0) {
     const Eigen::Index padded = (m + 3) / 4 * 4;
     for (auto* a : { &m_damping_x, &m_damping_y, &m_damping_z, &m_damping_w })
@@ -165,47 +147,6 @@ RbfCorrection::RbfCorrection(Parameters p)
     m_damping_w.head(m) = m_p.damping_weights;
   }
   m_ends = clamp_ends(m_p.trusted, [&](const Vec3& s, Mat3* h) { return formula(s, h); });
-}
-
-Vec3 RbfCorrection::energy_kernels_sum(const Vec3& stretches, Mat3* hessian) const {
-  // Σ_j w_j ∇φ_j = Σ_j w_j d_j/φ_j and Σ_j w_j ∇²φ_j = (Σ_j w_j/φ_j) I − Σ_j (w_j/φ_j³) d_j d_jᵀ
-  // over the permuted copies j (d_j = σ − copy_j), four copies per packed step.
-  using Lanes = Eigen::Array4d;
-  const double eps2 = m_p.epsilon * m_p.epsilon;
-  Lanes gx = Lanes::Zero(), gy = Lanes::Zero(), gz = Lanes::Zero(), diag = Lanes::Zero(),
-        hxx = Lanes::Zero(), hyy = Lanes::Zero(), hzz = Lanes::Zero(), hxy = Lanes::Zero(),
-        hxz = Lanes::Zero(), hyz = Lanes::Zero();
-  for (Eigen::Index j = 0; j < m_energy_w.size(); j += 4) {
-    const Lanes dx = stretches[0] - m_energy_x.segment<4>(j),
-                dy = stretches[1] - m_energy_y.segment<4>(j),
-                dz = stretches[2] - m_energy_z.segment<4>(j);
-    const Lanes r2 = dx * dx + dy * dy + dz * dz + eps2;
-    // ε = 0 at a copy: the subgradient 0 (Eigen's select would not run packed). One division per
-    // copy, 1/φ: the square root and the divisions bound this loop, the simulator's hottest with
-    // a learned correction.
-    const Lanes inv_phi = (r2 > 0).select(r2.sqrt().inverse(), 0.0);
-    const Lanes inv = m_energy_w.segment<4>(j) * inv_phi;
-    gx += inv * dx;
-    gy += inv * dy;
-    gz += inv * dz;
-    if (hessian) {
-      const Lanes inv3 = inv * inv_phi * inv_phi;
-      diag += inv;
-      hxx += inv3 * dx * dx;
-      hyy += inv3 * dy * dy;
-      hzz += inv3 * dz * dz;
-      hxy += inv3 * dx * dy;
-      hxz += inv3 * dx * dz;
-      hyz += inv3 * dy * dz;
-    }
-  }
-  if (hessian) {
-    const double d = diag.sum(), xy = hxy.sum(), xz = hxz.sum(), yz = hyz.sum();
-    *hessian
-        += (Mat3() << d - hxx.sum(), -xy, -xz, -xy, d - hyy.sum(), -yz, -xz, -yz, d - hzz.sum())
-               .finished();
-  }
-  return { gx.sum(), gy.sum(), gz.sum() };
 }
 
 double RbfCorrection::elastic_energy(const Vec3& stretches) const {
@@ -346,7 +287,7 @@ Vec3 RbfCorrection::formula(const Vec3& stretches, Mat3* d_stretches) const {
     for (int k = 0; k < 3; ++k)
       y.col(k) = stretch_view(stretches, k);
     const Vec3 n = elastic_views(y, nullptr);
-    return m_p.energy_kernels ? Vec3(n + energy_kernels_sum(stretches, nullptr)) : n;
+    return m_p.energy_kernels ? Vec3(n + m_energy_kernels.gradient_sum(stretches, nullptr)) : n;
   }
   std::array<std::array<int, 3>, 3> views;
   Mat3 y, d_y;
@@ -360,7 +301,7 @@ Vec3 RbfCorrection::formula(const Vec3& stretches, Mat3* d_stretches) const {
     for (int c = 0; c < 3; ++c)
       (*d_stretches)(k, views[k][c]) += d_y(c, k);
   if (m_p.energy_kernels)
-    n += energy_kernels_sum(stretches, d_stretches);
+    n += m_energy_kernels.gradient_sum(stretches, d_stretches);
   return n;
 }
 

@@ -3,6 +3,7 @@
 /// an isotropic elastic RBF in the principal stretches plus a stretch-dependent correction Δα₁
 /// of the Rayleigh stiffness-damping coefficient. Rationale and conventions: docs/learning.md.
 #include <elastolearn/material/correction.hpp>
+#include <elastolearn/material/energy_kernel_copies.hpp>
 #include <elastolearn/material/trusted_stretches.hpp>
 
 #include <array>
@@ -16,6 +17,16 @@ namespace elastolearn::material {
 /// stretch distance ε, so that N and its gradient are continuous everywhere.
 inline double rbf_kernel(double squared_distance, double epsilon) {
   return std::sqrt(squared_distance + epsilon * epsilon);
+}
+
+/// 1/φ of four kernels from their r² = ‖d‖² + ε², and 0 where r² = 0 (ε = 0 at a centre: the
+/// subgradient 0). With ε > 0 (`smoothed`) r² > 0 everywhere and the square roots and divisions
+/// run packed; Eigen 3.4's select runs coefficient-wise, and so would every operation inside it,
+/// which made these the hottest instructions of a simulation with a learned correction.
+inline Eigen::Array4d inverse_kernels(const Eigen::Array4d& r2, bool smoothed) {
+  if (smoothed)
+    return r2.sqrt().inverse();
+  return (r2 > 0).select(r2.sqrt().inverse(), 0.0);
 }
 
 /// The view of the stretches seen by principal direction k: y_k = (σ_k, max(σ_a, σ_b),
@@ -167,15 +178,12 @@ class RbfCorrection final : public Correction {
   /// The tails' part of h(y) (all but the kernels) and, if d_y is non-null, its ∂/∂y.
   double elastic_tail(const Vec3& y, Vec3* d_y) const;
   /// h(y_k) of the three views y_k = column k of `y` and, if d_y is non-null, column k of *d_y =
-  /// ∂h/∂y at y_k; with energy_kernels the kernels are left out (energy_kernels_sum adds them).
+  /// ∂h/∂y at y_k; with energy_kernels the kernels are left out (m_energy_kernels adds them).
   Vec3 elastic_views(const Mat3& y, Mat3* d_y) const;
-  /// Σ_i w_i ∇S_i(σ) and, if not null, Σ_i w_i ∇²S_i(σ) added to *hessian.
-  Vec3 energy_kernels_sum(const Vec3& stretches, Mat3* hessian) const;
   Parameters m_p;
-  /// Energy kernels as plain kernels in σ-space: S_i(σ) = Σ_π φ(‖σ − P_π⁻¹ c_i‖), so the six
-  /// permuted copies of every centre, with its weight, in structure-of-arrays form padded to a
-  /// multiple of 4 (zero weight) for packed evaluation. Empty for stress kernels.
-  Eigen::ArrayXd m_energy_x, m_energy_y, m_energy_z, m_energy_w;
+  /// The energy kernels, packed: Σ_i w_i ∇S_i(σ) is m_energy_kernels.gradient_sum(σ). Empty for
+  /// stress kernels.
+  EnergyKernelCopies m_energy_kernels;
   /// The damping kernels likewise: centres and damping weights, padded to a multiple of 4 (zero
   /// weight); empty without damping weights.
   Eigen::ArrayXd m_damping_x, m_damping_y, m_damping_z, m_damping_w;
