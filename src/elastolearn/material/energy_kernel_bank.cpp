@@ -1,5 +1,6 @@
 #include <elastolearn/core/error.hpp>
 #include <elastolearn/material/energy_kernel_bank.hpp>
+#include <elastolearn/material/energy_kernel_copies.hpp>
 #include <elastolearn/material/rbf_correction.hpp>
 
 #include <array>

@@ -76,7 +76,14 @@ template <bool WithHessian>
   return { lane_sum(gx), lane_sum(gy), lane_sum(gz) };
 }
 
-const bool k_has_avx = __builtin_cpu_supports("avx");
+/// Whether the CPU and the OS support AVX. This runs among the static initialisers, which may
+/// precede libgcc's own CPU detection, hence __builtin_cpu_init first.
+bool detect_avx() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx");
+}
+
+const bool k_has_avx = detect_avx();
 #else
 constexpr bool k_has_avx = false;
 #endif

@@ -6,6 +6,15 @@
 
 namespace elastolearn::material {
 
+/// 1/φ of four kernels from their r² = ‖d‖² + ε², and 0 where r² = 0 (ε = 0 at a centre: the
+/// subgradient 0). With ε > 0 (`smoothed`) r² > 0 everywhere and the square roots and divisions
+/// run packed; Eigen 3.4's select runs coefficient-wise, and so does every operation inside it.
+inline Eigen::Array4d inverse_kernels(const Eigen::Array4d& r2, bool smoothed) {
+  if (smoothed)
+    return r2.sqrt().inverse();
+  return (r2 > 0).select(r2.sqrt().inverse(), 0.0);
+}
+
 class EnergyKernelCopies {
   public:
   EnergyKernelCopies() = default;

@@ -19,16 +19,6 @@ inline double rbf_kernel(double squared_distance, double epsilon) {
   return std::sqrt(squared_distance + epsilon * epsilon);
 }
 
-/// 1/φ of four kernels from their r² = ‖d‖² + ε², and 0 where r² = 0 (ε = 0 at a centre: the
-/// subgradient 0). With ε > 0 (`smoothed`) r² > 0 everywhere and the square roots and divisions
-/// run packed; Eigen 3.4's select runs coefficient-wise, and so would every operation inside it,
-/// which made these the hottest instructions of a simulation with a learned correction.
-inline Eigen::Array4d inverse_kernels(const Eigen::Array4d& r2, bool smoothed) {
-  if (smoothed)
-    return r2.sqrt().inverse();
-  return (r2 > 0).select(r2.sqrt().inverse(), 0.0);
-}
-
 /// The view of the stretches seen by principal direction k: y_k = (σ_k, max(σ_a, σ_b),
 /// min(σ_a, σ_b)) with a, b the other two directions. y_k is unchanged by swapping a and b.
 Vec3 stretch_view(const Vec3& stretches, int k);
@@ -184,8 +174,8 @@ class RbfCorrection final : public Correction {
   /// The energy kernels, packed: Σ_i w_i ∇S_i(σ) is m_energy_kernels.gradient_sum(σ). Empty for
   /// stress kernels.
   EnergyKernelCopies m_energy_kernels;
-  /// The damping kernels likewise: centres and damping weights, padded to a multiple of 4 (zero
-  /// weight); empty without damping weights.
+  /// The damping kernels: centres and damping weights in structure-of-arrays form, padded to a
+  /// multiple of 4 (zero weight) for packed evaluation; empty without damping weights.
   Eigen::ArrayXd m_damping_x, m_damping_y, m_damping_z, m_damping_w;
   ClampEnds m_ends; ///< what the smooth forms keep beyond the trusted stretches
 };
